@@ -1,0 +1,31 @@
+#!/usr/bin/env bash
+# Installs planarvo's build and test dependencies from Debian 12 packages.
+# Idempotent: packages already present are skipped; apt-get runs only when something is missing.
+set -euo pipefail
+
+packages=(
+  build-essential cmake ninja-build pkg-config git
+  pocl-opencl-icd ocl-icd-opencl-dev opencl-headers opencl-clhpp-headers clinfo
+  libeigen3-dev
+  libopencv-core-dev libopencv-imgproc-dev libopencv-imgcodecs-dev libopencv-videoio-dev
+  libopencv-calib3d-dev libopencv-video-dev
+  libsuitesparse-dev
+  libgtest-dev libgmock-dev
+  python3
+)
+# Benchmark-only peer (issue 3): Ceres Solver. Installed when PLANARVO_BENCH_DEPS=1.
+if [ "${PLANARVO_BENCH_DEPS:-0}" = 1 ]; then packages+=(libceres-dev); fi
+
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -eq 0 ]; then
+  echo "install-deps: all ${#packages[@]} packages present"
+  exit 0
+fi
+echo "install-deps: installing ${missing[*]}"
+if [ "$(id -u)" -ne 0 ]; then SUDO=sudo; else SUDO=; fi
+export DEBIAN_FRONTEND=noninteractive
+$SUDO apt-get update -qq
+$SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"

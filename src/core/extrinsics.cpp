@@ -1,0 +1,66 @@
+#include "core/extrinsics.h"
+
+#include <cmath>
+#include <Eigen/Geometry>
+
+#include "core/error.h"
+
+namespace planarvo {
+
+Eigen::Matrix3d Extrinsics::R0() {
+  Eigen::Matrix3d r;
+  r << 0, -1, 0, -1, 0, 0, 0, 0, -1;
+  return r;
+}
+
+Eigen::Matrix3d Extrinsics::R_vc() const {
+  using Eigen::AngleAxisd;
+  using Eigen::Vector3d;
+  return (AngleAxisd(yaw, Vector3d::UnitZ()) * AngleAxisd(pitch, Vector3d::UnitY()) *
+          AngleAxisd(roll, Vector3d::UnitX()))
+             .toRotationMatrix() *
+         R0();
+}
+
+Eigen::Matrix4d Extrinsics::T_vc() const {
+  Eigen::Matrix4d T = Eigen::Matrix4d::Identity();
+  T.topLeftCorner<3, 3>() = R_vc();
+  T.topRightCorner<3, 1>() = t_vc();
+  return T;
+}
+
+Eigen::Vector3d Extrinsics::plane_normal_camera() const {
+  return R_vc().transpose() * Eigen::Vector3d::UnitZ();
+}
+
+Extrinsics Extrinsics::from_matrix(const Eigen::Matrix4d& T) {
+  const Eigen::Matrix3d R = T.topLeftCorner<3, 3>();
+  if (!((R * R.transpose() - Eigen::Matrix3d::Identity()).norm() < 1e-6) ||
+      !(std::abs(R.determinant() - 1.0) < 1e-6))
+    throw_invalid_argument("T_robot_camera: rotation part is not orthonormal with determinant 1");
+  // M = Rz(yaw) Ry(pitch) Rx(roll) (R0 is its own inverse).
+  const Eigen::Matrix3d M = R * R0().transpose();
+  Extrinsics e;
+  e.pitch = std::asin(std::max(-1.0, std::min(1.0, -M(2, 0))));
+  e.roll = std::atan2(M(2, 1), M(2, 2));
+  e.yaw = std::atan2(M(1, 0), M(0, 0));
+  e.x = T(0, 3);
+  e.y = T(1, 3);
+  e.z = T(2, 3);
+  return e;
+}
+
+Eigen::Matrix3d ground_homography(const Eigen::Matrix3d& K, const Extrinsics& e,
+                                  const Eigen::Matrix4d& robot_motion) {
+  // Camera motion from reference to live, X_l = R X_r + t: T_cl_cr = T_cv * T_vl_vr * T_vc with
+  // T_vl_vr = motion^-1 (the motion is the live pose in the reference robot frame).
+  const Eigen::Matrix4d T_vc = e.T_vc();
+  const Eigen::Matrix4d T_lr = T_vc.inverse() * robot_motion.inverse() * T_vc;
+  const Eigen::Matrix3d R = T_lr.topLeftCorner<3, 3>();
+  const Eigen::Vector3d t = T_lr.topRightCorner<3, 1>();
+  const Eigen::Vector3d n = e.plane_normal_camera();
+  const Eigen::Matrix3d H = K * (R - t * n.transpose() / e.z) * K.inverse();
+  return H / H(2, 2);
+}
+
+}  // namespace planarvo

@@ -1,0 +1,33 @@
+// The camera's pose on the robot, T_vc = (R_vc | t_vc), in the conventions of
+// shared/spec/conventions.md: R_vc = Rz(yaw) Ry(pitch) Rx(roll) R0, with R0 the camera looking
+// straight down, image top towards the robot's front.
+#pragma once
+#include <Eigen/Core>
+
+namespace planarvo {
+
+struct Extrinsics {
+  double x = 0.0, y = 0.0, z = 0.0;           // camera centre in the robot frame, metres
+  double roll = 0.0, pitch = 0.0, yaw = 0.0;  // radians
+
+  Eigen::Matrix3d R_vc() const;
+  Eigen::Vector3d t_vc() const { return {x, y, z}; }
+  Eigen::Matrix4d T_vc() const;
+  // Ground-plane normal in camera coordinates, n_c = R_vc^T (0,0,1): ground points X satisfy
+  // n_c^T X = -z.
+  Eigen::Vector3d plane_normal_camera() const;
+
+  // Recovers the six values from a rigid transform; throws InvalidArgument when the rotation
+  // is not orthonormal.
+  static Extrinsics from_matrix(const Eigen::Matrix4d& T_vc);
+  // R0: camera axes in robot coordinates for roll = pitch = yaw = 0.
+  static Eigen::Matrix3d R0();
+};
+
+// The homography mapping undistorted reference pixels to undistorted live pixels on the ground
+// plane, for the robot's relative motion T_k^-1 T_{k+1} = motion (conventions.md, "Homography
+// between two frames"; the paper's eq. 3). K is the 3x3 camera matrix.
+Eigen::Matrix3d ground_homography(const Eigen::Matrix3d& K, const Extrinsics& e,
+                                  const Eigen::Matrix4d& robot_motion);
+
+}  // namespace planarvo

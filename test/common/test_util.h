@@ -1,0 +1,63 @@
+// Helpers shared by the tests: scratch directories, paths to shared data, running the CLI.
+#pragma once
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <random>
+#include <string>
+
+#include <gtest/gtest.h>
+
+namespace planarvo::test {
+
+inline std::filesystem::path shared_dir() { return PLANARVO_SHARED_DIR; }
+inline std::filesystem::path source_dir() { return PLANARVO_SOURCE_DIR; }
+inline std::filesystem::path texture(const std::string& name) {
+  return shared_dir() / "data" / "textures" / name;
+}
+
+// A fresh, empty directory under the build tree, unique per test, removed on destruction.
+class ScratchDir {
+ public:
+  ScratchDir() {
+    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    std::string name = info ? std::string(info->test_suite_name()) + "." + info->name() : "scratch";
+    for (char& c : name)
+      if (c == '/') c = '_';
+    path_ = std::filesystem::path(PLANARVO_BINARY_DIR) / "test-scratch" / name;
+    std::filesystem::remove_all(path_);
+    std::filesystem::create_directories(path_);
+  }
+  ~ScratchDir() {
+    if (!std::getenv("PLANARVO_KEEP_SCRATCH")) {
+      std::error_code ec;
+      std::filesystem::remove_all(path_, ec);
+    }
+  }
+  const std::filesystem::path& path() const { return path_; }
+  std::filesystem::path operator/(const std::string& s) const { return path_ / s; }
+
+ private:
+  std::filesystem::path path_;
+};
+
+struct CommandResult {
+  int exit_code = -1;
+  std::string output;  // stdout and stderr together
+};
+
+// Runs the planarvo command-line tool with the given arguments (a shell-quoted string).
+inline CommandResult run_cli(const std::string& args) {
+  const std::string cmd = std::string("\"") + PLANARVO_CLI_PATH + "\" " + args + " 2>&1";
+  CommandResult r;
+  FILE* p = popen(cmd.c_str(), "r");
+  if (!p) return r;
+  char buf[4096];
+  size_t n;
+  while ((n = fread(buf, 1, sizeof buf, p)) > 0) r.output.append(buf, n);
+  const int status = pclose(p);
+  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return r;
+}
+
+}  // namespace planarvo::test
