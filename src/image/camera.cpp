@@ -1,0 +1,68 @@
+#include "image/camera.h"
+
+#include <cmath>
+#include <string>
+
+#include <Eigen/Dense>
+
+#include "core/error.h"
+
+namespace planarvo {
+
+Eigen::Matrix3d CameraModel::K() const {
+  Eigen::Matrix3d k;
+  k << fx, 0, cx, 0, fy, cy, 0, 0, 1;
+  return k;
+}
+
+Eigen::Vector2d CameraModel::distort(const Eigen::Vector2d& xn) const {
+  const double x = xn.x(), y = xn.y();
+  const double r2 = x * x + y * y;
+  const double radial = 1.0 + r2 * (k1 + r2 * (k2 + r2 * k3));
+  return {x * radial + 2.0 * p1 * x * y + p2 * (r2 + 2.0 * x * x),
+          y * radial + p1 * (r2 + 2.0 * y * y) + 2.0 * p2 * x * y};
+}
+
+Eigen::Vector2d CameraModel::undistort(const Eigen::Vector2d& xd) const {
+  if (!has_distortion()) return xd;
+  // Newton on distort(x) = xd, started at xd, with the analytic Jacobian of the forward model.
+  Eigen::Vector2d x = xd;
+  for (int it = 0; it < 50; ++it) {
+    const double u = x.x(), v = x.y();
+    const double r2 = u * u + v * v;
+    const double radial = 1.0 + r2 * (k1 + r2 * (k2 + r2 * k3));
+    const double dradial = k1 + r2 * (2.0 * k2 + 3.0 * r2 * k3);  // d radial / d r2
+    Eigen::Matrix2d J;
+    J(0, 0) = radial + 2.0 * u * u * dradial + 2.0 * p1 * v + 6.0 * p2 * u;
+    J(0, 1) = 2.0 * u * v * dradial + 2.0 * p1 * u + 2.0 * p2 * v;
+    J(1, 0) = 2.0 * u * v * dradial + 2.0 * p1 * u + 2.0 * p2 * v;
+    J(1, 1) = radial + 2.0 * v * v * dradial + 6.0 * p1 * v + 2.0 * p2 * u;
+    const Eigen::Vector2d r = distort(x) - xd;
+    const Eigen::Vector2d step = J.partialPivLu().solve(r);
+    x -= step;
+    if (step.squaredNorm() < 1e-30) break;
+  }
+  return x;
+}
+
+Eigen::Vector2d CameraModel::project(const Eigen::Vector3d& X) const {
+  const Eigen::Vector2d d = distort(Eigen::Vector2d(X.x() / X.z(), X.y() / X.z()));
+  return {fx * d.x() + cx, fy * d.y() + cy};
+}
+
+Eigen::Vector2d CameraModel::unproject(const Eigen::Vector2d& pixel) const {
+  return undistort(Eigen::Vector2d((pixel.x() - cx) / fx, (pixel.y() - cy) / fy));
+}
+
+void CameraModel::validate(const char* what) const {
+  const std::string where(what);
+  if (width <= 0 || height <= 0)
+    throw_invalid_input(where + ": image_width and image_height must be positive (got " +
+                        std::to_string(width) + "x" + std::to_string(height) + ")");
+  for (double v : {fx, fy, cx, cy, k1, k2, p1, p2, k3})
+    if (!std::isfinite(v)) throw_invalid_input(where + ": camera parameters contain NaN or inf");
+  if (!(fx > 0) || !(fy > 0))
+    throw_invalid_input(where + ": focal lengths fx, fy must be positive");
+}
+
+}  // namespace planarvo

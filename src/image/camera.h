@@ -1,0 +1,33 @@
+// The pinhole camera with OpenCV's radial-tangential distortion (k1 k2 p1 p2 k3), exactly as
+// cv::undistortPoints / cv::initUndistortRectifyMap define it. Pixel (0,0) is the centre of the
+// top-left pixel. "Normalised" coordinates are (X/Z, Y/Z) of a camera-frame point.
+#pragma once
+#include <Eigen/Core>
+
+namespace planarvo {
+
+struct CameraModel {
+  int width = 0, height = 0;
+  double fx = 0, fy = 0, cx = 0, cy = 0;
+  double k1 = 0, k2 = 0, p1 = 0, p2 = 0, k3 = 0;
+
+  Eigen::Matrix3d K() const;
+  bool has_distortion() const { return k1 != 0 || k2 != 0 || p1 != 0 || p2 != 0 || k3 != 0; }
+
+  // Undistorted normalised -> distorted normalised (OpenCV's forward model).
+  Eigen::Vector2d distort(const Eigen::Vector2d& xn) const;
+  // Distorted normalised -> undistorted normalised, by Newton's method to machine precision
+  // (converges for the distortions real lenses have; see camera.cpp).
+  Eigen::Vector2d undistort(const Eigen::Vector2d& xd) const;
+
+  // Camera-frame point -> distorted pixel.
+  Eigen::Vector2d project(const Eigen::Vector3d& X) const;
+  // Distorted pixel -> undistorted normalised coordinates (the ray (x, y, 1)).
+  Eigen::Vector2d unproject(const Eigen::Vector2d& pixel) const;
+
+  // Throws InvalidInput (naming `what`, e.g. the file) when sizes or focal lengths are not
+  // positive or a value is not finite.
+  void validate(const char* what) const;
+};
+
+}  // namespace planarvo
