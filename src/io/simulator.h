@@ -1,0 +1,216 @@
+// The simulator: renders test sequences of a downward-looking camera on a differential-drive
+// robot over a textured ground plane, with exact ground truth (see src/io/SIMULATOR.md).
+//
+// Geometry follows shared/spec/conventions.md: robot pose T_wv in SE(2), camera pose
+// T_wc = T_wv * T_vc, ground plane z = 0. The ground texture is the photograph tiled over the
+// whole plane by mirroring (period two texture sizes along each axis); world point (X, Y) is at
+// texture coordinates (u, v) = (X / texel_size, Y / texel_size), integer (u, v) at texel
+// centres, texel (0, 0) centred on the world origin.
+#pragma once
+#include <array>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <random>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+#include <opencv2/core.hpp>
+
+#include "core/extrinsics.h"
+#include "core/se2.h"
+#include "image/camera.h"
+
+namespace planarvo::ocl {
+class Runtime;
+}
+
+namespace planarvo::sim {
+
+enum class MotionProfile {
+  Mixed,     // forward and backward driving, turns both ways, turning in place, stops
+  Straight,  // forwards and backwards along one line
+  Circle,    // one constant-curvature circle
+  Spin,      // turning in place
+};
+
+// The paper's camera configuration 1: x 0.2441, y -0.0185, z 0.1787 m, roll 12.4, pitch 17.6,
+// yaw -9.2 degrees.
+Extrinsics default_extrinsics();
+// width x height pixels with a horizontal field of view of fov_deg measured on the distorted
+// image (the centres of the outermost pixel columns are fov_deg apart), mild barrel distortion
+// k1 = -0.12, k2 = 0.03, principal point a little off the image centre as real lenses have.
+CameraModel default_camera(int width = 640, int height = 480, double fov_deg = 80.0);
+
+struct Options {
+  std::string texture;          // path of the ground photograph (any cv::imread format)
+  double texel_size = 0.0004;   // metres per texture pixel
+  Extrinsics extrinsics = default_extrinsics();
+  CameraModel camera = default_camera();
+  double seconds = 10.0;        // sequence length: round(seconds * fps) frames at t = k / fps
+  double fps = 30.0;
+  uint64_t seed = 1;
+  MotionProfile motion = MotionProfile::Mixed;
+  double max_speed = 0.8;           // peak |v|, m/s
+  double max_turn_rate = 1.5;       // peak |omega|, rad/s
+  double max_acceleration = 1.5;    // bound on |dv/dt|, m/s^2
+  double max_angular_acceleration = 4.0;  // bound on |domega/dt|, rad/s^2
+  SE2 start_pose;                   // the robot's true pose at the first frame
+  double pixel_noise = 1.0;         // standard deviation of additive noise, grey levels
+  double gain_variation = 0.05;     // amplitude of the slow gain change, relative
+  double odometry_noise = 0.01;     // relative standard deviation of each wheel's travel
+  double odometry_noise_floor = 1e-6;  // absolute floor of that standard deviation, metres
+  double wheel_base = 0.33;         // distance between the wheels, metres (a Pioneer 3-DX)
+  int supersampling = 3;            // samples per pixel along each axis
+  bool mipmap = true;               // prefilter the texture (off only for tests/references)
+  // Called with the fraction done and the stage; return false to cancel (Error Cancelled).
+  std::function<bool(double, const char*)> progress;
+};
+
+// Throws InvalidArgument naming the first bad value.
+void validate(const Options& options);
+
+// Frame times, true poses, per-interval velocities and direction labels, wheel odometry.
+struct Trajectory {
+  std::vector<double> t;                   // N frame times
+  std::vector<SE2> pose;                   // N true robot poses T_wv
+  std::vector<Eigen::Vector2d> velocity;   // N-1: (v, omega), constant over interval k..k+1
+  std::vector<int> direction;              // N-1: sign of v, 0 when v == 0
+  std::vector<SE2> odometry;               // N wheel-odometry poses (odometry frame = world)
+};
+
+// Pure and deterministic for a seed. Velocities are held constant over each frame interval
+// (a controller commanding at the frame rate), so each interval is an exact arc:
+// pose[k+1] = pose[k] * SE2::exp((v dt, 0, omega dt)).
+Trajectory generate_trajectory(const Options& options);
+
+// ---------------------------------------------------------------------------------------------
+// Rendering. The texture is prefiltered into a float mip pyramid; every output pixel averages
+// supersampling^2 subsamples, each a trilinear lookup at the level matching the subsample's
+// footprint on the ground. The OpenCL kernel (kernels/render.cl) and render_reference() below
+// compute the same float arithmetic from the same tables.
+
+// Float mip pyramid of a texture whose sides are powers of two: level 0 is the texture, level
+// l+1 the 2x2 box average of level l, down to a side of 1. Box blocks never straddle the
+// mirror lines, so each level mirror-tiles exactly like the texture.
+struct MipPyramid {
+  int width = 0, height = 0;     // level 0
+  std::vector<float> data;       // all levels, row-major, one after another
+  std::vector<int> levels;       // per level: offset into data, width, height
+  float mean = 0.0f;             // of level 0
+  int num_levels() const { return static_cast<int>(levels.size() / 3); }
+};
+// texture: CV_8UC1 or CV_32FC1 with power-of-two sides (see prepare_texture).
+MipPyramid build_mip_pyramid(const cv::Mat& texture);
+
+// A grey texture resized to the nearest power-of-two sides (unchanged when they already are),
+// as CV_32FC1; texel_scale gets the factors (old size / new size) along x and y, by which the
+// physical texel size grows.
+cv::Mat prepare_texture(const cv::Mat& texture, Eigen::Vector2d* texel_scale);
+
+// Per-camera ray tables, computed once in double with CameraModel::unproject, stored as float
+// planes (plane-major so neighbouring work-items read neighbouring floats):
+//   pixel: 6 planes of width*height: undistorted normalised ray (x, y) of the pixel centre and
+//          the Jacobian d(x, y)/d(pixel) (row-major 2x2) there;
+//   sub:   2 * S*S planes: the ray (x, y) of each subsample; subsample (i, j) of pixel (c, r)
+//          sits at (c + (i + 0.5)/S - 0.5, r + (j + 0.5)/S - 0.5), plane pair j*S + i.
+struct RayTable {
+  int width = 0, height = 0, supersampling = 1;
+  std::vector<float> pixel;
+  std::vector<float> sub;
+};
+RayTable build_ray_table(const CameraModel& camera, int supersampling);
+
+// The per-frame parameter block the kernel reads as __constant float*.
+enum RenderParam {
+  kParamH = 0,            // 9: homography, undistorted ray (x, y, 1) -> texture coordinates
+  kParamInvS = 9,         // 1 / supersampling: a subsample's share of the pixel
+  kParamLodMax = 10,      // highest mip level used (0: no mip-mapping)
+  kParamFar = 11,         // value of rays that miss the ground or land absurdly far
+  kParamInvCount = 12,    // 1 / supersampling^2
+  kParamCount = 16
+};
+using FrameParams = std::array<float, kParamCount>;
+
+// Maps undistorted rays (x, y, 1) of the camera at robot pose T_wv to homogeneous texture
+// coordinates relative to `origin` (texels). texel = physical size of a texel along u and v.
+Eigen::Matrix3d ray_to_texture(const SE2& robot_pose, const Extrinsics& extrinsics,
+                               const Eigen::Vector2d& texel, const Eigen::Vector2d& origin);
+
+// The parameter block for one frame. The homography is taken relative to an origin shifted
+// by a whole number of mirror periods (2 texture sizes) close to the camera, which leaves the
+// tiling unchanged and keeps the float texture coordinates small however far the robot goes.
+FrameParams frame_params(const SE2& robot_pose, const Extrinsics& extrinsics,
+                         const Eigen::Vector2d& texel, const MipPyramid& pyramid,
+                         int supersampling, bool mipmap);
+
+// The plain C++ reference of the render kernel: CV_32FC1, grey levels.
+cv::Mat render_reference(const MipPyramid& pyramid, const RayTable& rays, const FrameParams& p);
+
+class Renderer {
+ public:
+  // texture: a grey image (CV_8UC1 or CV_32FC1), any size (see prepare_texture). Uses
+  // options.camera, extrinsics, texel_size, supersampling and mipmap.
+  Renderer(ocl::Runtime& runtime, const cv::Mat& texture, const Options& options);
+  ~Renderer();
+  Renderer(const Renderer&) = delete;
+  Renderer& operator=(const Renderer&) = delete;
+
+  // The noise-free, gain-free image at a robot pose: CV_32FC1 grey levels, or rounded CV_8UC1.
+  cv::Mat render_float(const SE2& robot_pose);
+  cv::Mat render(const SE2& robot_pose);
+
+  const MipPyramid& pyramid() const;
+  const RayTable& rays() const;
+  FrameParams params(const SE2& robot_pose) const;
+  // Texel size along u and v in metres (texel_size times the prepare_texture scale).
+  Eigen::Vector2d texel() const;
+  // The OpenCL build options of the render program (registered with the Runtime).
+  static std::string build_options();
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+// ---------------------------------------------------------------------------------------------
+// The camera: slow smooth gain change, additive Gaussian noise, 8-bit quantisation.
+
+// Per frame: gain 1 + a g(t) and offset 60 a o(t) grey levels, a = gain_variation, where g and
+// o are smooth random curves in [-1, 1] made of slow sinusoids (periods of 3 to 20 s) with
+// random phases.
+struct Exposure {
+  double gain = 1.0, offset = 0.0;
+};
+std::vector<Exposure> exposure_series(const Options& options, const std::vector<double>& t);
+// round(clamp(gain * image + offset + noise)), noise ~ N(0, sigma^2) per pixel from a generator
+// seeded with frame_seed. image: CV_32FC1; returns CV_8UC1.
+cv::Mat apply_camera(const cv::Mat& image, const Exposure& exposure, double sigma,
+                     uint64_t frame_seed);
+
+// Deterministic random numbers, the same on every platform (std::mt19937_64 with explicit
+// conversions; no std:: distributions).
+class Random {
+ public:
+  explicit Random(uint64_t seed) : g_(seed) {}
+  double uniform() { return static_cast<double>(g_() >> 11) * 0x1.0p-53; }  // [0, 1)
+  double uniform(double a, double b) { return a + (b - a) * uniform(); }
+  double normal();  // standard normal, Box-Muller
+  int sign() { return uniform() < 0.5 ? -1 : 1; }
+
+ private:
+  std::mt19937_64 g_;
+  double spare_ = 0.0;
+  bool has_spare_ = false;
+};
+// A well-mixed 64-bit seed for stream `stream` of a user seed (splitmix64).
+uint64_t derive_seed(uint64_t seed, uint64_t stream);
+
+// ---------------------------------------------------------------------------------------------
+// Renders the whole data set into out_dir (created if missing): camera.yaml, images/NNNNNN.png,
+// frames.txt, odometry.txt, direction.txt, groundtruth.txt, extrinsics_gt.yaml, and
+// simulation.yaml recording the options.
+void simulate(ocl::Runtime& runtime, const Options& options, const std::string& out_dir);
+
+}  // namespace planarvo::sim
