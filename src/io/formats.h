@@ -42,10 +42,12 @@ struct DirectionLabel {
 std::vector<DirectionLabel> read_direction(const std::string& path);
 void write_direction(const std::string& path, const std::vector<DirectionLabel>& labels);
 
-// frames.txt: "timestamp relative/path" per line, '#' comments.
+// frames.txt: "timestamp relative/path" per line, '#' comments. The path is everything after
+// the whitespace that follows the timestamp, trimmed, so it may contain inner spaces.
 struct FrameEntry {
   double t;
   std::string path;  // as written in frames.txt, relative to the data set directory
+  int line = 0;      // its line in frames.txt (0 when it did not come from a file), for messages
 };
 std::vector<FrameEntry> read_frames(const std::string& path);
 void write_frames(const std::string& path, const std::vector<FrameEntry>& frames);
