@@ -119,7 +119,6 @@ class VideoSource {
     bool usable = true;
     for (size_t i = 0; i < msec.size(); ++i)
       if (!std::isfinite(msec[i]) || (i > 0 && !(msec[i] > msec[i - 1]))) usable = false;
-    if (msec.size() == 1 && !std::isfinite(msec[0])) usable = false;
     if (usable) {
       const double shift = time_after_frame && fps > 0 ? 1000.0 / fps : 0.0;
       for (double m : msec) times_.push_back((m - shift) / 1000.0);
