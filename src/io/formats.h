@@ -1,7 +1,12 @@
 // The files users already have (shared/spec/formats.md): OpenCV calibration YAML, extrinsics
-// YAML, TUM trajectories, direction labels, per-frame statistics CSV. Every reader names the
-// file, and the line where one applies, in its InvalidInput errors; every writer throws
-// Error(Io) naming the file when it cannot write.
+// YAML, TUM trajectories, direction labels, frames.txt (the statistics CSV is in stats.h).
+// Every reader names the file, and the line where one applies ("file:line: ..."), in its
+// InvalidInput errors: wrong field count, unparsable number, NaN or inf, non-increasing
+// timestamps, a bad label. Text readers skip blank lines and lines starting with '#', and accept
+// CRLF. Every writer throws Error(Io) naming the file when it cannot write, and
+// Error(InvalidArgument) for values its reader would reject (non-finite, non-increasing times),
+// so that what we write always reads back. Numbers are written locale-independently: timestamps
+// with 9 decimals, everything else in the shortest form that reads back to the same double.
 #pragma once
 #include <string>
 #include <vector>
@@ -14,6 +19,10 @@
 
 namespace planarvo::io {
 
+// image_width, image_height, camera_matrix (3x3, no skew), distortion_coefficients (1x4, 1x5,
+// 4x1 or 5x1: k1 k2 p1 p2 [k3]; 8, 12 or 14 are accepted when the coefficients past k3 are all
+// zero). Other keys (OpenCV's sample writes many) are ignored. Written as the sample does, with
+// a 5x1 distortion vector.
 CameraModel read_camera_yaml(const std::string& path);
 void write_camera_yaml(const std::string& path, const CameraModel& camera);
 
@@ -24,6 +33,9 @@ struct ExtrinsicsFile {
   std::string method;
   std::string notes;
 };
+// x y z roll pitch yaw are required; T_robot_camera (checked against them to 1e-6 per entry),
+// covariance (6x6), estimated (a sequence of those six names, no repeats), method and notes
+// (strings) are optional. The writer writes every key.
 ExtrinsicsFile read_extrinsics_yaml(const std::string& path);
 void write_extrinsics_yaml(const std::string& path, const ExtrinsicsFile& e);
 
@@ -31,10 +43,12 @@ struct StampedPose {
   double t;
   SE2 pose;
 };
-// TUM: "t x y z qx qy qz qw"; planar poses only (z = 0, rotation about z), else InvalidInput.
+// TUM: "t x y z qx qy qz qw"; planar poses only: |z| and the normalised |qx|, |qy| at most 1e-6,
+// else InvalidInput. The quaternion need not be normalised; yaw = 2 atan2(qz, qw), wrapped.
 std::vector<StampedPose> read_tum(const std::string& path);
 void write_tum(const std::string& path, const std::vector<StampedPose>& poses);
 
+// direction.txt: "t s" per line, s one of +1, -1, 0 (written "1.0" or "-0" also read).
 struct DirectionLabel {
   double t;
   int sign;  // +1, -1, 0 for the interval from the previous timestamp to t
@@ -42,10 +56,12 @@ struct DirectionLabel {
 std::vector<DirectionLabel> read_direction(const std::string& path);
 void write_direction(const std::string& path, const std::vector<DirectionLabel>& labels);
 
-// frames.txt: "timestamp relative/path" per line, '#' comments.
+// frames.txt: "timestamp relative/path" per line, '#' comments. The path is everything after
+// the whitespace that follows the timestamp, trimmed, so it may contain inner spaces.
 struct FrameEntry {
   double t;
   std::string path;  // as written in frames.txt, relative to the data set directory
+  int line = 0;      // its line in frames.txt (0 when it did not come from a file), for messages
 };
 std::vector<FrameEntry> read_frames(const std::string& path);
 void write_frames(const std::string& path, const std::vector<FrameEntry>& frames);

@@ -1,6 +1,6 @@
 // src/ocl owns everything OpenCL: device selection, program build (from the embedded sources,
 // the on-disk program cache, or prebuilt binaries), and the command queue. Other layers ask a
-// Runtime for programs by name and never call clBuildProgram themselves.
+// Runtime for programs by name and never call clBuildProgram themselves. See README.md.
 #pragma once
 #include <cstdint>
 #include <map>
@@ -34,20 +34,43 @@ struct DeviceInfo {
 
 struct RuntimeOptions {
   // Which device: "" picks the default (first GPU or accelerator, else the first device), an
-  // integer picks by global index, anything else is a case-insensitive substring of
-  // "platform name / device name". When empty, the environment variable PLANARVO_DEVICE is used.
+  // integer picks by global index, "gpu", "cpu" or "accelerator" pick the first device of that
+  // type, anything else is a case-insensitive substring of "platform name / device name /
+  // platform version" (the platform version is where e.g. "PoCL" or "CUDA" shows). When
+  // empty, the environment variable PLANARVO_DEVICE is used.
   std::string device;
   // On-disk program cache; "" means $PLANARVO_CACHE_DIR, else $XDG_CACHE_HOME/planarvo, else
-  // ~/.cache/planarvo. Set use_cache = false to always build from source.
+  // ~/.cache/planarvo. Set use_cache = false to always build from source. A cache directory
+  // that cannot be created or written is not an error: programs are then simply not cached.
   std::string cache_dir;
   bool use_cache = true;
   // When set, programs are loaded from prebuilt binaries in this directory
-  // (clCreateProgramWithBinary) and never compiled; see export_binaries().
+  // (clCreateProgramWithBinary) and never compiled; see export_binaries() and README.md for
+  // the directory's manifest, kManifestFileName.
   std::string binaries_dir;
 };
 
+// Where each program a Runtime handed out came from; tests use it to tell a cache hit from a
+// miss.
+struct ProgramStats {
+  int built_from_source = 0;     // compiled from the embedded source
+  int loaded_from_cache = 0;     // loaded from the on-disk program cache
+  int loaded_from_binaries = 0;  // loaded from RuntimeOptions::binaries_dir
+  int cache_rejected = 0;        // cache entries that existed but were corrupt, stale or
+                                 // refused by the driver (each was then rebuilt from source)
+  int cache_write_failures = 0;  // built programs whose cache entry could not be written
+};
+
+// The manifest that export_binaries() writes and RuntimeOptions::binaries_dir reads.
+inline constexpr const char* kManifestFileName = "planarvo-kernels.txt";
+
+// The name of the embedded program that is a prelude to all others (kernels/common.cl), never
+// a program by itself.
+inline constexpr const char* kPreludeName = "common";
+
 // Every platform's devices, in the order `planarvo devices` lists them. Never throws for a
-// machine without OpenCL: returns an empty list.
+// machine without OpenCL: returns an empty list. A platform or device that cannot be queried
+// is left out.
 std::vector<DeviceInfo> list_devices();
 
 class Runtime {
@@ -64,19 +87,38 @@ class Runtime {
   cl::CommandQueue& queue() { return queue_; }
 
   // The program built from kernels/<name>.cl with the given build options ("-D WG=64 ..."),
-  // memoised per (name, options). Throws Error(OpenCL) with the build log on failure.
+  // memoised per (name, normalised options). Thread-safe. Adds -cl-std=CL1.2 on devices whose
+  // OpenCL C is 1.2 or newer. Throws Error(OpenCL) with the build log on failure; with
+  // binaries_dir set, Error(InvalidInput or OpenCL) naming the program, options, device and
+  // directory when no usable binary is there.
   cl::Program& program(const std::string& name, const std::string& options = "");
 
-  // Writes prebuilt binaries of every embedded program, built with the options that the
-  // engine's layers register for it (register_build_options), into dir.
+  // Writes prebuilt binaries of every embedded program (except the prelude), built with the
+  // options that the engine's layers register for it (register_build_options; "" for a
+  // program with none registered), into dir, and adds them to dir's manifest. Always builds
+  // from source (or the program cache), never from binaries_dir. Throws Error(Io) when dir
+  // cannot be written, Error(OpenCL) when a build fails.
   void export_binaries(const std::string& dir);
 
   // Layers declare the build options they will use for a program, so that export_binaries()
-  // can build exactly those variants. Idempotent.
+  // can build exactly those variants. Idempotent; thread-safe.
   static void register_build_options(const std::string& program, const std::string& options);
+  // The normalised option sets registered for a program, sorted.
+  static std::vector<std::string> registered_build_options(const std::string& program);
+
+  ProgramStats stats() const;
+  // The program cache directory in use; "" when caching is off.
+  const std::string& cache_dir() const { return cache_dir_; }
+  // The options a program is actually built with: the normalised options plus what the
+  // device needs (-cl-std=CL1.2).
+  std::string effective_build_options(const std::string& options) const;
 
  private:
   cl::Program build(const std::string& name, const std::string& options);
+  cl::Program build_from_source(const std::string& name, const std::string& source,
+                                const std::string& effective_options);
+  cl::Program load_from_binaries(const std::string& name, const std::string& options);
+  cl::Program build_with_cache(const std::string& name, const std::string& options);
 
   RuntimeOptions options_;
   DeviceInfo info_;
@@ -84,9 +126,27 @@ class Runtime {
   cl::Device device_;
   cl::Context context_;
   cl::CommandQueue queue_;
-  std::mutex mutex_;
+  mutable std::mutex mutex_;
   std::map<std::string, cl::Program> programs_;
+  std::string cache_dir_;
+  ProgramStats stats_;
 };
+
+// The source a program is built from: the prelude kernels/common.cl (when the library embeds
+// one) followed by kernels/<name>.cl, each behind a #line directive so that compiler messages
+// name the right file and line. Throws Error(Internal) for a name that is not embedded.
+std::string program_source(const std::string& name);
+// The composition program_source() uses, for any prelude ("" for none).
+std::string compose_program_source(const std::string& prelude, const std::string& name,
+                                   const std::string& source);
+
+// Build options in the one spelling that memoisation, the cache and the manifest compare:
+// leading and trailing whitespace removed, each run of whitespace outside double quotes
+// replaced by one space.
+std::string normalize_build_options(const std::string& options);
+
+// FNV-1a 64 of the bytes of s (the manifest's options hash, and the cache's key hashes).
+uint64_t fnv1a64(const std::string& s);
 
 // "CL_INVALID_VALUE" etc. for an OpenCL error code.
 const char* error_name(cl_int code);

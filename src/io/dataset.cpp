@@ -1,0 +1,395 @@
+// Data set reading. Images are decoded on demand (all of them at open with verify_images).
+//
+// Video: frames come from cv::VideoCapture. Opening scans the whole file once with grab(), to
+// count the frames and take each frame's time (CAP_PROP_POS_MSEC; index / fps when the
+// container has no usable times); FFmpeg decodes in grab(), so opening costs about one decode
+// of the video. Frames read in order (i, i+1, ...) cost one decode each, and the last
+// kVideoCacheSize decoded frames are kept, so that re-reading a recent frame is free. Reading
+// an earlier frame that is no longer cached reopens the file and grabs forward to it: O(i)
+// decodes. Seeking (CAP_PROP_POS_FRAMES) is not used, because it is inexact for codecs with
+// inter frames in some backends.
+#include "io/dataset.h"
+
+#include <algorithm>
+#include <cmath>
+#include <deque>
+#include <filesystem>
+#include <utility>
+
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <opencv2/videoio.hpp>
+#include <opencv2/videoio/registry.hpp>
+
+#include "core/error.h"
+#include "io/text.h"
+
+namespace planarvo::io {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+constexpr size_t kVideoCacheSize = 4;
+
+class Progress {
+ public:
+  explicit Progress(const ProgressCallback& cb) : cb_(cb) {}
+  void report(double fraction, const char* stage) const {
+    if (cb_ && !cb_(std::clamp(fraction, 0.0, 1.0), stage))
+      throw Error(ErrorCode::Cancelled, std::string("opening the data set was cancelled while ") + stage);
+  }
+
+ private:
+  const ProgressCallback& cb_;
+};
+
+std::string size_text(int w, int h) { return std::to_string(w) + "x" + std::to_string(h); }
+
+// An 8-bit image of any channel count to CV_8UC1 of the camera's size; `name` and `context`
+// (e.g. "frame 3, frames.txt:5") go into the messages.
+cv::Mat to_grey_checked(const cv::Mat& img, const CameraModel& camera, const std::string& name,
+                        const std::string& context) {
+  if (img.depth() != CV_8U)
+    throw_invalid_input(name + ": " + (img.depth() == CV_16U ? "a 16-bit" : "a non-8-bit") +
+                        " image (" + context + "); planarvo reads 8-bit grey or colour images, "
+                        "convert it to 8 bits first");
+  if (img.cols != camera.width || img.rows != camera.height)
+    throw_invalid_input(name + ": " + size_text(img.cols, img.rows) + " pixels (" + context +
+                        "), but camera.yaml says " + size_text(camera.width, camera.height));
+  cv::Mat grey;
+  switch (img.channels()) {
+    case 1: grey = img; break;
+    case 2: cv::extractChannel(img, grey, 0); break;  // grey + alpha
+    case 3: cv::cvtColor(img, grey, cv::COLOR_BGR2GRAY); break;
+    case 4: cv::cvtColor(img, grey, cv::COLOR_BGRA2GRAY); break;
+    default:
+      throw_invalid_input(name + ": an image with " + std::to_string(img.channels()) +
+                          " channels (" + context + ")");
+  }
+  return grey;
+}
+
+cv::Mat read_image(const fs::path& file, const CameraModel& camera, const std::string& context) {
+  const std::string name = file.string();
+  std::error_code ec;
+  if (!fs::exists(file, ec)) throw_invalid_input(name + ": the image does not exist (" + context + ")");
+  cv::Mat img;
+  try {
+    // ANYDEPTH so that 16-bit images are seen (and rejected) rather than silently scaled;
+    // ANYCOLOR keeps grey images one channel. EXIF orientation is applied, as by cv::imread's
+    // default, so images look as they did to the calibration.
+    img = cv::imread(name, cv::IMREAD_ANYDEPTH | cv::IMREAD_ANYCOLOR);
+  } catch (const cv::Exception& e) {
+    throw_invalid_input(name + ": the image cannot be decoded (" + context + "): " + e.err);
+  }
+  if (img.empty())
+    throw_invalid_input(name + ": the image cannot be decoded (" + context + ")");
+  return to_grey_checked(img, camera, name, context);
+}
+
+// The frames of a video file, with the cost model described at the top of this file.
+class VideoSource {
+ public:
+  VideoSource(std::string path, const CameraModel& camera, bool verify, const Progress& progress,
+              double progress_from)
+      : path_(std::move(path)), camera_(camera) {
+    std::error_code ec;
+    if (!fs::exists(path_, ec)) throw_invalid_input(path_ + ": the video does not exist");
+    open_first_backend();
+    const double fps = cap_.get(cv::CAP_PROP_FPS);
+    const double count_hint = cap_.get(cv::CAP_PROP_FRAME_COUNT);
+    // OpenCV's own MJPEG reader reports the time after the grabbed frame, not its start.
+    const bool time_after_frame = cap_.getBackendName() == "CV_MJPEG";
+    std::vector<double> msec;
+    while (cap_.grab()) {
+      const int64_t i = static_cast<int64_t>(msec.size());
+      msec.push_back(cap_.get(cv::CAP_PROP_POS_MSEC));
+      // The first frame is always decoded: a size mismatch is found at open, and it is cached
+      // for the first read.
+      if (verify || i == 0) remember(i, retrieve(i));
+      // The container's frame count is a hint (it may be missing or wrong), so never 1 here.
+      const double done = count_hint > 0 ? std::min(0.99, static_cast<double>(i + 1) / count_hint) : 0.0;
+      progress.report(progress_from + (1.0 - progress_from) * done,
+                      verify ? "decoding video" : "scanning video");
+    }
+    next_ = static_cast<int64_t>(msec.size());
+    if (msec.empty()) throw_invalid_input(path_ + ": the video has no frames that can be read");
+
+    bool usable = true;
+    for (size_t i = 0; i < msec.size(); ++i)
+      if (!std::isfinite(msec[i]) || (i > 0 && !(msec[i] > msec[i - 1]))) usable = false;
+    if (usable) {
+      const double shift = time_after_frame && fps > 0 ? 1000.0 / fps : 0.0;
+      for (double m : msec) times_.push_back((m - shift) / 1000.0);
+    } else if (std::isfinite(fps) && fps > 0) {
+      for (size_t i = 0; i < msec.size(); ++i) times_.push_back(static_cast<double>(i) / fps);
+    } else {
+      throw_invalid_input(path_ + ": the video has neither increasing frame times nor a frame rate");
+    }
+  }
+
+  const std::vector<double>& times() const { return times_; }
+
+  cv::Mat frame(int64_t i) {
+    for (const auto& [index, image] : cache_)
+      if (index == i) return image;
+    if (i < next_) {
+      open(api_);
+      next_ = 0;
+    }
+    for (; next_ < i; ++next_)
+      if (!cap_.grab()) fail_read(next_);
+    if (!cap_.grab()) fail_read(i);
+    next_ = i + 1;
+    cv::Mat grey = retrieve(i);
+    remember(i, grey);
+    return grey;
+  }
+
+  std::string name(int64_t i) const { return path_ + " frame " + std::to_string(i); }
+
+ private:
+  // FFmpeg, else OpenCV's own MJPEG reader; other backends only when neither is built in.
+  // (CAP_ANY would also try GStreamer and image sequences, which log errors for a bad file.)
+  void open_first_backend() {
+    std::vector<int> apis;
+    for (cv::VideoCaptureAPIs api : {cv::CAP_FFMPEG, cv::CAP_OPENCV_MJPEG})
+      if (cv::videoio_registry::hasBackend(api)) apis.push_back(api);
+    if (apis.empty()) apis.push_back(cv::CAP_ANY);
+    for (int api : apis)
+      if (try_open(api)) {
+        api_ = api == cv::CAP_ANY ? static_cast<int>(cap_.get(cv::CAP_PROP_BACKEND)) : api;
+        return;
+      }
+    throw_invalid_input(path_ + ": the video cannot be opened (not a video OpenCV's FFmpeg or "
+                        "MJPEG reader can decode)");
+  }
+
+  bool try_open(int api) {
+    cap_.release();
+    try {
+      return cap_.open(path_, api) && cap_.isOpened();
+    } catch (const cv::Exception&) {
+      return false;
+    }
+  }
+
+  void open(int api) {
+    if (!try_open(api)) throw_invalid_input(path_ + ": the video cannot be opened again");
+  }
+
+  cv::Mat retrieve(int64_t i) {
+    cv::Mat img;
+    if (!cap_.retrieve(img) || img.empty())
+      throw_invalid_input(path_ + ": frame " + std::to_string(i) + " of the video cannot be decoded");
+    cv::Mat grey = to_grey_checked(img, camera_, path_, "frame " + std::to_string(i));
+    return grey.data == img.data ? grey.clone() : grey;  // the capture reuses its buffer
+  }
+
+  void remember(int64_t i, const cv::Mat& image) {
+    if (cache_.size() == kVideoCacheSize) cache_.pop_front();
+    cache_.emplace_back(i, image);
+  }
+
+  [[noreturn]] void fail_read(int64_t i) const {
+    throw_invalid_input(path_ + ": frame " + std::to_string(i) +
+                        " of the video cannot be read (did the file change after it was opened?)");
+  }
+
+  std::string path_;
+  CameraModel camera_;
+  cv::VideoCapture cap_;
+  int api_ = cv::CAP_ANY;
+  int64_t next_ = 0;  // the index the next grab() returns
+  std::vector<double> times_;
+  std::deque<std::pair<int64_t, cv::Mat>> cache_;
+};
+
+}  // namespace
+
+std::optional<SE2> interpolate_pose(const std::vector<StampedPose>& samples, double t) {
+  if (samples.empty() || !(t >= samples.front().t) || !(t <= samples.back().t)) return std::nullopt;
+  const auto it = std::lower_bound(samples.begin(), samples.end(), t,
+                                   [](const StampedPose& s, double v) { return s.t < v; });
+  if (it->t == t) return it->pose;
+  const StampedPose& a = *(it - 1);
+  const StampedPose& b = *it;
+  return interpolate_linear(a.pose, b.pose, (t - a.t) / (b.t - a.t));
+}
+
+std::optional<int> direction_at(const std::vector<DirectionLabel>& labels, double t) {
+  // The first label with t_k >= t: its interval (t_{k-1}, t_k] contains t.
+  const auto it = std::lower_bound(labels.begin(), labels.end(), t,
+                                   [](const DirectionLabel& l, double v) { return l.t < v; });
+  if (it == labels.end()) return std::nullopt;
+  return it->sign;
+}
+
+struct Dataset::Impl {
+  std::string directory;
+  fs::path dir;
+  CameraModel camera;
+  std::vector<FrameEntry> frames;
+  std::string frames_file;
+  bool has_odometry = false, has_groundtruth = false, has_direction = false;
+  std::vector<StampedPose> odometry, groundtruth;
+  std::vector<DirectionLabel> direction;
+  std::optional<ExtrinsicsFile> extrinsics, extrinsics_gt;
+  std::unique_ptr<VideoSource> video;
+
+  std::string context(int64_t i) const {
+    return "frame " + std::to_string(i) + ", " + detail::where(frames_file, frames[static_cast<size_t>(i)].line);
+  }
+};
+
+namespace {
+
+// Optional trajectory/label files: absent is fine; present must be valid, non-empty and must
+// apply to at least one frame (a file that applies to none is almost always a clock or unit
+// mismatch, e.g. milliseconds against seconds).
+template <typename T, typename Reader, typename Applies>
+bool read_optional(const fs::path& file, std::vector<T>& out, Reader reader, Applies applies,
+                   int64_t frame_count, const char* what) {
+  std::error_code ec;
+  if (!fs::exists(file, ec)) return false;
+  out = reader(file.string());
+  if (out.empty()) throw_invalid_input(file.string() + ": has no " + what + " (only comments or blank lines)");
+  bool any = false;
+  for (int64_t i = 0; i < frame_count && !any; ++i) any = applies(i);
+  if (!any)
+    throw_invalid_input(file.string() + ": its times [" + detail::format_exact(out.front().t) +
+                        ", " + detail::format_exact(out.back().t) +
+                        "] apply to no frame; are they on the frames' clock, in seconds?");
+  return true;
+}
+
+}  // namespace
+
+Dataset::Dataset(const std::string& directory, DatasetOptions options) : impl_(std::make_unique<Impl>()) {
+  Impl& d = *impl_;
+  const Progress progress(options.progress);
+  progress.report(0.0, "reading data set files");
+  d.directory = directory;
+  d.dir = fs::path(directory);
+  std::error_code ec;
+  if (!fs::exists(d.dir, ec)) throw_invalid_input(directory + ": the data set directory does not exist");
+  if (!fs::is_directory(d.dir, ec)) throw_invalid_input(directory + ": not a directory");
+
+  d.camera = read_camera_yaml((d.dir / "camera.yaml").string());
+
+  // The text files first, so that a typo is reported before the long part.
+  constexpr double kTextShare = 0.05;
+  if (options.video.empty()) {
+    d.frames_file = (d.dir / "frames.txt").string();
+    if (!fs::exists(d.frames_file, ec))
+      throw_invalid_input(d.frames_file + ": does not exist (a data set needs frames.txt and "
+                          "images/, or a video)");
+    d.frames = read_frames(d.frames_file);
+    if (d.frames.empty()) throw_invalid_input(d.frames_file + ": lists no frames");
+    // A stat per image is cheap and finds a misspelt path now, not an hour into a run.
+    for (size_t i = 0; i < d.frames.size(); ++i) {
+      const fs::path file = d.dir / d.frames[i].path;
+      if (!fs::is_regular_file(file, ec))
+        throw_invalid_input(file.string() + ": the image does not exist (" +
+                            d.context(static_cast<int64_t>(i)) + ")");
+    }
+  } else {
+    d.video = std::make_unique<VideoSource>(options.video, d.camera, options.verify_images,
+                                            progress, kTextShare);
+    for (double t : d.video->times()) d.frames.push_back({t, std::string(), 0});
+  }
+  const int64_t n = static_cast<int64_t>(d.frames.size());
+
+  d.has_odometry = read_optional(
+      d.dir / "odometry.txt", d.odometry, read_tum,
+      [&](int64_t i) { return interpolate_pose(d.odometry, d.frames[static_cast<size_t>(i)].t).has_value(); },
+      n, "poses");
+  d.has_groundtruth = read_optional(
+      d.dir / "groundtruth.txt", d.groundtruth, read_tum,
+      [&](int64_t i) { return interpolate_pose(d.groundtruth, d.frames[static_cast<size_t>(i)].t).has_value(); },
+      n, "poses");
+  // With one frame there is no interval for a label to apply to.
+  d.has_direction = read_optional(
+      d.dir / "direction.txt", d.direction, read_direction,
+      [&](int64_t i) {
+        if (n == 1) return true;
+        if (i == 0) return false;
+        const auto& f = d.frames;
+        return direction_at(d.direction, 0.5 * (f[size_t(i) - 1].t + f[size_t(i)].t)).has_value();
+      },
+      n, "labels");
+  if (fs::exists(d.dir / "extrinsics.yaml", ec))
+    d.extrinsics = read_extrinsics_yaml((d.dir / "extrinsics.yaml").string());
+  if (fs::exists(d.dir / "extrinsics_gt.yaml", ec))
+    d.extrinsics_gt = read_extrinsics_yaml((d.dir / "extrinsics_gt.yaml").string());
+
+  if (options.verify_images && !d.video) {
+    for (int64_t i = 0; i < n; ++i) {
+      progress.report(kTextShare + (1.0 - kTextShare) * static_cast<double>(i) / static_cast<double>(n),
+                      "verifying images");
+      read_image(d.dir / d.frames[static_cast<size_t>(i)].path, d.camera, d.context(i));
+    }
+  }
+  progress.report(1.0, "done");
+}
+
+Dataset::~Dataset() = default;
+Dataset::Dataset(Dataset&&) noexcept = default;
+Dataset& Dataset::operator=(Dataset&&) noexcept = default;
+
+void Dataset::check_index(int64_t i, const char* what) const {
+  if (i < 0 || i >= frame_count())
+    throw_invalid_argument(std::string(what) + ": frame index " + std::to_string(i) +
+                           " is outside [0, " + std::to_string(frame_count()) + ")");
+}
+
+const std::string& Dataset::directory() const { return impl_->directory; }
+const CameraModel& Dataset::camera() const { return impl_->camera; }
+bool Dataset::is_video() const { return impl_->video != nullptr; }
+int64_t Dataset::frame_count() const { return static_cast<int64_t>(impl_->frames.size()); }
+const std::vector<FrameEntry>& Dataset::frames() const { return impl_->frames; }
+
+double Dataset::timestamp(int64_t i) const {
+  check_index(i, "Dataset::timestamp");
+  return impl_->frames[static_cast<size_t>(i)].t;
+}
+
+std::string Dataset::frame_source(int64_t i) const {
+  check_index(i, "Dataset::frame_source");
+  if (impl_->video) return impl_->video->name(i);
+  return (impl_->dir / impl_->frames[static_cast<size_t>(i)].path).string();
+}
+
+cv::Mat Dataset::frame(int64_t i) {
+  check_index(i, "Dataset::frame");
+  if (impl_->video) return impl_->video->frame(i);
+  return read_image(impl_->dir / impl_->frames[static_cast<size_t>(i)].path, impl_->camera,
+                    impl_->context(i));
+}
+
+bool Dataset::has_odometry() const { return impl_->has_odometry; }
+const std::vector<StampedPose>& Dataset::odometry() const { return impl_->odometry; }
+std::optional<SE2> Dataset::odometry_at(int64_t i) const {
+  return interpolate_pose(impl_->odometry, timestamp(i));
+}
+
+bool Dataset::has_groundtruth() const { return impl_->has_groundtruth; }
+const std::vector<StampedPose>& Dataset::groundtruth() const { return impl_->groundtruth; }
+std::optional<SE2> Dataset::groundtruth_at(int64_t i) const {
+  return interpolate_pose(impl_->groundtruth, timestamp(i));
+}
+
+bool Dataset::has_direction() const { return impl_->has_direction; }
+const std::vector<DirectionLabel>& Dataset::direction_labels() const { return impl_->direction; }
+std::optional<int> Dataset::direction_for_interval(int64_t i) const {
+  check_index(i, "Dataset::direction_for_interval");
+  if (i == 0) return std::nullopt;
+  const auto& f = impl_->frames;
+  return direction_at(impl_->direction, 0.5 * (f[static_cast<size_t>(i) - 1].t + f[static_cast<size_t>(i)].t));
+}
+
+const std::optional<ExtrinsicsFile>& Dataset::extrinsics() const { return impl_->extrinsics; }
+const std::optional<ExtrinsicsFile>& Dataset::extrinsics_gt() const { return impl_->extrinsics_gt; }
+
+}  // namespace planarvo::io

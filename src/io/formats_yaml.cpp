@@ -1,0 +1,258 @@
+// The OpenCV FileStorage YAML formats of formats.h: the camera calibration (as OpenCV's
+// calibration sample writes it) and the extrinsics (formats.md, Outputs).
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <filesystem>
+#include <string>
+
+#include <opencv2/core.hpp>
+
+#include "core/error.h"
+#include "io/formats.h"
+#include "io/text.h"
+
+namespace planarvo::io {
+
+namespace {
+
+const std::array<const char*, 6> kExtrinsicNames = {"x", "y", "z", "roll", "pitch", "yaw"};
+
+// A T_robot_camera that differs from the matrix of the six values by more than this (in any
+// entry: metres, or rotation-matrix units ~ radians) is an error: well above the ~1e-16 rounding
+// of the written numbers, well below any real disagreement.
+constexpr double kMatrixAgreement = 1e-6;
+
+[[noreturn]] void fail(const std::string& path, const std::string& message) {
+  throw_invalid_input(path + ": " + message);
+}
+
+// Opens path for reading, with our own message for a missing file (OpenCV's is a log line).
+void open_for_reading(cv::FileStorage& fs, const std::string& path) {
+  std::error_code ec;
+  if (!std::filesystem::exists(path, ec)) fail(path, "does not exist");
+  if (std::filesystem::is_directory(path, ec)) fail(path, "is a directory, not a file");
+  if (!fs.open(path, cv::FileStorage::READ)) fail(path, "cannot be opened as OpenCV YAML");
+}
+
+// Runs body, turning OpenCV's parse errors into InvalidInput naming the file.
+template <typename F>
+auto with_parse_errors(const std::string& path, F&& body) {
+  try {
+    return body();
+  } catch (const cv::Exception& e) {
+    fail(path, "not a valid OpenCV FileStorage YAML file (" + e.err + ")");
+  }
+}
+
+cv::FileNode required(const cv::FileStorage& fs, const std::string& path, const char* key) {
+  cv::FileNode n = fs[key];
+  if (n.empty() || n.isNone()) fail(path, std::string("missing key '") + key + "'");
+  return n;
+}
+
+double read_real(const cv::FileNode& n, const std::string& path, const char* key) {
+  if (!n.isReal() && !n.isInt()) fail(path, std::string("'") + key + "' is not a number");
+  const double v = n.real();
+  if (!std::isfinite(v)) fail(path, std::string("'") + key + "' is not finite (NaN or inf)");
+  return v;
+}
+
+int read_int(const cv::FileNode& n, const std::string& path, const char* key) {
+  if (n.isInt()) return n;
+  // Accept 640.0, which some writers produce, but not 640.5.
+  const double v = read_real(n, path, key);
+  if (v != std::floor(v) || std::abs(v) > 1e9)
+    fail(path, std::string("'") + key + "' is not an integer");
+  return static_cast<int>(v);
+}
+
+cv::Mat read_matrix(const cv::FileNode& n, const std::string& path, const char* key) {
+  cv::Mat m;
+  if (!n.isMap()) fail(path, std::string("'") + key + "' is not an opencv-matrix");
+  n >> m;
+  if (m.empty() || m.channels() != 1) fail(path, std::string("'") + key + "' is not a matrix");
+  m.convertTo(m, CV_64F);
+  for (int r = 0; r < m.rows; ++r)
+    for (int c = 0; c < m.cols; ++c)
+      if (!std::isfinite(m.at<double>(r, c)))
+        fail(path, std::string("'") + key + "' contains NaN or inf");
+  return m;
+}
+
+std::string read_string(const cv::FileNode& n, const std::string& path, const char* key) {
+  if (!n.isString()) fail(path, std::string("'") + key + "' is not a string");
+  return n.string();
+}
+
+std::string size_text(const cv::Mat& m) {
+  return std::to_string(m.rows) + "x" + std::to_string(m.cols);
+}
+
+// Writes the FileStorage text through TextWriter, so that a failed write is Error(Io) naming
+// the file (cv::FileStorage writing a file itself reports nothing).
+void write_storage_text(const std::string& path, cv::FileStorage& fs) {
+  const std::string text = fs.releaseAndGetString();
+  detail::TextWriter w(path);
+  w.write(text);
+  w.close();
+}
+
+cv::FileStorage memory_writer() {
+  return cv::FileStorage(".yaml", cv::FileStorage::WRITE | cv::FileStorage::MEMORY |
+                                      cv::FileStorage::FORMAT_YAML);
+}
+
+}  // namespace
+
+CameraModel read_camera_yaml(const std::string& path) {
+  return with_parse_errors(path, [&] {
+    cv::FileStorage fs;
+    open_for_reading(fs, path);
+    CameraModel cam;
+    cam.width = read_int(required(fs, path, "image_width"), path, "image_width");
+    cam.height = read_int(required(fs, path, "image_height"), path, "image_height");
+
+    const cv::Mat K = read_matrix(required(fs, path, "camera_matrix"), path, "camera_matrix");
+    if (K.rows != 3 || K.cols != 3)
+      fail(path, "'camera_matrix' is " + size_text(K) + ", expected 3x3");
+    cam.fx = K.at<double>(0, 0);
+    cam.fy = K.at<double>(1, 1);
+    cam.cx = K.at<double>(0, 2);
+    cam.cy = K.at<double>(1, 2);
+    if (std::abs(K.at<double>(0, 1)) > 1e-9 * std::abs(cam.fx))
+      fail(path, "'camera_matrix' has a skew term K(0,1) != 0, which is not supported");
+    if (K.at<double>(1, 0) != 0 || K.at<double>(2, 0) != 0 || K.at<double>(2, 1) != 0 ||
+        std::abs(K.at<double>(2, 2) - 1.0) > 1e-12)
+      fail(path, "'camera_matrix' is not of the form [fx 0 cx; 0 fy cy; 0 0 1]");
+
+    const cv::Mat D = read_matrix(required(fs, path, "distortion_coefficients"), path,
+                                  "distortion_coefficients");
+    const int n = static_cast<int>(D.total());
+    // OpenCV's rational and thin-prism models have 8, 12 or 14 coefficients; with the extra
+    // ones zero they are the 5-coefficient model, which is what calibrateCamera returns with
+    // those flags unset but an 8x1 output array.
+    const bool known_count = n == 4 || n == 5 || n == 8 || n == 12 || n == 14;
+    if ((D.rows != 1 && D.cols != 1) || !known_count)
+      fail(path, "'distortion_coefficients' is " + size_text(D) +
+                     ", expected 1x4, 1x5, 4x1 or 5x1 (k1 k2 p1 p2 [k3])");
+    const double* d = D.ptr<double>();
+    for (int i = 5; i < n; ++i)
+      if (d[i] != 0.0)
+        fail(path, "'distortion_coefficients' uses OpenCV's rational or thin-prism model "
+                   "(coefficient " + std::to_string(i + 1) + " is not zero), which is not supported");
+    cam.k1 = d[0];
+    cam.k2 = d[1];
+    cam.p1 = d[2];
+    cam.p2 = d[3];
+    cam.k3 = n >= 5 ? d[4] : 0.0;
+    cam.validate(path.c_str());
+    return cam;
+  });
+}
+
+void write_camera_yaml(const std::string& path, const CameraModel& camera) {
+  try {
+    camera.validate(path.c_str());
+  } catch (const Error& e) {
+    throw_invalid_argument(e.what());
+  }
+  cv::FileStorage fs = memory_writer();
+  fs << "image_width" << camera.width;
+  fs << "image_height" << camera.height;
+  cv::Mat K = (cv::Mat_<double>(3, 3) << camera.fx, 0, camera.cx, 0, camera.fy, camera.cy, 0, 0, 1);
+  fs << "camera_matrix" << K;
+  // 5x1, as calibrateCamera returns it and OpenCV's calibration sample writes it.
+  cv::Mat D = (cv::Mat_<double>(5, 1) << camera.k1, camera.k2, camera.p1, camera.p2, camera.k3);
+  fs << "distortion_coefficients" << D;
+  write_storage_text(path, fs);
+}
+
+ExtrinsicsFile read_extrinsics_yaml(const std::string& path) {
+  return with_parse_errors(path, [&] {
+    cv::FileStorage fs;
+    open_for_reading(fs, path);
+    ExtrinsicsFile out;
+    double* values[6] = {&out.value.x,    &out.value.y,     &out.value.z,
+                         &out.value.roll, &out.value.pitch, &out.value.yaw};
+    for (size_t i = 0; i < 6; ++i)
+      *values[i] = read_real(required(fs, path, kExtrinsicNames[i]), path, kExtrinsicNames[i]);
+
+    const cv::FileNode tn = fs["T_robot_camera"];
+    if (!tn.empty() && !tn.isNone()) {
+      const cv::Mat T = read_matrix(tn, path, "T_robot_camera");
+      if (T.rows != 4 || T.cols != 4)
+        fail(path, "'T_robot_camera' is " + size_text(T) + ", expected 4x4");
+      const Eigen::Matrix4d expected = out.value.T_vc();
+      double worst = 0.0;
+      for (int r = 0; r < 4; ++r)
+        for (int c = 0; c < 4; ++c)
+          worst = std::max(worst, std::abs(T.at<double>(r, c) - expected(r, c)));
+      if (worst > kMatrixAgreement)
+        fail(path, "'T_robot_camera' disagrees with x y z roll pitch yaw (largest difference " +
+                       detail::format_exact(worst) + ")");
+    }
+
+    const cv::FileNode cn = fs["covariance"];
+    if (!cn.empty() && !cn.isNone()) {
+      const cv::Mat C = read_matrix(cn, path, "covariance");
+      if (C.rows != 6 || C.cols != 6)
+        fail(path, "'covariance' is " + size_text(C) + ", expected 6x6");
+      for (int r = 0; r < 6; ++r)
+        for (int c = 0; c < 6; ++c) out.covariance(r, c) = C.at<double>(r, c);
+    }
+
+    const cv::FileNode en = fs["estimated"];
+    if (!en.empty() && !en.isNone()) {
+      if (!en.isSeq()) fail(path, "'estimated' is not a sequence such as [x, yaw]");
+      for (const cv::FileNode& item : en) {
+        if (!item.isString()) fail(path, "'estimated' holds something that is not a name");
+        const std::string name = item.string();
+        if (std::find_if(kExtrinsicNames.begin(), kExtrinsicNames.end(),
+                         [&](const char* k) { return name == k; }) == kExtrinsicNames.end())
+          fail(path, "'estimated' names '" + name + "', not one of x y z roll pitch yaw");
+        if (std::find(out.estimated.begin(), out.estimated.end(), name) != out.estimated.end())
+          fail(path, "'estimated' names '" + name + "' twice");
+        out.estimated.push_back(name);
+      }
+    }
+
+    const cv::FileNode mn = fs["method"];
+    if (!mn.empty() && !mn.isNone()) out.method = read_string(mn, path, "method");
+    const cv::FileNode nn = fs["notes"];
+    if (!nn.empty() && !nn.isNone()) out.notes = read_string(nn, path, "notes");
+    return out;
+  });
+}
+
+void write_extrinsics_yaml(const std::string& path, const ExtrinsicsFile& e) {
+  const double values[6] = {e.value.x, e.value.y, e.value.z, e.value.roll, e.value.pitch, e.value.yaw};
+  for (double v : values)
+    if (!std::isfinite(v)) throw_invalid_argument(path + ": extrinsics are not finite");
+  if (!e.covariance.allFinite()) throw_invalid_argument(path + ": covariance is not finite");
+  for (const std::string& name : e.estimated)
+    if (std::find_if(kExtrinsicNames.begin(), kExtrinsicNames.end(),
+                     [&](const char* k) { return name == k; }) == kExtrinsicNames.end())
+      throw_invalid_argument(path + ": estimated names '" + name +
+                             "', not one of x y z roll pitch yaw");
+
+  cv::FileStorage fs = memory_writer();
+  for (size_t i = 0; i < 6; ++i) fs << kExtrinsicNames[i] << values[i];
+  const Eigen::Matrix4d T = e.value.T_vc();
+  cv::Mat Tm(4, 4, CV_64F), Cm(6, 6, CV_64F);
+  for (int r = 0; r < 4; ++r)
+    for (int c = 0; c < 4; ++c) Tm.at<double>(r, c) = T(r, c);
+  for (int r = 0; r < 6; ++r)
+    for (int c = 0; c < 6; ++c) Cm.at<double>(r, c) = e.covariance(r, c);
+  fs << "T_robot_camera" << Tm;
+  fs << "covariance" << Cm;
+  fs << "estimated" << "[";
+  for (const std::string& name : e.estimated) fs << name;
+  fs << "]";
+  // cv::write, not <<: operator<< reads a leading '[' or '{' of a string as structure.
+  cv::write(fs, "method", e.method);
+  cv::write(fs, "notes", e.notes);
+  write_storage_text(path, fs);
+}
+
+}  // namespace planarvo::io

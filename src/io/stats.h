@@ -1,0 +1,38 @@
+// The per-frame statistics CSV (formats.md, Outputs: --stats FILE): one row per frame, written
+// and flushed as the frames are processed, so that a crash loses no earlier row.
+#pragma once
+#include <string>
+
+#include "io/text.h"
+
+namespace planarvo::io {
+
+struct FrameStats {
+  double timestamp = 0.0;  // the frame's time, seconds
+  double vx = 0.0, vy = 0.0;  // robot-frame velocity over the interval ending at this frame, m/s
+  double omega = 0.0;         // angular velocity, rad/s
+  int iterations = 0;         // tracker iterations, all pyramid levels
+  double final_cost = 0.0;
+  double inlier_fraction = 0.0;
+  double ms = 0.0;     // engine time for the frame (upload, undistortion, pyramid, tracking)
+  std::string status;  // e.g. "ok", "first", "lost"; quoted in the file when it needs to be
+};
+
+// Writes the header at construction and one flushed row per add(). Every failure is Error(Io)
+// naming the file. Neither copyable nor movable (hold it by pointer to pass it on).
+class StatsWriter {
+ public:
+  static constexpr const char* kHeader =
+      "timestamp,vx,vy,omega,iterations,final_cost,inlier_fraction,ms,status";
+
+  explicit StatsWriter(const std::string& path);
+  void add(const FrameStats& row);
+  // Closes the file, reporting a failed final write (the destructor closes without reporting).
+  void close();
+  const std::string& path() const { return out_.path(); }
+
+ private:
+  detail::TextWriter out_;
+};
+
+}  // namespace planarvo::io

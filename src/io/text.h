@@ -1,0 +1,68 @@
+// Internal to src/io: reading line-oriented text files with errors that name the file and line,
+// locale-independent number parsing and formatting, and a checked writer. Not part of the
+// interface other layers use (that is formats.h, stats.h, dataset.h).
+#pragma once
+#include <cstdio>
+#include <fstream>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace planarvo::io::detail {
+
+// "path:line: message", the form compilers use, so editors can jump to it.
+std::string where(const std::string& path, int line);
+
+// Reads a text file line by line, skipping blank lines and lines whose first non-blank character
+// is '#'. Strips a trailing '\r' (files written on Windows) and surrounding blanks. Throws
+// InvalidInput naming the file when it cannot be opened or read.
+class LineReader {
+ public:
+  explicit LineReader(std::string path);
+  // The next content line into `line`; false at the end of the file.
+  bool next(std::string& line);
+  int line_number() const { return line_number_; }
+  const std::string& path() const { return path_; }
+  // Throws InvalidInput "path:line: message" for the current line.
+  [[noreturn]] void fail(const std::string& message) const;
+
+ private:
+  std::string path_;
+  std::ifstream in_;
+  int line_number_ = 0;
+};
+
+// Whitespace-separated fields of a line.
+std::vector<std::string_view> split_fields(std::string_view line);
+
+// Parses a whole field as a finite double (locale-independent; a leading '+' is accepted).
+// On failure reader.fail() with a message naming `what`.
+double parse_number(const LineReader& reader, std::string_view field, const char* what);
+
+// Locale-independent formatting: the shortest text that reads back to the same double, and a
+// fixed-point form with `decimals` digits after the point (timestamps).
+std::string format_exact(double v);
+std::string format_fixed(double v, int decimals);
+
+// A file opened for writing whose every failure is Error(Io) naming the file.
+class TextWriter {
+ public:
+  explicit TextWriter(std::string path);
+  ~TextWriter();
+  TextWriter(const TextWriter&) = delete;
+  TextWriter& operator=(const TextWriter&) = delete;
+
+  void write(std::string_view text);
+  // Hands the written text to the operating system, so that a crash of this process loses none.
+  void flush();
+  // Closes the file, reporting a failed final write; the destructor closes silently.
+  void close();
+  const std::string& path() const { return path_; }
+
+ private:
+  [[noreturn]] void fail(const char* what) const;
+  std::string path_;
+  std::FILE* file_ = nullptr;
+};
+
+}  // namespace planarvo::io::detail

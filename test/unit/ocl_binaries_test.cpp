@@ -1,0 +1,256 @@
+// Prebuilt program binaries (the FPGA path): export, manifest, loading without a compiler, and
+// the errors a user sees when the directory does not fit (src/ocl/manifest.h).
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "common/test_util.h"
+#include "core/error.h"
+#include "ocl/runtime.h"
+#include "unit/ocl_test_helpers.h"
+
+namespace planarvo {
+namespace {
+
+namespace fs = std::filesystem;
+using ::testing::HasSubstr;
+
+std::string read_text(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+void write_text(const fs::path& p, const std::string& s) {
+  std::ofstream out(p, std::ios::binary | std::ios::trunc);
+  out << s;
+}
+
+std::vector<std::string> split(const std::string& s, char sep) {
+  std::vector<std::string> out;
+  std::string cur;
+  std::istringstream in(s);
+  while (std::getline(in, cur, sep)) out.push_back(cur);
+  return out;
+}
+
+// The manifest's non-comment lines, split into fields.
+std::vector<std::vector<std::string>> manifest_lines(const fs::path& dir) {
+  std::vector<std::vector<std::string>> out;
+  for (const std::string& line : split(read_text(dir / ocl::kManifestFileName), '\n'))
+    if (!line.empty() && line[0] != '#') out.push_back(split(line, '\t'));
+  return out;
+}
+
+ocl::RuntimeOptions from_binaries(const fs::path& dir) {
+  ocl::RuntimeOptions o;
+  o.binaries_dir = dir.string();
+  o.use_cache = false;
+  return o;
+}
+
+// Exports every program with fill's "" and "-D VARIANT=7" variants into dir.
+void export_to(const fs::path& dir) {
+  ocl::Runtime::register_build_options("fill", "");
+  ocl::Runtime::register_build_options("fill", "-D VARIANT=7");
+  ocl::RuntimeOptions o;
+  o.use_cache = false;
+  ocl::Runtime rt(o);
+  rt.export_binaries(dir.string());
+}
+
+class OclBinaries : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = scratch_ / "binaries";
+    export_to(dir_);
+  }
+  // The manifest line for fill with the given options.
+  std::vector<std::string> fill_line(const std::string& options) {
+    for (const auto& f : manifest_lines(dir_))
+      if (f[0] == "fill" && (f.size() > 5 ? f[5] : std::string()) == options) return f;
+    ADD_FAILURE() << "no manifest line for fill with \"" << options << "\"";
+    return {};
+  }
+  test::ScratchDir scratch_;
+  fs::path dir_;
+};
+
+TEST_F(OclBinaries, ExportWritesABinaryAndAManifestLinePerVariant) {
+  ocl::Runtime rt;
+  const auto lines = manifest_lines(dir_);
+  ASSERT_EQ(lines.size(), 2u);  // fill twice; the prelude (if any) is never a program
+  for (const auto& f : lines) {
+    ASSERT_GE(f.size(), 5u);
+    EXPECT_EQ(f[0], "fill");
+    EXPECT_EQ(f[1].size(), 16u);  // options hash
+    EXPECT_TRUE(fs::is_regular_file(dir_ / f[2])) << f[2];
+    EXPECT_GT(fs::file_size(dir_ / f[2]), 0u);
+    EXPECT_EQ(f[3], rt.device_info().device_name);
+    EXPECT_EQ(f[4], rt.device_info().driver_version);
+  }
+  EXPECT_NE(fill_line("")[2], fill_line("-D VARIANT=7")[2]);
+  // The documented hash: FNV-1a 64 of the options, 16 lowercase hex digits.
+  char hash[17];
+  std::snprintf(hash, sizeof hash, "%016llx",
+                static_cast<unsigned long long>(ocl::fnv1a64("-D VARIANT=7")));
+  EXPECT_EQ(fill_line("-D VARIANT=7")[1], hash);
+  EXPECT_EQ(ocl::fnv1a64(""), 0xcbf29ce484222325ull);  // FNV-1a 64's offset basis
+  EXPECT_EQ(ocl::fnv1a64("a"), 0xaf63dc4c8601ec8cull);  // the published test vector
+}
+
+TEST_F(OclBinaries, RuntimeRunsFromBinariesWithoutCompiling) {
+  ocl::Runtime rt(from_binaries(dir_));
+  test::expect_fill_works(rt, rt.program("fill"));
+  test::expect_fill_works(rt, rt.program("fill", "  -D VARIANT=7 "));
+  EXPECT_EQ(rt.stats().built_from_source, 0);
+  EXPECT_EQ(rt.stats().loaded_from_cache, 0);
+  EXPECT_EQ(rt.stats().loaded_from_binaries, 2);
+}
+
+TEST_F(OclBinaries, MissingManifestNamesProgramDeviceAndDirectory) {
+  fs::remove(dir_ / ocl::kManifestFileName);
+  ocl::Runtime rt(from_binaries(dir_));
+  const std::string msg =
+      test::error_message([&] { rt.program("fill"); }, ErrorCode::InvalidInput);
+  EXPECT_THAT(msg, HasSubstr("\"fill\""));
+  EXPECT_THAT(msg, HasSubstr(rt.device_info().device_name));
+  EXPECT_THAT(msg, HasSubstr(dir_.string()));
+  EXPECT_THAT(msg, HasSubstr(ocl::kManifestFileName));
+}
+
+TEST_F(OclBinaries, MissingBinaryFileNamesProgramDeviceAndDirectory) {
+  const auto line = fill_line("-D VARIANT=7");
+  ASSERT_FALSE(line.empty());
+  fs::remove(dir_ / line[2]);
+  ocl::Runtime rt(from_binaries(dir_));
+  EXPECT_NO_THROW(rt.program("fill"));  // the other variant is still there
+  const std::string msg = test::error_message([&] { rt.program("fill", "-D VARIANT=7"); },
+                                              ErrorCode::InvalidInput);
+  EXPECT_THAT(msg, HasSubstr("\"fill\""));
+  EXPECT_THAT(msg, HasSubstr("-D VARIANT=7"));
+  EXPECT_THAT(msg, HasSubstr(line[2]));
+  EXPECT_THAT(msg, HasSubstr("missing"));
+  EXPECT_THAT(msg, HasSubstr(rt.device_info().device_name));
+  EXPECT_THAT(msg, HasSubstr(dir_.string()));
+}
+
+TEST_F(OclBinaries, BinaryForAnotherDeviceIsMismatched) {
+  std::string text = read_text(dir_ / ocl::kManifestFileName);
+  ocl::Runtime probe;
+  const std::string& name = probe.device_info().device_name;
+  for (size_t at = text.find('\t' + name + '\t'); at != std::string::npos;
+       at = text.find('\t' + name + '\t'))
+    text.replace(at + 1, name.size(), "Some Other FPGA Board");
+  write_text(dir_ / ocl::kManifestFileName, text);
+
+  ocl::Runtime rt(from_binaries(dir_));
+  const std::string msg =
+      test::error_message([&] { rt.program("fill"); }, ErrorCode::InvalidInput);
+  EXPECT_THAT(msg, HasSubstr("mismatched binary"));
+  EXPECT_THAT(msg, HasSubstr("built for \"Some Other FPGA Board\""));
+  EXPECT_THAT(msg, HasSubstr("this device is \"" + name + "\""));
+  EXPECT_THAT(msg, HasSubstr("fill"));
+  EXPECT_THAT(msg, HasSubstr(dir_.string()));
+}
+
+TEST_F(OclBinaries, BinaryForAnotherDriverIsMismatched) {
+  const auto line = fill_line("");
+  ASSERT_GE(line.size(), 5u);
+  std::string text = read_text(dir_ / ocl::kManifestFileName);
+  const std::string old_fields = '\t' + line[3] + '\t' + line[4] + '\n';
+  const size_t at = text.find(line[2] + old_fields);
+  ASSERT_NE(at, std::string::npos);
+  text.replace(at + line[2].size(), old_fields.size(), '\t' + line[3] + "\t0.0-older\n");
+  write_text(dir_ / ocl::kManifestFileName, text);
+
+  ocl::Runtime rt(from_binaries(dir_));
+  const std::string msg =
+      test::error_message([&] { rt.program("fill"); }, ErrorCode::InvalidInput);
+  EXPECT_THAT(msg, HasSubstr("mismatched binary"));
+  EXPECT_THAT(msg, HasSubstr("driver 0.0-older"));
+  EXPECT_THAT(msg, HasSubstr(rt.device_info().driver_version));
+}
+
+TEST_F(OclBinaries, VariantNotExportedIsNamed) {
+  ocl::Runtime rt(from_binaries(dir_));
+  const std::string msg = test::error_message([&] { rt.program("fill", "-D VARIANT=8"); },
+                                              ErrorCode::InvalidInput);
+  EXPECT_THAT(msg, HasSubstr("no prebuilt binary"));
+  EXPECT_THAT(msg, HasSubstr("\"fill\" with options \"-D VARIANT=8\""));
+  EXPECT_THAT(msg, HasSubstr("\"-D VARIANT=7\""));  // what there is instead
+  EXPECT_THAT(msg, HasSubstr(rt.device_info().device_name));
+  EXPECT_THAT(msg, HasSubstr(dir_.string()));
+  EXPECT_EQ(rt.stats().built_from_source, 0);  // no fallback to the compiler
+}
+
+TEST_F(OclBinaries, DriverRejectingTheBinaryIsAnOpenCLError) {
+  const auto line = fill_line("");
+  ASSERT_FALSE(line.empty());
+  write_text(dir_ / line[2], std::string(4096, '\x7f'));
+  ocl::Runtime rt(from_binaries(dir_));
+  const std::string msg = test::error_message([&] { rt.program("fill"); }, ErrorCode::OpenCL);
+  EXPECT_THAT(msg, HasSubstr("\"fill\""));
+  EXPECT_THAT(msg, HasSubstr(line[2]));
+  EXPECT_THAT(msg, HasSubstr(rt.device_info().device_name));
+  EXPECT_THAT(msg, HasSubstr(dir_.string()));
+}
+
+TEST_F(OclBinaries, HandWrittenLineLoadsAVendorBinary) {
+  // What an FPGA user does with an .aocx: copy the file in, write one line by hand, with "-"
+  // for the hash, "*" for the driver and no options field.
+  const auto line = fill_line("");
+  ASSERT_FALSE(line.empty());
+  const fs::path vendor = scratch_ / "vendor";
+  fs::create_directories(vendor / "board");
+  fs::copy_file(dir_ / line[2], vendor / "board" / "kernels.aocx");
+  ocl::Runtime probe;
+  write_text(vendor / ocl::kManifestFileName,
+             "# written by hand\n\n"
+             "fill \t - \t board/kernels.aocx \t " + probe.device_info().device_name +
+                 " \t *\r\n");
+  ocl::Runtime rt(from_binaries(vendor));
+  test::expect_fill_works(rt, rt.program("fill"));
+  EXPECT_EQ(rt.stats().loaded_from_binaries, 1);
+}
+
+TEST_F(OclBinaries, MalformedManifestNamesTheLine) {
+  write_text(dir_ / ocl::kManifestFileName, "# comment\nfill only-two-fields\n");
+  ocl::Runtime rt(from_binaries(dir_));
+  const std::string msg =
+      test::error_message([&] { rt.program("fill"); }, ErrorCode::InvalidInput);
+  EXPECT_THAT(msg, HasSubstr(std::string(ocl::kManifestFileName) + ":2"));
+  EXPECT_THAT(msg, HasSubstr("TAB"));
+
+  write_text(dir_ / ocl::kManifestFileName, "fill\t0123456789abcdef\tx.bin\t*\t*\t-D A=1\n");
+  const std::string bad_hash =
+      test::error_message([&] { rt.program("fill"); }, ErrorCode::InvalidInput);
+  EXPECT_THAT(bad_hash, HasSubstr("options hash 0123456789abcdef does not match"));
+}
+
+TEST_F(OclBinaries, ReExportKeepsOtherDevicesAndReplacesThisOne) {
+  const std::string foreign = "fill\t-\tother.bin\tSome Other FPGA Board\t1.0\n";
+  write_text(dir_ / ocl::kManifestFileName,
+             read_text(dir_ / ocl::kManifestFileName) + foreign);
+  export_to(dir_);
+  const auto lines = manifest_lines(dir_);
+  EXPECT_EQ(lines.size(), 3u);
+  EXPECT_THAT(read_text(dir_ / ocl::kManifestFileName), HasSubstr(foreign));
+}
+
+TEST(OclBinariesExport, UnwritableDirectoryIsAnIoError) {
+  test::ScratchDir scratch;
+  write_text(scratch / "file", "x");
+  ocl::Runtime rt;
+  const std::string dir = (scratch / "file" / "binaries").string();
+  const std::string msg =
+      test::error_message([&] { rt.export_binaries(dir); }, ErrorCode::Io);
+  EXPECT_THAT(msg, HasSubstr(dir));
+}
+
+}  // namespace
+}  // namespace planarvo
