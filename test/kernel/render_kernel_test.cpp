@@ -1,0 +1,209 @@
+// kernels/render.cl against its plain C++ reference (render_reference), on random textures,
+// cameras, extrinsics and poses, with a poisoned, padded output buffer.
+#include <cmath>
+#include <random>
+
+#include <gtest/gtest.h>
+
+#include "io/simulator.h"
+#include "ocl/runtime.h"
+
+namespace planarvo::sim {
+namespace {
+
+constexpr float kPoison = -12345.0f;
+
+// Both compute the same float operations; they differ by the compiler's freedom (fused
+// multiply-adds, the last bit of log2 and of the reciprocal), so texture coordinates agree to
+// a few float roundings of their magnitude. On a noise texture whose neighbouring texels
+// differ by up to 255 grey levels, a pixel may then differ by up to
+//   kTolerance + 255 * kUlps * 2^-24 * (|u| + |v|),
+// (u, v) the pixel centre's texture coordinates (level 0 texels, after the origin shift).
+constexpr double kTolerance = 0.01;
+constexpr double kUlps = 8.0;
+
+cv::Mat noise_texture(int w, int h, uint64_t seed) {
+  Random r(seed);
+  cv::Mat t(h, w, CV_32FC1);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) t.at<float>(y, x) = static_cast<float>(255.0 * r.uniform());
+  return t;
+}
+
+CameraModel random_camera(Random& r, int w, int h) {
+  CameraModel c = default_camera(w, h, r.uniform(50.0, 90.0));
+  c.fy = c.fx * r.uniform(0.97, 1.03);
+  c.cx += r.uniform(-5, 5);
+  c.cy += r.uniform(-5, 5);
+  c.k1 = r.uniform(-0.15, 0.0);
+  c.k2 = r.uniform(0.0, 0.03);
+  c.p1 = r.uniform(-0.002, 0.002);
+  c.p2 = r.uniform(-0.002, 0.002);
+  return c;
+}
+
+Extrinsics random_extrinsics(Random& r, double max_tilt_deg) {
+  Extrinsics e;
+  e.x = r.uniform(-0.3, 0.3);
+  e.y = r.uniform(-0.1, 0.1);
+  e.z = r.uniform(0.08, 0.5);
+  e.roll = r.uniform(-max_tilt_deg, max_tilt_deg) * M_PI / 180;
+  e.pitch = r.uniform(-max_tilt_deg, max_tilt_deg) * M_PI / 180;
+  e.yaw = r.uniform(-M_PI, M_PI);
+  return e;
+}
+
+struct KernelRun {
+  cv::Mat image;  // width x height
+  bool padding_untouched = true;
+};
+
+// Runs render_ground directly on its own buffers: output rows padded to a larger stride,
+// everything poisoned first.
+// The work-group shape is a build option: the Renderer's default and another.
+struct WorkGroup {
+  size_t x, y;
+  std::string options() const {
+    return "-D RENDER_WG_X=" + std::to_string(x) + " -D RENDER_WG_Y=" + std::to_string(y);
+  }
+};
+
+KernelRun run_kernel(ocl::Runtime& rt, const MipPyramid& pyr, const RayTable& rays,
+                     const FrameParams& prm, const WorkGroup& wg = {16, 4}) {
+  const int w = rays.width, h = rays.height, stride = w + 7;
+  cl::Context& ctx = rt.context();
+  auto upload = [&](const auto& v) {
+    return cl::Buffer(ctx, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, v.size() * sizeof(v[0]),
+                      const_cast<void*>(static_cast<const void*>(v.data())));
+  };
+  cl::Buffer tex = upload(pyr.data), levels = upload(pyr.levels), pix = upload(rays.pixel),
+             sub = upload(rays.sub), params = upload(prm);
+  std::vector<float> host(static_cast<size_t>(stride) * static_cast<size_t>(h), kPoison);
+  cl::Buffer out(ctx, CL_MEM_READ_WRITE | CL_MEM_COPY_HOST_PTR, host.size() * sizeof(float), host.data());
+  cl::Kernel k(rt.program("render", wg.options()), "render_ground");
+  const int ns = rays.supersampling * rays.supersampling;
+  k.setArg(0, tex);
+  k.setArg(1, levels);
+  k.setArg(2, pix);
+  k.setArg(3, sub);
+  k.setArg(4, ns);
+  k.setArg(5, params);
+  k.setArg(6, w);
+  k.setArg(7, h);
+  k.setArg(8, out);
+  k.setArg(9, stride);
+  const size_t wx = wg.x, wy = wg.y;
+  rt.queue().enqueueNDRangeKernel(k, cl::NullRange,
+                                  cl::NDRange((w + wx - 1) / wx * wx, (h + wy - 1) / wy * wy),
+                                  cl::NDRange(wx, wy));
+  rt.queue().enqueueReadBuffer(out, CL_TRUE, 0, host.size() * sizeof(float), host.data());
+  KernelRun r;
+  r.image = cv::Mat(h, w, CV_32FC1);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < stride; ++x) {
+      const float v = host[static_cast<size_t>(y * stride + x)];
+      if (x < w)
+        r.image.at<float>(y, x) = v;
+      else if (v != kPoison)
+        r.padding_untouched = false;
+    }
+  return r;
+}
+
+void expect_match(const KernelRun& run, const cv::Mat& ref, const RayTable& rays,
+                  const FrameParams& prm, const std::string& what) {
+  int unwritten = 0, off = 0;
+  double worst = 0.0;
+  const size_t n = static_cast<size_t>(rays.width) * static_cast<size_t>(rays.height);
+  for (int y = 0; y < ref.rows; ++y)
+    for (int x = 0; x < ref.cols; ++x) {
+      const float k = run.image.at<float>(y, x), r = ref.at<float>(y, x);
+      if (k == kPoison) ++unwritten;
+      const size_t p = static_cast<size_t>(y) * static_cast<size_t>(rays.width) + static_cast<size_t>(x);
+      const double rx = rays.pixel[p], ry = rays.pixel[n + p];
+      const double g2 = prm[6] * rx + prm[7] * ry + prm[8];
+      const double u = (prm[0] * rx + prm[1] * ry + prm[2]) / g2;
+      const double v = (prm[3] * rx + prm[4] * ry + prm[5]) / g2;
+      const double scale = g2 < 0 ? std::min(std::abs(u) + std::abs(v), 2e7) : 0.0;
+      const double d = std::abs(static_cast<double>(k) - r);
+      if (!(d <= kTolerance + 255.0 * kUlps * 0x1.0p-24 * scale)) ++off;
+      worst = std::max(worst, d);
+    }
+  EXPECT_EQ(unwritten, 0) << what;
+  EXPECT_EQ(off, 0) << what << ": worst difference " << worst;
+  EXPECT_TRUE(run.padding_untouched) << what;
+}
+
+TEST(RenderKernel, DefaultWorkGroupIsTheTestedOne) {
+  EXPECT_EQ(Renderer::build_options(), (WorkGroup{16, 4}).options());
+}
+
+TEST(RenderKernel, MatchesReferenceOnRandomScenes) {
+  ocl::Runtime rt;
+  Random r(2024);
+  // Sizes that are not multiples of the work-group, non-square power-of-two textures.
+  const int sizes[][2] = {{97, 61}, {160, 120}, {203, 150}};
+  const int tex_sizes[][2] = {{256, 256}, {512, 128}, {64, 256}};
+  int case_no = 0;
+  for (int ss : {1, 2, 3})
+    for (int i = 0; i < 3; ++i, ++case_no) {
+      const CameraModel cam = random_camera(r, sizes[i][0], sizes[i][1]);
+      const Extrinsics e = random_extrinsics(r, 35.0);
+      const MipPyramid pyr = build_mip_pyramid(noise_texture(tex_sizes[i][0], tex_sizes[i][1], 7 + case_no));
+      const RayTable rays = build_ray_table(cam, ss);
+      const Eigen::Vector2d texel(r.uniform(0.0002, 0.002), r.uniform(0.0002, 0.002));
+      const SE2 pose(r.uniform(-500, 500), r.uniform(-500, 500), r.uniform(-M_PI, M_PI));
+      for (bool mip : {true, false}) {
+        const FrameParams prm = frame_params(pose, e, texel, pyr, ss, mip);
+        const WorkGroup wg = case_no % 2 ? WorkGroup{16, 4} : WorkGroup{32, 1};
+        expect_match(run_kernel(rt, pyr, rays, prm, wg), render_reference(pyr, rays, prm), rays, prm,
+                     "case " + std::to_string(case_no) + (mip ? " mip" : " no mip"));
+      }
+    }
+}
+
+// A camera tilted far enough to see the horizon: rays that miss the ground take the far value.
+TEST(RenderKernel, MatchesReferenceAcrossTheHorizon) {
+  ocl::Runtime rt;
+  CameraModel cam = default_camera(128, 96, 90.0);
+  Extrinsics e;
+  e.z = 0.3;
+  e.pitch = 70.0 * M_PI / 180;
+  const MipPyramid pyr = build_mip_pyramid(noise_texture(128, 128, 3));
+  const RayTable rays = build_ray_table(cam, 2);
+  const FrameParams prm = frame_params(SE2(0.2, 0.1, 0.3), e, Eigen::Vector2d(0.001, 0.001), pyr, 2, true);
+  const cv::Mat ref = render_reference(pyr, rays, prm);
+  // Part of the image is sky (exactly the far value), part is ground.
+  int sky = 0;
+  for (int y = 0; y < ref.rows; ++y)
+    for (int x = 0; x < ref.cols; ++x) sky += ref.at<float>(y, x) == prm[kParamFar];
+  EXPECT_GT(sky, ref.rows * ref.cols / 10);
+  EXPECT_LT(sky, ref.rows * ref.cols * 9 / 10);
+  expect_match(run_kernel(rt, pyr, rays, prm), ref, rays, prm, "horizon");
+}
+
+// The Renderer class runs the same kernel with the same tables.
+TEST(RenderKernel, RendererMatchesReference) {
+  ocl::Runtime rt;
+  Options o;
+  o.camera = default_camera(150, 100);
+  o.supersampling = 2;
+  const cv::Mat texture = noise_texture(256, 256, 5);
+  Renderer renderer(rt, texture, o);
+  const SE2 pose(3.0, -7.0, 1.0);
+  KernelRun run;
+  run.image = renderer.render_float(pose);
+  const cv::Mat& k = run.image;
+  ASSERT_EQ(k.type(), CV_32FC1);
+  ASSERT_EQ(k.size(), cv::Size(150, 100));
+  expect_match(run, render_reference(renderer.pyramid(), renderer.rays(), renderer.params(pose)),
+               renderer.rays(), renderer.params(pose), "renderer");
+  const cv::Mat k8 = renderer.render(pose);
+  ASSERT_EQ(k8.type(), CV_8UC1);
+  for (int y = 0; y < k8.rows; ++y)
+    for (int x = 0; x < k8.cols; ++x)
+      ASSERT_NEAR(k8.at<uint8_t>(y, x), k.at<float>(y, x), 0.5 + 1e-4);
+}
+
+}  // namespace
+}  // namespace planarvo::sim
