@@ -208,9 +208,21 @@ class Random {
 uint64_t derive_seed(uint64_t seed, uint64_t stream);
 
 // ---------------------------------------------------------------------------------------------
+// Where simulate() spent its time, seconds of wall-clock time.
+struct SimulationStats {
+  double setup = 0;    // trajectory, texture, mip pyramid, ray tables, kernel build
+  double render = 0;   // the render kernel, including the read-back
+  double camera = 0;   // gain, offset, noise, quantisation
+  double write = 0;    // PNG encoding and writing, text files
+  int64_t frames = 0;
+};
+
 // Renders the whole data set into out_dir (created if missing): camera.yaml, images/NNNNNN.png,
-// frames.txt, odometry.txt, direction.txt, groundtruth.txt, extrinsics_gt.yaml, and
-// simulation.yaml recording the options.
-void simulate(ocl::Runtime& runtime, const Options& options, const std::string& out_dir);
+// frames.txt (written last, so an interrupted run leaves no openable data set), odometry.txt,
+// direction.txt, groundtruth.txt, extrinsics_gt.yaml, and simulation.yaml recording the options.
+// Throws InvalidArgument for bad options, InvalidInput for an unreadable texture, Io when a
+// file cannot be written, Cancelled when options.progress returns false.
+void simulate(ocl::Runtime& runtime, const Options& options, const std::string& out_dir,
+              SimulationStats* stats = nullptr);
 
 }  // namespace planarvo::sim

@@ -1,0 +1,152 @@
+// simulate(): a whole data set in the layout of shared/spec/formats.md, written with the
+// writers of formats.h.
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <string>
+
+#include <opencv2/core/persistence.hpp>
+#include <opencv2/imgcodecs.hpp>
+
+#include "core/error.h"
+#include "io/formats.h"
+#include "io/simulator.h"
+#include "ocl/runtime.h"
+
+namespace planarvo::sim {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+
+const char* profile_name(MotionProfile p) {
+  switch (p) {
+    case MotionProfile::Mixed: return "mixed";
+    case MotionProfile::Straight: return "straight";
+    case MotionProfile::Circle: return "circle";
+    case MotionProfile::Spin: return "spin";
+  }
+  return "?";
+}
+
+void report(const Options& o, double fraction, const char* stage) {
+  if (o.progress && !o.progress(fraction, stage))
+    throw Error(ErrorCode::Cancelled, std::string("simulation cancelled while ") + stage);
+}
+
+// The options a data set was made with, for reproducing it (not read by planarvo).
+void write_simulation_yaml(const std::string& path, const Options& o, const Eigen::Vector2d& texel) {
+  try {
+    cv::FileStorage fs(path, cv::FileStorage::WRITE);
+    if (!fs.isOpened()) throw Error(ErrorCode::Io, path + ": cannot be written");
+    fs << "generator" << "planarvo simulator";
+    fs << "texture" << o.texture;
+    fs << "texel_size" << o.texel_size;
+    fs << "texel_size_u" << texel.x();
+    fs << "texel_size_v" << texel.y();
+    fs << "seed" << std::to_string(o.seed);
+    fs << "motion" << profile_name(o.motion);
+    fs << "seconds" << o.seconds << "fps" << o.fps;
+    fs << "max_speed" << o.max_speed << "max_turn_rate" << o.max_turn_rate;
+    fs << "max_acceleration" << o.max_acceleration;
+    fs << "max_angular_acceleration" << o.max_angular_acceleration;
+    fs << "start_pose" << std::vector<double>{o.start_pose.x, o.start_pose.y, o.start_pose.theta};
+    fs << "pixel_noise" << o.pixel_noise << "gain_variation" << o.gain_variation;
+    fs << "odometry_noise" << o.odometry_noise << "odometry_noise_floor" << o.odometry_noise_floor;
+    fs << "wheel_base" << o.wheel_base;
+    fs << "supersampling" << o.supersampling << "mipmap" << static_cast<int>(o.mipmap);
+    fs.release();
+  } catch (const cv::Exception& e) {
+    throw Error(ErrorCode::Io, path + ": cannot be written (" + e.err + ")");
+  }
+}
+
+}  // namespace
+
+void simulate(ocl::Runtime& runtime, const Options& options, const std::string& out_dir,
+              SimulationStats* stats) {
+  SimulationStats st;
+  auto t0 = Clock::now();
+  validate(options);
+  if (options.texture.empty()) throw_invalid_argument("simulator options: no texture given");
+  if (out_dir.empty()) throw_invalid_argument("simulate: no output directory given");
+  if (!std::filesystem::is_regular_file(options.texture))
+    throw_invalid_input(options.texture + ": no such file (the simulator's texture)");
+  const cv::Mat texture = cv::imread(options.texture, cv::IMREAD_GRAYSCALE);
+  if (texture.empty())
+    throw_invalid_input(options.texture + ": cannot be read as an image (the simulator's texture)");
+
+  namespace fs = std::filesystem;
+  const fs::path dir(out_dir), images = dir / "images";
+  std::error_code ec;
+  fs::create_directories(images, ec);
+  if (ec || !fs::is_directory(images))
+    throw Error(ErrorCode::Io, images.string() + ": cannot create the directory (" + ec.message() + ")");
+
+  report(options, 0.0, "setting up");
+  const Trajectory tr = generate_trajectory(options);
+  Renderer renderer(runtime, texture, options);
+  const std::vector<Exposure> exposure = exposure_series(options, tr.t);
+  st.setup = seconds_since(t0);
+
+  t0 = Clock::now();
+  io::write_camera_yaml((dir / "camera.yaml").string(), options.camera);
+  io::ExtrinsicsFile gt;
+  gt.value = options.extrinsics;
+  gt.method = "simulator";
+  gt.notes = "ground truth of a simulated data set (seed " + std::to_string(options.seed) + ")";
+  io::write_extrinsics_yaml((dir / "extrinsics_gt.yaml").string(), gt);
+  std::vector<io::StampedPose> truth, odometry;
+  std::vector<io::DirectionLabel> labels;
+  for (size_t k = 0; k < tr.t.size(); ++k) {
+    truth.push_back({tr.t[k], tr.pose[k]});
+    odometry.push_back({tr.t[k], tr.odometry[k]});
+    if (k > 0) labels.push_back({tr.t[k], tr.direction[k - 1]});
+  }
+  io::write_tum((dir / "groundtruth.txt").string(), truth);
+  io::write_tum((dir / "odometry.txt").string(), odometry);
+  io::write_direction((dir / "direction.txt").string(), labels);
+  write_simulation_yaml((dir / "simulation.yaml").string(), options, renderer.texel());
+  st.write += seconds_since(t0);
+
+  const std::vector<int> png = {cv::IMWRITE_PNG_COMPRESSION, 1};
+  std::vector<io::FrameEntry> frames;
+  const size_t n = tr.t.size();
+  for (size_t k = 0; k < n; ++k) {
+    report(options, static_cast<double>(k) / static_cast<double>(n), "rendering");
+    t0 = Clock::now();
+    const cv::Mat clean = renderer.render_float(tr.pose[k]);
+    st.render += seconds_since(t0);
+
+    t0 = Clock::now();
+    const cv::Mat image = apply_camera(clean, exposure[k], options.pixel_noise,
+                                       derive_seed(options.seed, 1000 + k));
+    st.camera += seconds_since(t0);
+
+    t0 = Clock::now();
+    char name[32];
+    std::snprintf(name, sizeof name, "images/%06zu.png", k);
+    const std::string path = (dir / name).string();
+    bool ok = false;
+    try {
+      ok = cv::imwrite(path, image, png);
+    } catch (const cv::Exception& e) {
+      throw Error(ErrorCode::Io, path + ": cannot be written (" + e.err + ")");
+    }
+    if (!ok) throw Error(ErrorCode::Io, path + ": cannot be written");
+    frames.push_back({tr.t[k], name, 0});
+    st.write += seconds_since(t0);
+  }
+  t0 = Clock::now();
+  io::write_frames((dir / "frames.txt").string(), frames);
+  st.write += seconds_since(t0);
+  st.frames = static_cast<int64_t>(n);
+  if (options.progress) options.progress(1.0, "done");  // too late to cancel
+  if (stats) *stats = st;
+}
+
+}  // namespace planarvo::sim
