@@ -438,6 +438,15 @@ cl::Program Runtime::load_from_binaries(const std::string& name, const std::stri
   return p;
 }
 
+void Runtime::prepare_all() {
+  for (const EmbeddedSource* s = embedded_sources(); s->name; ++s) {
+    if (std::string(s->name) == kPreludeName) continue;
+    std::vector<std::string> option_sets = registered_build_options(s->name);
+    if (option_sets.empty()) option_sets.push_back("");
+    for (const std::string& options : option_sets) program(s->name, options);
+  }
+}
+
 void Runtime::export_binaries(const std::string& dir) {
   std::lock_guard<std::mutex> lock(mutex_);
   std::error_code ec;

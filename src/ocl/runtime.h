@@ -100,6 +100,10 @@ class Runtime {
   // cannot be written, Error(OpenCL) when a build fails.
   void export_binaries(const std::string& dir);
 
+  // Builds (or loads) every embedded program with each registered option set, as
+  // export_binaries() would, so that the first frame does not pay for compilation.
+  void prepare_all();
+
   // Layers declare the build options they will use for a program, so that export_binaries()
   // can build exactly those variants. Idempotent; thread-safe.
   static void register_build_options(const std::string& program, const std::string& options);

@@ -1,0 +1,119 @@
+// C API: data sets (src/io/dataset.h).
+#include <cstring>
+#include <memory>
+#include <string>
+
+#include "capi/convert.h"
+#include "capi/status.h"
+#include "core/error.h"
+#include "io/dataset.h"
+
+using planarvo::capi::guard;
+using planarvo::capi::require;
+
+struct planarvo_dataset {
+  std::unique_ptr<planarvo::io::Dataset> dataset;
+  cv::Mat frame;  // the last decoded frame, which planarvo_dataset_frame's image points into
+};
+
+extern "C" {
+
+PLANARVO_API void planarvo_dataset_options_init(planarvo_dataset_options* options) {
+  if (!options) return;
+  std::memset(options, 0, sizeof *options);
+  options->struct_size = sizeof *options;
+}
+
+PLANARVO_API planarvo_status planarvo_dataset_open(const char* directory, const planarvo_dataset_options* options,
+                                                   planarvo_dataset** dataset) {
+  return guard([&] {
+    require(dataset != nullptr, "planarvo_dataset_open: dataset is NULL");
+    *dataset = nullptr;
+    require(directory != nullptr && *directory, "planarvo_dataset_open: directory is NULL or empty");
+    planarvo::io::DatasetOptions o;
+    if (options) {
+      planarvo::capi::require_struct_size(options->struct_size,
+                                          offsetof(planarvo_dataset_options, progress_user_data) + sizeof(void*),
+                                          "planarvo_dataset_options");
+      if (options->video) o.video = options->video;
+      o.verify_images = options->verify_images != 0;
+      if (options->progress) {
+        const planarvo_progress_fn fn = options->progress;
+        void* user = options->progress_user_data;
+        o.progress = [fn, user](double f, const char* stage) { return fn(user, f, stage) == 0; };
+      }
+    }
+    auto handle = std::make_unique<planarvo_dataset>();
+    handle->dataset = std::make_unique<planarvo::io::Dataset>(directory, o);
+    *dataset = handle.release();
+  });
+}
+
+PLANARVO_API void planarvo_dataset_destroy(planarvo_dataset* dataset) { delete dataset; }
+
+PLANARVO_API planarvo_status planarvo_dataset_info_get(const planarvo_dataset* dataset, planarvo_dataset_info* info) {
+  return guard([&] {
+    require(dataset != nullptr && info != nullptr, "planarvo_dataset_info_get: NULL argument");
+    planarvo::capi::require_struct_size(info->struct_size, sizeof(planarvo_dataset_info), "planarvo_dataset_info");
+    const planarvo::io::Dataset& d = *dataset->dataset;
+    planarvo_dataset_info out;
+    std::memset(&out, 0, sizeof out);
+    out.struct_size = info->struct_size;
+    out.frame_count = d.frame_count();
+    out.first_timestamp = d.timestamp(0);
+    out.last_timestamp = d.timestamp(d.frame_count() - 1);
+    out.camera = planarvo::capi::to_c(d.camera());
+    out.has_odometry = d.has_odometry();
+    out.has_direction = d.has_direction();
+    out.has_groundtruth = d.has_groundtruth();
+    if (d.extrinsics()) {
+      out.has_extrinsics = 1;
+      out.extrinsics = planarvo::capi::to_c(d.extrinsics()->value);
+    }
+    if (d.extrinsics_gt()) {
+      out.has_extrinsics_gt = 1;
+      out.extrinsics_gt = planarvo::capi::to_c(d.extrinsics_gt()->value);
+    }
+    *info = out;
+  });
+}
+
+PLANARVO_API planarvo_status planarvo_dataset_frame_data(const planarvo_dataset* dataset, int64_t index,
+                                                         planarvo_frame_data* data) {
+  return guard([&] {
+    require(dataset != nullptr && data != nullptr, "planarvo_dataset_frame_data: NULL argument");
+    const planarvo::io::Dataset& d = *dataset->dataset;
+    require(index >= 0 && index < d.frame_count(), "planarvo_dataset_frame_data: index out of range");
+    planarvo_frame_data out;
+    std::memset(&out, 0, sizeof out);
+    out.timestamp = d.timestamp(index);
+    if (auto o = d.odometry_at(index)) {
+      out.has_odometry = 1;
+      out.odometry = planarvo::capi::to_c(*o);
+    }
+    if (auto g = d.groundtruth_at(index)) {
+      out.has_groundtruth = 1;
+      out.groundtruth = planarvo::capi::to_c(*g);
+    }
+    if (auto s = d.direction_for_interval(index)) {
+      out.has_direction = 1;
+      out.direction = *s;
+    }
+    *data = out;
+  });
+}
+
+PLANARVO_API planarvo_status planarvo_dataset_frame(planarvo_dataset* dataset, int64_t index, planarvo_image* image) {
+  return guard([&] {
+    require(dataset != nullptr && image != nullptr, "planarvo_dataset_frame: NULL argument");
+    require(index >= 0 && index < dataset->dataset->frame_count(), "planarvo_dataset_frame: index out of range");
+    dataset->frame = dataset->dataset->frame(index);
+    image->data = dataset->frame.data;
+    image->width = dataset->frame.cols;
+    image->height = dataset->frame.rows;
+    image->stride = dataset->frame.step[0];
+    image->format = PLANARVO_GRAY8;
+  });
+}
+
+}  // extern "C"

@@ -1,0 +1,95 @@
+// C API: camera and extrinsics YAML, TUM trajectories.
+#include <cmath>
+#include <sstream>
+#include <string>
+
+#include "capi/convert.h"
+#include "capi/status.h"
+#include "core/error.h"
+#include "io/formats.h"
+
+using planarvo::capi::guard;
+using planarvo::capi::require;
+
+namespace {
+void require_path(const char* path, const char* fn) {
+  require(path != nullptr && *path != '\0', (std::string(fn) + ": path is NULL or empty").c_str());
+}
+}  // namespace
+
+extern "C" {
+
+PLANARVO_API planarvo_status planarvo_camera_load(const char* path, planarvo_camera* camera) {
+  return guard([&] {
+    require_path(path, "planarvo_camera_load");
+    require(camera != nullptr, "planarvo_camera_load: camera is NULL");
+    *camera = planarvo::capi::to_c(planarvo::io::read_camera_yaml(path));
+  });
+}
+
+PLANARVO_API planarvo_status planarvo_camera_save(const char* path, const planarvo_camera* camera) {
+  return guard([&] {
+    require_path(path, "planarvo_camera_save");
+    require(camera != nullptr, "planarvo_camera_save: camera is NULL");
+    const planarvo::CameraModel m = planarvo::capi::to_cpp(*camera);
+    try {
+      m.validate("planarvo_camera_save");
+    } catch (const planarvo::Error& e) {
+      throw planarvo::Error(planarvo::ErrorCode::InvalidArgument, e.what());
+    }
+    planarvo::io::write_camera_yaml(path, m);
+  });
+}
+
+PLANARVO_API planarvo_status planarvo_extrinsics_load(const char* path, planarvo_extrinsics* e) {
+  return guard([&] {
+    require_path(path, "planarvo_extrinsics_load");
+    require(e != nullptr, "planarvo_extrinsics_load: extrinsics is NULL");
+    *e = planarvo::capi::to_c(planarvo::io::read_extrinsics_yaml(path).value);
+  });
+}
+
+PLANARVO_API planarvo_status planarvo_extrinsics_save(const char* path, const planarvo_extrinsics* e,
+                                                      const double* covariance, const char* estimated,
+                                                      const char* method, const char* notes) {
+  return guard([&] {
+    require_path(path, "planarvo_extrinsics_save");
+    require(e != nullptr, "planarvo_extrinsics_save: extrinsics is NULL");
+    planarvo::io::ExtrinsicsFile f;
+    f.value = planarvo::capi::to_cpp(*e);
+    for (double v : {e->x, e->y, e->z, e->roll, e->pitch, e->yaw})
+      require(std::isfinite(v), "planarvo_extrinsics_save: a value is NaN or inf");
+    if (covariance)
+      for (int i = 0; i < 36; ++i) f.covariance(i / 6, i % 6) = covariance[i];
+    if (estimated) {
+      std::stringstream ss(estimated);
+      std::string name;
+      while (std::getline(ss, name, ','))
+        if (!name.empty()) f.estimated.push_back(name);
+    }
+    if (method) f.method = method;
+    if (notes) f.notes = notes;
+    planarvo::io::write_extrinsics_yaml(path, f);
+  });
+}
+
+PLANARVO_API planarvo_status planarvo_extrinsics_matrix(const planarvo_extrinsics* e, double matrix[16]) {
+  return guard([&] {
+    require(e != nullptr && matrix != nullptr, "planarvo_extrinsics_matrix: NULL argument");
+    const Eigen::Matrix4d T = planarvo::capi::to_cpp(*e).T_vc();
+    for (int i = 0; i < 16; ++i) matrix[i] = T(i / 4, i % 4);
+  });
+}
+
+PLANARVO_API planarvo_status planarvo_write_tum(const char* path, const double* timestamps,
+                                                const planarvo_se2* poses, size_t count) {
+  return guard([&] {
+    require_path(path, "planarvo_write_tum");
+    require(count == 0 || (timestamps != nullptr && poses != nullptr), "planarvo_write_tum: NULL arrays");
+    std::vector<planarvo::io::StampedPose> v(count);
+    for (size_t i = 0; i < count; ++i) v[i] = {timestamps[i], planarvo::capi::to_cpp(poses[i])};
+    planarvo::io::write_tum(path, v);
+  });
+}
+
+}  // extern "C"

@@ -1,0 +1,19 @@
+// The structs behind the C API's opaque handles, and the exception for output buffers that are
+// too small. Only src/capi includes this.
+#pragma once
+#include <memory>
+#include <stdexcept>
+#include <string>
+
+#include "ocl/runtime.h"
+#include "planarvo/planarvo.h"
+
+struct planarvo_context {
+  std::unique_ptr<planarvo::ocl::Runtime> runtime;
+};
+
+namespace planarvo::capi {
+struct BufferTooSmall : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+}  // namespace planarvo::capi

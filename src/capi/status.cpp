@@ -1,0 +1,99 @@
+#include "capi/status.h"
+
+#include <new>
+#include <stdexcept>
+
+#include <CL/opencl.hpp>
+#include <opencv2/core.hpp>
+
+#include "capi/handles.h"
+#include "core/error.h"
+#include "ocl/runtime.h"
+
+namespace planarvo::capi {
+namespace {
+
+thread_local std::string t_last_error;
+
+planarvo_status to_status(ErrorCode code) {
+  switch (code) {
+    case ErrorCode::InvalidArgument: return PLANARVO_ERROR_INVALID_ARGUMENT;
+    case ErrorCode::InvalidInput: return PLANARVO_ERROR_INVALID_INPUT;
+    case ErrorCode::Io: return PLANARVO_ERROR_IO;
+    case ErrorCode::NoDevice: return PLANARVO_ERROR_NO_DEVICE;
+    case ErrorCode::OpenCL: return PLANARVO_ERROR_OPENCL;
+    case ErrorCode::Failed: return PLANARVO_ERROR_FAILED;
+    case ErrorCode::Cancelled: return PLANARVO_ERROR_CANCELLED;
+    case ErrorCode::Internal: return PLANARVO_ERROR_INTERNAL;
+  }
+  return PLANARVO_ERROR_INTERNAL;
+}
+
+}  // namespace
+
+planarvo_status fail(planarvo_status status, const std::string& message) {
+  try {
+    t_last_error = message;
+  } catch (...) {
+    // Out of memory while recording the message: keep the status, lose the text.
+  }
+  return status;
+}
+
+planarvo_status translate_current_exception() noexcept {
+  try {
+    throw;
+  } catch (const Error& e) {
+    return fail(to_status(e.code()), e.what());
+  } catch (const BufferTooSmall& e) {
+    return fail(PLANARVO_ERROR_BUFFER_TOO_SMALL, e.what());
+  } catch (const cl::Error& e) {
+    return fail(PLANARVO_ERROR_OPENCL,
+                std::string(e.what()) + " failed: " + ocl::error_name(e.err()));
+  } catch (const cv::Exception& e) {
+    return fail(PLANARVO_ERROR_INTERNAL, std::string("OpenCV: ") + e.what());
+  } catch (const std::bad_alloc&) {
+    return fail(PLANARVO_ERROR_INTERNAL, "out of memory");
+  } catch (const std::exception& e) {
+    return fail(PLANARVO_ERROR_INTERNAL, std::string("internal error: ") + e.what());
+  } catch (...) {
+    return fail(PLANARVO_ERROR_INTERNAL, "internal error: unknown exception");
+  }
+}
+
+void require(bool condition, const char* message) {
+  if (!condition) throw Error(ErrorCode::InvalidArgument, message);
+}
+
+void require_struct_size(size_t struct_size, size_t offset_end, const char* name) {
+  if (struct_size < offset_end)
+    throw Error(ErrorCode::InvalidArgument,
+                std::string(name) + ".struct_size is " + std::to_string(struct_size) +
+                    ": set it to sizeof(" + name + ") and initialise with the _init function");
+}
+
+}  // namespace planarvo::capi
+
+extern "C" {
+
+PLANARVO_API const char* planarvo_last_error(void) {
+  return planarvo::capi::t_last_error.c_str();
+}
+
+PLANARVO_API const char* planarvo_status_name(planarvo_status status) {
+  switch (status) {
+    case PLANARVO_OK: return "PLANARVO_OK";
+    case PLANARVO_ERROR_INVALID_ARGUMENT: return "PLANARVO_ERROR_INVALID_ARGUMENT";
+    case PLANARVO_ERROR_INVALID_INPUT: return "PLANARVO_ERROR_INVALID_INPUT";
+    case PLANARVO_ERROR_IO: return "PLANARVO_ERROR_IO";
+    case PLANARVO_ERROR_NO_DEVICE: return "PLANARVO_ERROR_NO_DEVICE";
+    case PLANARVO_ERROR_OPENCL: return "PLANARVO_ERROR_OPENCL";
+    case PLANARVO_ERROR_FAILED: return "PLANARVO_ERROR_FAILED";
+    case PLANARVO_ERROR_CANCELLED: return "PLANARVO_ERROR_CANCELLED";
+    case PLANARVO_ERROR_BUFFER_TOO_SMALL: return "PLANARVO_ERROR_BUFFER_TOO_SMALL";
+    case PLANARVO_ERROR_INTERNAL: return "PLANARVO_ERROR_INTERNAL";
+  }
+  return "PLANARVO_ERROR_UNKNOWN";
+}
+
+}  // extern "C"

@@ -1,0 +1,330 @@
+// `planarvo simulate`, `planarvo info` and `planarvo demo`: data sets in and out.
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <string>
+#include <unistd.h>
+#include <vector>
+
+#include "common.h"
+
+namespace planarvo::cli {
+namespace {
+
+constexpr double kDeg = M_PI / 180.0;
+namespace fs = std::filesystem;
+
+double seconds_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+// The built-in texture: installed beside the tool (../share/planarvo/textures), else the source
+// tree's copy.
+std::string default_texture() {
+  std::error_code ec;
+  const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
+  if (!ec) {
+    const fs::path installed = exe.parent_path().parent_path() / "share/planarvo/textures/asphalt_01.png";
+    if (fs::exists(installed)) return installed.string();
+  }
+  if (fs::exists(PLANARVO_INSTALLED_TEXTURE)) return PLANARVO_INSTALLED_TEXTURE;
+  return PLANARVO_DEFAULT_TEXTURE;
+}
+
+std::vector<OptionSpec> simulate_options() {
+  std::vector<OptionSpec> s = {
+      {"out", "DIR", "output data set directory (created)", ""},
+      {"texture", "FILE", "ground photograph (grey or colour image)", "built-in asphalt_01.png"},
+      {"texel", "METRES", "size of one texture pixel on the ground", "0.0004"},
+      {"extrinsics", "x,y,z,roll,pitch,yaw", "camera on the robot: metres and degrees",
+       "0.2441,-0.0185,0.1787,12.4,17.6,-9.2"},
+      {"seconds", "S", "duration", "10"},
+      {"fps", "F", "frame rate", "30"},
+      {"seed", "N", "random seed (same seed, same data set)", "1"},
+      {"motion", "KIND", "mixed | straight | circle | spin", "mixed"},
+      {"max-speed", "M/S", "peak linear speed", "0.8"},
+      {"max-turn-rate", "RAD/S", "peak angular speed", "1.5"},
+      {"noise", "SIGMA", "pixel noise standard deviation, grey levels", "1"},
+      {"gain-variation", "REL", "amplitude of slow camera gain changes", "0.05"},
+      {"odometry-noise", "REL", "wheel odometry error per unit of wheel travel", "0.01"},
+      {"width", "PX", "image width", "640"},
+      {"height", "PX", "image height", "480"},
+      {"fov", "DEG", "horizontal field of view", "80"},
+      {"distortion", "k1,k2,p1,p2,k3", "lens distortion (OpenCV model)", "-0.12,0.03,0,0,0"},
+      {"supersampling", "N", "N x N samples per pixel (plus mip-mapping)", "3"},
+      {"quiet", "", "no progress bar", ""},
+      {"help", "", "show this help", ""},
+  };
+  for (auto& d : device_options()) s.push_back(d);
+  return s;
+}
+
+// Fills sim options from the command line over the library's defaults.
+void apply_simulate_args(const Args& a, planarvo_sim_options* o, std::string* texture) {
+  *texture = a.get("texture", default_texture());
+  o->texture = texture->c_str();
+  o->texel_size = a.get_double("texel", o->texel_size);
+  if (a.has("extrinsics")) {
+    const auto v = a.get_doubles("extrinsics", 6);
+    o->extrinsics = {v[0], v[1], v[2], v[3] * kDeg, v[4] * kDeg, v[5] * kDeg};
+  }
+  o->seconds = a.get_double("seconds", o->seconds);
+  o->fps = a.get_double("fps", o->fps);
+  const long long seed = a.get_int("seed", static_cast<long long>(o->seed));
+  if (seed < 0) throw UsageError("--seed must be non-negative");
+  o->seed = static_cast<uint64_t>(seed);
+  const std::string motion = a.get("motion", "mixed");
+  if (motion == "mixed") o->motion = PLANARVO_MOTION_MIXED;
+  else if (motion == "straight") o->motion = PLANARVO_MOTION_STRAIGHT;
+  else if (motion == "circle") o->motion = PLANARVO_MOTION_CIRCLE;
+  else if (motion == "spin") o->motion = PLANARVO_MOTION_SPIN;
+  else throw UsageError("--motion must be mixed, straight, circle or spin, not \"" + motion + "\"");
+  o->max_speed = a.get_double("max-speed", o->max_speed);
+  o->max_turn_rate = a.get_double("max-turn-rate", o->max_turn_rate);
+  o->pixel_noise = a.get_double("noise", o->pixel_noise);
+  o->gain_variation = a.get_double("gain-variation", o->gain_variation);
+  o->odometry_noise = a.get_double("odometry-noise", o->odometry_noise);
+  o->supersampling = static_cast<int32_t>(a.get_int("supersampling", o->supersampling));
+  planarvo_camera& c = o->camera;
+  if (a.has("width") || a.has("height") || a.has("fov")) {
+    const long long w = a.get_int("width", c.width), h = a.get_int("height", c.height);
+    if (w < 8 || h < 8 || w > 16384 || h > 16384) throw UsageError("--width/--height must be 8..16384");
+    const double fov = a.get_double("fov", 2.0 * std::atan(c.cx / c.fx + 0.5 / c.fx) / kDeg);
+    if (!(fov > 1 && fov < 170)) throw UsageError("--fov must be between 1 and 170 degrees");
+    c.width = static_cast<int32_t>(w);
+    c.height = static_cast<int32_t>(h);
+    c.fx = c.fy = 0.5 * static_cast<double>(w) / std::tan(0.5 * fov * kDeg);
+    c.cx = 0.5 * static_cast<double>(w) - 0.5;
+    c.cy = 0.5 * static_cast<double>(h) - 0.5;
+  }
+  if (a.has("distortion")) {
+    const auto d = a.get_doubles("distortion", 5);
+    c.k1 = d[0]; c.k2 = d[1]; c.p1 = d[2]; c.p2 = d[3]; c.k3 = d[4];
+  }
+}
+
+struct DatasetDeleter {
+  void operator()(planarvo_dataset* d) const { planarvo_dataset_destroy(d); }
+};
+using DatasetPtr = std::unique_ptr<planarvo_dataset, DatasetDeleter>;
+
+DatasetPtr open_dataset(const std::string& dir, const std::string& video, bool verify, Progress* progress) {
+  planarvo_dataset_options o;
+  planarvo_dataset_options_init(&o);
+  if (!video.empty()) o.video = video.c_str();
+  o.verify_images = verify ? 1 : 0;
+  o.progress = &Progress::callback;
+  o.progress_user_data = progress;
+  planarvo_dataset* d = nullptr;
+  check(planarvo_dataset_open(dir.c_str(), &o, &d));
+  return DatasetPtr(d);
+}
+
+// What a trajectory and its wheel odometry look like against ground truth.
+struct DriveSummary {
+  double distance = 0, peak_speed = 0, peak_turn = 0;
+  int forward = 0, backward = 0, still = 0;
+  bool has_odometry = false;
+  double odo_end_error = 0, odo_heading_error = 0, odo_rms_step = 0;
+};
+
+DriveSummary summarise(planarvo_dataset* ds, int64_t n) {
+  DriveSummary s;
+  std::vector<planarvo_frame_data> f(static_cast<size_t>(n));
+  for (int64_t i = 0; i < n; ++i) check(planarvo_dataset_frame_data(ds, i, &f[static_cast<size_t>(i)]));
+  double sq = 0;
+  int steps = 0;
+  s.has_odometry = n > 1 && f[0].has_odometry && f[0].has_groundtruth;
+  for (size_t i = 1; i < f.size(); ++i) {
+    const auto &a = f[i - 1], &b = f[i];
+    const double dt = b.timestamp - a.timestamp;
+    if (a.has_groundtruth && b.has_groundtruth) {
+      const double d = std::hypot(b.groundtruth.x - a.groundtruth.x, b.groundtruth.y - a.groundtruth.y);
+      const double dth = std::remainder(b.groundtruth.theta - a.groundtruth.theta, 2 * M_PI);
+      s.distance += d;
+      s.peak_speed = std::max(s.peak_speed, d / dt);
+      s.peak_turn = std::max(s.peak_turn, std::abs(dth) / dt);
+      if (a.has_odometry && b.has_odometry) {
+        // Relative motion in the frame of a, for both, compared.
+        auto rel = [](const planarvo_se2& p, const planarvo_se2& q) {
+          const double c = std::cos(p.theta), sn = std::sin(p.theta);
+          const double dx = q.x - p.x, dy = q.y - p.y;
+          return planarvo_se2{c * dx + sn * dy, -sn * dx + c * dy, std::remainder(q.theta - p.theta, 2 * M_PI)};
+        };
+        const planarvo_se2 g = rel(a.groundtruth, b.groundtruth), o = rel(a.odometry, b.odometry);
+        sq += (g.x - o.x) * (g.x - o.x) + (g.y - o.y) * (g.y - o.y);
+        ++steps;
+      }
+    }
+    if (b.has_direction) {
+      if (b.direction > 0) ++s.forward;
+      else if (b.direction < 0) ++s.backward;
+      else ++s.still;
+    }
+  }
+  if (s.has_odometry && f.back().has_odometry && f.back().has_groundtruth) {
+    // Both trajectories relative to their first pose.
+    auto rel0 = [](const planarvo_se2& p0, const planarvo_se2& p) {
+      const double c = std::cos(p0.theta), sn = std::sin(p0.theta);
+      const double dx = p.x - p0.x, dy = p.y - p0.y;
+      return planarvo_se2{c * dx + sn * dy, -sn * dx + c * dy, std::remainder(p.theta - p0.theta, 2 * M_PI)};
+    };
+    const planarvo_se2 g = rel0(f.front().groundtruth, f.back().groundtruth);
+    const planarvo_se2 o = rel0(f.front().odometry, f.back().odometry);
+    s.odo_end_error = std::hypot(g.x - o.x, g.y - o.y);
+    s.odo_heading_error = std::abs(std::remainder(g.theta - o.theta, 2 * M_PI));
+    s.odo_rms_step = steps ? std::sqrt(sq / steps) : 0;
+  }
+  return s;
+}
+
+void print_dataset(planarvo_dataset* ds, const std::string& dir) {
+  planarvo_dataset_info info{};
+  info.struct_size = sizeof info;
+  check(planarvo_dataset_info_get(ds, &info));
+  const auto& c = info.camera;
+  const double span = info.last_timestamp - info.first_timestamp;
+  std::printf("data set %s\n", dir.c_str());
+  std::printf("  frames      %lld over %.3f s (%.2f fps)\n", static_cast<long long>(info.frame_count), span,
+              info.frame_count > 1 ? static_cast<double>(info.frame_count - 1) / span : 0.0);
+  std::printf("  camera      %dx%d, fx %.2f fy %.2f cx %.2f cy %.2f, distortion %.4g %.4g %.4g %.4g %.4g\n",
+              c.width, c.height, c.fx, c.fy, c.cx, c.cy, c.k1, c.k2, c.p1, c.p2, c.k3);
+  std::printf("  odometry    %s\n  direction   %s\n  groundtruth %s\n", info.has_odometry ? "yes" : "no",
+              info.has_direction ? "yes" : "no", info.has_groundtruth ? "yes" : "no");
+  auto ext = [](const char* label, int has, const planarvo_extrinsics& e) {
+    if (!has) {
+      std::printf("  %-11s no\n", label);
+      return;
+    }
+    std::printf("  %-11s x %.1f mm, y %.1f mm, z %.1f mm, roll %.2f deg, pitch %.2f deg, yaw %.2f deg\n", label,
+                e.x * 1e3, e.y * 1e3, e.z * 1e3, e.roll / kDeg, e.pitch / kDeg, e.yaw / kDeg);
+  };
+  ext("extrinsics", info.has_extrinsics, info.extrinsics);
+  ext("true extr.", info.has_extrinsics_gt, info.extrinsics_gt);
+  if (info.has_groundtruth) {
+    const DriveSummary s = summarise(ds, info.frame_count);
+    std::printf("  drive       %.2f m, peak %.2f m/s and %.2f rad/s; intervals: %d forward, %d backward, "
+                "%d without linear motion\n",
+                s.distance, s.peak_speed, s.peak_turn, s.forward, s.backward, s.still);
+  }
+}
+
+}  // namespace
+
+int cmd_simulate(int argc, char** argv) {
+  const auto specs = simulate_options();
+  Args args(specs, argc, argv, 1);
+  if (args.has("help")) {
+    std::printf("usage: planarvo simulate --out DIR [options]\n\n"
+                "Renders a downward-looking camera on a differential-drive robot over a textured ground\n"
+                "plane, with exact ground truth, in the data set layout planarvo reads.\n\n%s",
+                format_options(specs).c_str());
+    return kExitOk;
+  }
+  if (!args.positionals().empty()) throw UsageError("unexpected argument " + args.positionals()[0]);
+  if (!args.has("out")) throw UsageError("--out DIR is required");
+  planarvo_sim_options o;
+  planarvo_sim_options_init(&o);
+  std::string texture;
+  apply_simulate_args(args, &o, &texture);
+  ContextPtr ctx = make_context(args);
+  Progress progress(!args.has("quiet"));
+  o.progress = &Progress::callback;
+  o.progress_user_data = &progress;
+  const auto t0 = std::chrono::steady_clock::now();
+  check(planarvo_simulate(ctx.get(), &o, args.get("out").c_str()));
+  progress.finish();
+  std::printf("simulated %.1f s at %.0f fps (%dx%d) over %s into %s in %.1f s on %s\n", o.seconds, o.fps,
+              o.camera.width, o.camera.height, texture.c_str(), args.get("out").c_str(), seconds_since(t0),
+              device_name(ctx.get()).c_str());
+  return kExitOk;
+}
+
+int cmd_info(int argc, char** argv) {
+  const std::vector<OptionSpec> specs = {
+      {"video", "FILE", "a video file standing in for images/ and frames.txt", ""},
+      {"verify", "", "decode every image now (sizes, unreadable files)", ""},
+      {"quiet", "", "no progress bar", ""},
+      {"help", "", "show this help", ""}};
+  Args args(specs, argc, argv, 1);
+  if (args.has("help") || args.positionals().size() != 1) {
+    std::printf("usage: planarvo info DATASET [--verify] [--video FILE]\n\n"
+                "Reads a data set (shared layout: camera.yaml, frames.txt, images/, optional odometry.txt,\n"
+                "direction.txt, groundtruth.txt, extrinsics.yaml), checks it and prints what it holds.\n\n%s",
+                format_options(specs).c_str());
+    return args.has("help") ? kExitOk : kExitUsage;
+  }
+  Progress progress(!args.has("quiet"));
+  DatasetPtr ds = open_dataset(args.positionals()[0], args.get("video"), args.has("verify"), &progress);
+  progress.finish();
+  print_dataset(ds.get(), args.positionals()[0]);
+  if (args.has("verify")) std::printf("  every image decoded and checked\n");
+  return kExitOk;
+}
+
+int cmd_demo(int argc, char** argv) {
+  std::vector<OptionSpec> specs = simulate_options();
+  specs.erase(std::remove_if(specs.begin(), specs.end(), [](const OptionSpec& s) { return s.name == "out"; }),
+              specs.end());
+  specs.insert(specs.begin(), {"out", "DIR", "where to write the simulated data set", "a new folder in $TMPDIR"});
+  Args args(specs, argc, argv, 1);
+  if (args.has("help")) {
+    std::printf("usage: planarvo demo [options]\n\n"
+                "The main job on a built-in default: simulates a short drive over a real ground texture,\n"
+                "reads it back and runs the engine on it, and prints its accuracy against ground truth.\n\n%s",
+                format_options(specs).c_str());
+    return kExitOk;
+  }
+  if (!args.positionals().empty()) throw UsageError("unexpected argument " + args.positionals()[0]);
+  std::string out = args.get("out");
+  if (out.empty()) {
+    const char* tmp = std::getenv("TMPDIR");
+    std::string templ = std::string(tmp && *tmp ? tmp : "/tmp") + "/planarvo-demo-XXXXXX";
+    if (!mkdtemp(templ.data())) throw ApiError(PLANARVO_ERROR_IO, "cannot create a folder in " + templ);
+    out = templ;
+  }
+  planarvo_sim_options o;
+  planarvo_sim_options_init(&o);
+  std::string texture;
+  apply_simulate_args(args, &o, &texture);
+  ContextPtr ctx = make_context(args);
+  std::printf("planarvo %s demo on %s\n", planarvo_version_string(), device_name(ctx.get()).c_str());
+  std::printf("1. simulate: %.0f s at %.0f fps, %dx%d, over %s (texel %.2f mm)\n", o.seconds, o.fps,
+              o.camera.width, o.camera.height, fs::path(texture).filename().c_str(), o.texel_size * 1e3);
+  std::printf("   camera at x %.1f mm, y %.1f mm, height %.1f mm, roll %.1f, pitch %.1f, yaw %.1f deg\n",
+              o.extrinsics.x * 1e3, o.extrinsics.y * 1e3, o.extrinsics.z * 1e3, o.extrinsics.roll / kDeg,
+              o.extrinsics.pitch / kDeg, o.extrinsics.yaw / kDeg);
+  Progress progress(!args.has("quiet"));
+  o.progress = &Progress::callback;
+  o.progress_user_data = &progress;
+  auto t0 = std::chrono::steady_clock::now();
+  check(planarvo_simulate(ctx.get(), &o, out.c_str()));
+  progress.finish();
+  std::printf("   wrote %s in %.1f s\n", out.c_str(), seconds_since(t0));
+
+  t0 = std::chrono::steady_clock::now();
+  DatasetPtr ds = open_dataset(out, "", true, &progress);
+  progress.finish();
+  std::printf("2. read back and checked every image in %.1f s\n", seconds_since(t0));
+  planarvo_dataset_info info{};
+  info.struct_size = sizeof info;
+  check(planarvo_dataset_info_get(ds.get(), &info));
+  const DriveSummary s = summarise(ds.get(), info.frame_count);
+  std::printf("3. the drive (ground truth): %.2f m, peak %.2f m/s, %.2f rad/s; intervals: %d forward, %d backward,"
+              " %d without linear motion\n",
+              s.distance, s.peak_speed, s.peak_turn, s.forward, s.backward, s.still);
+  std::printf("\n   accuracy against ground truth       end-point error   heading error   per-frame RMS\n");
+  if (s.has_odometry)
+    std::printf("   wheel odometry (simulated, %.0f%%)   %8.1f mm (%4.2f%%) %9.3f deg %11.3f mm\n",
+                o.odometry_noise * 100, s.odo_end_error * 1e3, 100 * s.odo_end_error / std::max(s.distance, 1e-9),
+                s.odo_heading_error / kDeg, s.odo_rms_step * 1e3);
+  std::printf("   visual odometry                     not built yet: the dense tracker comes next (issue 4)\n");
+  std::printf("\nLook at the frames in %s/images; `planarvo info %s` describes the data set.\n", out.c_str(),
+              out.c_str());
+  return kExitOk;
+}
+
+}  // namespace planarvo::cli

@@ -1,0 +1,74 @@
+// `planarvo devices` and `planarvo kernels`: the OpenCL side of the tool.
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include "common.h"
+
+namespace planarvo::cli {
+namespace {
+
+std::string bytes(uint64_t b) {
+  char buf[32];
+  if (b >= (1ull << 30)) std::snprintf(buf, sizeof buf, "%.1f GiB", static_cast<double>(b) / (1ull << 30));
+  else if (b >= (1ull << 20)) std::snprintf(buf, sizeof buf, "%.1f MiB", static_cast<double>(b) / (1ull << 20));
+  else std::snprintf(buf, sizeof buf, "%llu KiB", static_cast<unsigned long long>(b >> 10));
+  return buf;
+}
+
+}  // namespace
+
+int cmd_devices(int argc, char** argv) {
+  const std::vector<OptionSpec> specs = {{"help", "", "show this help", ""}};
+  Args args(specs, argc, argv, 1);
+  if (args.has("help")) {
+    std::printf("usage: planarvo devices\n\nLists every OpenCL platform and device; the number in the first\n"
+                "column is what --device N and PLANARVO_DEVICE=N select.\n");
+    return kExitOk;
+  }
+  if (!args.positionals().empty()) throw UsageError("devices takes no arguments");
+  size_t n = 0;
+  check(planarvo_list_devices(nullptr, 0, &n));
+  if (n == 0) {
+    std::fprintf(stderr, "planarvo devices: no OpenCL platform or device found "
+                         "(install an ICD, e.g. Debian's pocl-opencl-icd)\n");
+    return kExitNoDevice;
+  }
+  std::vector<planarvo_device_info> devs(n);
+  for (auto& d : devs) d.struct_size = sizeof d;
+  check(planarvo_list_devices(devs.data(), devs.size(), &n));
+  for (const auto& d : devs) {
+    std::printf("%d  %-11s %s / %s\n", d.index, d.device_type, d.platform_name, d.device_name);
+    std::printf("   %s; %s; driver %s\n", d.device_version, d.opencl_c_version, d.driver_version);
+    std::printf("   image support %s, fp64 %s, local memory %s, global memory %s, max work-group %llu, "
+                "compute units %u\n",
+                d.image_support ? "yes" : "no", d.fp64 ? "yes" : "no", bytes(d.local_mem_size).c_str(),
+                bytes(d.global_mem_size).c_str(), static_cast<unsigned long long>(d.max_work_group_size),
+                d.compute_units);
+  }
+  return kExitOk;
+}
+
+int cmd_kernels(int argc, char** argv) {
+  std::vector<OptionSpec> specs = {
+      {"export", "DIR", "build every kernel program for the device and write the binaries to DIR", ""},
+      {"help", "", "show this help", ""}};
+  for (auto& s : device_options()) specs.push_back(s);
+  Args args(specs, argc, argv, 1);
+  if (args.has("help") || !args.has("export")) {
+    std::printf("usage: planarvo kernels --export DIR [--device SEL]\n\n"
+                "Writes prebuilt program binaries for the selected device into DIR, with a manifest\n"
+                "(planarvo-kernels.txt). Pass DIR to --kernel-binaries (or the C API's\n"
+                "kernel_binaries_dir) to run without compiling kernels, as FPGA runtimes require.\n\n%s",
+                format_options(specs).c_str());
+    return args.has("help") ? kExitOk : kExitUsage;
+  }
+  if (!args.positionals().empty()) throw UsageError("unexpected argument " + args.positionals()[0]);
+  ContextPtr ctx = make_context(args);
+  const std::string dir = args.get("export");
+  check(planarvo_context_export_kernels(ctx.get(), dir.c_str()));
+  std::printf("wrote kernel binaries for %s to %s\n", device_name(ctx.get()).c_str(), dir.c_str());
+  return kExitOk;
+}
+
+}  // namespace planarvo::cli

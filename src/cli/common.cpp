@@ -1,0 +1,85 @@
+#include "common.h"
+
+#include <cstdio>
+#include <unistd.h>
+
+namespace planarvo::cli {
+
+int ApiError::exit_code() const {
+  switch (status) {
+    case PLANARVO_ERROR_INVALID_ARGUMENT:
+    case PLANARVO_ERROR_INVALID_INPUT:
+    case PLANARVO_ERROR_IO:
+      return kExitUsage;
+    case PLANARVO_ERROR_NO_DEVICE:
+      return kExitNoDevice;
+    default:
+      return kExitFailed;
+  }
+}
+
+void check(planarvo_status status) {
+  if (status != PLANARVO_OK) throw ApiError(status, planarvo_last_error());
+}
+
+std::vector<OptionSpec> device_options() {
+  return {
+      {"device", "SEL", "OpenCL device: index or name substring (see `planarvo devices`)",
+       "$PLANARVO_DEVICE, else first GPU/accelerator, else CPU"},
+      {"kernel-binaries", "DIR", "load prebuilt kernel binaries from DIR; never compile", ""},
+      {"cache-dir", "DIR", "kernel program cache directory", "~/.cache/planarvo"},
+      {"no-cache", "", "do not use the kernel program cache", ""},
+  };
+}
+
+ContextPtr make_context(const Args& args) {
+  planarvo_context_options o;
+  planarvo_context_options_init(&o);
+  const std::string device = args.get("device"), bins = args.get("kernel-binaries"),
+                    cache = args.get("cache-dir");
+  if (!device.empty()) o.device = device.c_str();
+  if (!bins.empty()) o.kernel_binaries_dir = bins.c_str();
+  if (!cache.empty()) o.cache_dir = cache.c_str();
+  o.disable_cache = args.has("no-cache") ? 1 : 0;
+  planarvo_context* c = nullptr;
+  check(planarvo_context_create(&o, &c));
+  return ContextPtr(c);
+}
+
+std::string device_name(const planarvo_context* context) {
+  planarvo_device_info info{};
+  info.struct_size = sizeof info;
+  check(planarvo_context_device(context, &info));
+  return std::string(info.device_name) + " (" + info.platform_name + ")";
+}
+
+bool stderr_is_terminal() { return isatty(STDERR_FILENO) == 1; }
+
+Progress::Progress(bool enabled) : enabled_(enabled && stderr_is_terminal()) {}
+Progress::~Progress() { finish(); }
+
+int Progress::callback(void* self, double fraction, const char* stage) {
+  auto* p = static_cast<Progress*>(self);
+  if (!p->enabled_) return 0;
+  const int permille = static_cast<int>(fraction * 1000.0 + 0.5);
+  const std::string s = stage ? stage : "";
+  if (permille == p->last_permille_ && s == p->last_stage_) return 0;
+  p->last_permille_ = permille;
+  p->last_stage_ = s;
+  const int width = 30, filled = permille * width / 1000;
+  std::fprintf(stderr, "\r[%s%s] %5.1f%% %-24.24s", std::string(static_cast<size_t>(filled), '#').c_str(),
+               std::string(static_cast<size_t>(width - filled), ' ').c_str(), permille / 10.0, s.c_str());
+  std::fflush(stderr);
+  p->drawn_ = true;
+  return 0;
+}
+
+void Progress::finish() {
+  if (drawn_) {
+    std::fprintf(stderr, "\r%70s\r", "");
+    std::fflush(stderr);
+    drawn_ = false;
+  }
+}
+
+}  // namespace planarvo::cli

@@ -1,0 +1,66 @@
+// Shared pieces of the planarvo tool's commands: exit codes, the C API call checker, the context
+// options every device-using command accepts, and the terminal progress bar.
+#pragma once
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "args.h"
+#include "planarvo/planarvo.h"
+
+namespace planarvo::cli {
+
+// Exit codes (shared/spec/formats.md).
+enum Exit { kExitOk = 0, kExitFailed = 1, kExitUsage = 2, kExitNoDevice = 3 };
+
+// A failed C API call: main() prints "planarvo: <message>" and exits with exit_code().
+struct ApiError : std::runtime_error {
+  ApiError(planarvo_status s, const std::string& m) : std::runtime_error(m), status(s) {}
+  int exit_code() const;
+  planarvo_status status;
+};
+
+// Throws ApiError with planarvo_last_error() when status is not PLANARVO_OK.
+void check(planarvo_status status);
+
+// --device, --kernel-binaries, --cache-dir, --no-cache.
+std::vector<OptionSpec> device_options();
+struct ContextDeleter {
+  void operator()(planarvo_context* c) const { planarvo_context_destroy(c); }
+};
+using ContextPtr = std::unique_ptr<planarvo_context, ContextDeleter>;
+ContextPtr make_context(const Args& args);
+std::string device_name(const planarvo_context* context);
+
+// A progress bar on stderr when it is a terminal and --quiet is not given; silent otherwise.
+class Progress {
+ public:
+  explicit Progress(bool enabled);
+  ~Progress();
+  static int callback(void* self, double fraction, const char* stage);
+  void finish();
+
+ private:
+  bool enabled_;
+  bool drawn_ = false;
+  int last_permille_ = -1;
+  std::string last_stage_;
+};
+bool stderr_is_terminal();
+
+// Each command: returns the exit code; throws UsageError or ApiError.
+struct Command {
+  const char* name;
+  const char* summary;
+  int (*run)(int argc, char** argv);  // argv[0] is the command's name
+};
+const std::vector<Command>& commands();
+
+int cmd_devices(int argc, char** argv);
+int cmd_kernels(int argc, char** argv);
+int cmd_simulate(int argc, char** argv);
+int cmd_info(int argc, char** argv);
+int cmd_demo(int argc, char** argv);
+
+}  // namespace planarvo::cli

@@ -1,0 +1,192 @@
+// The planarvo tool as a user runs it: exit codes (0 ok, 1 failed, 2 bad usage or input,
+// 3 no device) and messages that name the file and line, for each kind of bad input.
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include <gtest/gtest.h>
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+
+#include "common/test_util.h"
+
+namespace planarvo {
+namespace {
+
+namespace fs = std::filesystem;
+using test::run_cli;
+using test::ScratchDir;
+
+void write(const fs::path& p, const std::string& text) {
+  fs::create_directories(p.parent_path());
+  std::ofstream(p) << text;
+}
+
+const char* kCameraYaml =
+    "%YAML:1.0\n---\nimage_width: 64\nimage_height: 48\n"
+    "camera_matrix: !!opencv-matrix\n   rows: 3\n   cols: 3\n   dt: d\n"
+    "   data: [ 50., 0., 31.5, 0., 50., 23.5, 0., 0., 1. ]\n"
+    "distortion_coefficients: !!opencv-matrix\n   rows: 1\n   cols: 5\n   dt: d\n"
+    "   data: [ -0.1, 0.01, 0., 0., 0. ]\n";
+
+// A small valid data set: 3 noise images of 64x48 with frames.txt and odometry.
+void make_dataset(const fs::path& dir) {
+  write(dir / "camera.yaml", kCameraYaml);
+  cv::Mat img(48, 64, CV_8UC1);
+  cv::RNG rng(3);
+  std::string frames;
+  for (int i = 0; i < 3; ++i) {
+    rng.fill(img, cv::RNG::UNIFORM, 0, 255);
+    fs::create_directories(dir / "images");
+    cv::imwrite((dir / "images" / (std::to_string(i) + ".png")).string(), img);
+    frames += std::to_string(0.1 * i) + " images/" + std::to_string(i) + ".png\n";
+  }
+  write(dir / "frames.txt", "# t path\n" + frames);
+  write(dir / "odometry.txt", "0.0 0 0 0 0 0 0 1\n0.2 0.1 0 0 0 0 0 1\n");
+}
+
+TEST(Cli, UsageErrorsExitWith2) {
+  EXPECT_EQ(run_cli("").exit_code, 2);
+  EXPECT_EQ(run_cli("no-such-command").exit_code, 2);
+  auto r = run_cli("simulate --out /tmp/x --no-such-option 1");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.output.find("--no-such-option"), std::string::npos) << r.output;
+  r = run_cli("simulate --out /tmp/x --seconds abc");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.output.find("--seconds"), std::string::npos) << r.output;
+  EXPECT_EQ(run_cli("simulate --out /tmp/x --motion zigzag").exit_code, 2);
+  EXPECT_EQ(run_cli("info").exit_code, 2);
+}
+
+TEST(Cli, HelpAndVersion) {
+  auto r = run_cli("--help");
+  EXPECT_EQ(r.exit_code, 0);
+  for (const char* cmd : {"demo", "simulate", "info", "devices", "kernels"})
+    EXPECT_NE(r.output.find(cmd), std::string::npos) << cmd;
+  EXPECT_EQ(run_cli("version").output, "planarvo 0.1.0\n");
+  EXPECT_EQ(run_cli("simulate --help").exit_code, 0);
+}
+
+TEST(Cli, DevicesListsPocl) {
+  auto r = run_cli("devices");
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("Portable Computing Language"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("max work-group"), std::string::npos);
+}
+
+TEST(Cli, UnknownDeviceExitsWith3) {
+  ScratchDir d;
+  auto r = run_cli("simulate --out " + (d / "s").string() + " --device no-such-device-xyz");
+  EXPECT_EQ(r.exit_code, 3) << r.output;
+  EXPECT_NE(r.output.find("no-such-device-xyz"), std::string::npos) << r.output;
+  r = run_cli("kernels --export " + (d / "k").string() + " --device 99");
+  EXPECT_EQ(r.exit_code, 3) << r.output;
+}
+
+TEST(Cli, InfoReadsAValidDataset) {
+  ScratchDir d;
+  make_dataset(d.path());
+  auto r = run_cli("info --verify " + d.path().string());
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("frames      3"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("odometry    yes"), std::string::npos) << r.output;
+}
+
+// Each bad input: exit code 2, and the message names the file (and line where it applies).
+struct BadInput {
+  const char* name;
+  void (*corrupt)(const fs::path&);
+  const char* must_mention;
+};
+
+const BadInput kBadInputs[] = {
+    {"missing_camera_yaml", [](const fs::path& d) { fs::remove(d / "camera.yaml"); }, "camera.yaml"},
+    {"camera_yaml_without_key",
+     [](const fs::path& d) { write(d / "camera.yaml", "%YAML:1.0\n---\nimage_width: 64\nimage_height: 48\n"); },
+     "camera_matrix"},
+    {"missing_frames_txt", [](const fs::path& d) { fs::remove(d / "frames.txt"); }, "frames.txt"},
+    {"missing_image", [](const fs::path& d) { fs::remove(d / "images" / "1.png"); }, "1.png"},
+    {"unreadable_image", [](const fs::path& d) { write(d / "images" / "2.png", "not a png"); }, "2.png"},
+    {"image_of_wrong_size",
+     [](const fs::path& d) { cv::imwrite((d / "images" / "1.png").string(), cv::Mat(10, 10, CV_8UC1, cv::Scalar(7))); },
+     "1.png"},
+    {"non_increasing_timestamps",
+     [](const fs::path& d) { write(d / "frames.txt", "0.0 images/0.png\n0.2 images/1.png\n0.1 images/2.png\n"); },
+     "frames.txt:3"},
+    {"nan_timestamp",
+     [](const fs::path& d) { write(d / "frames.txt", "0.0 images/0.png\nnan images/1.png\n"); }, "frames.txt:2"},
+    {"inf_in_odometry",
+     [](const fs::path& d) { write(d / "odometry.txt", "0.0 0 0 0 0 0 0 1\n0.2 inf 0 0 0 0 0 1\n"); },
+     "odometry.txt:2"},
+    {"empty_dataset", [](const fs::path& d) { write(d / "frames.txt", "# nothing\n"); }, "frames.txt"},
+    {"malformed_direction", [](const fs::path& d) { write(d / "direction.txt", "0.1 +1\n0.2 7\n"); }, "direction.txt:2"},
+    {"malformed_extrinsics", [](const fs::path& d) { write(d / "extrinsics.yaml", "%YAML:1.0\n---\nx: 1\n"); },
+     "extrinsics.yaml"},
+};
+
+class CliBadInput : public ::testing::TestWithParam<BadInput> {};
+
+TEST_P(CliBadInput, ExitsWith2AndNamesTheFile) {
+  ScratchDir d;
+  make_dataset(d.path());
+  GetParam().corrupt(d.path());
+  auto r = run_cli("info --verify " + d.path().string());
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find(GetParam().must_mention), std::string::npos) << r.output;
+}
+
+INSTANTIATE_TEST_SUITE_P(All, CliBadInput, ::testing::ValuesIn(kBadInputs),
+                         [](const auto& p) { return std::string(p.param.name); });
+
+TEST(Cli, MissingDatasetDirectory) {
+  auto r = run_cli("info /nonexistent/planarvo-data");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.output.find("/nonexistent/planarvo-data"), std::string::npos) << r.output;
+}
+
+TEST(Cli, SimulateThenInfoReadsItBack) {
+  ScratchDir d;
+  const std::string out = (d / "sim").string();
+  auto r = run_cli("simulate --quiet --out " + out + " --seconds 0.5 --width 160 --height 120 --fov 80 --seed 4");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  r = run_cli("info --verify " + out);
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("frames      15"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("groundtruth yes"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("true extr."), std::string::npos) << r.output;
+}
+
+TEST(Cli, SimulateRejectsBadTexture) {
+  ScratchDir d;
+  auto r = run_cli("simulate --quiet --out " + (d / "sim").string() + " --texture /nonexistent/floor.png");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("/nonexistent/floor.png"), std::string::npos) << r.output;
+}
+
+// FPGA flow: export binaries, then run a device job with them and without a compiler.
+TEST(Cli, KernelBinaryRoundTrip) {
+  ScratchDir d;
+  const std::string bins = (d / "bins").string();
+  auto r = run_cli("kernels --export " + bins);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  ASSERT_TRUE(fs::exists(d / "bins" / "planarvo-kernels.txt"));
+  r = run_cli("simulate --quiet --no-cache --kernel-binaries " + bins + " --out " + (d / "sim").string() +
+              " --seconds 0.2 --width 96 --height 64");
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  // A directory without binaries: a clear error naming the program and the device.
+  fs::create_directories(d / "empty");
+  r = run_cli("simulate --quiet --no-cache --kernel-binaries " + (d / "empty").string() + " --out " +
+              (d / "sim2").string() + " --seconds 0.2 --width 96 --height 64");
+  EXPECT_NE(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("render"), std::string::npos) << r.output;
+}
+
+TEST(Cli, DemoRunsOnASmallSetting) {
+  ScratchDir d;
+  auto r = run_cli("demo --quiet --out " + (d / "demo").string() + " --seconds 1 --width 160 --height 120");
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("wheel odometry"), std::string::npos) << r.output;
+}
+
+}  // namespace
+}  // namespace planarvo
