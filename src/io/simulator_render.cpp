@@ -116,6 +116,15 @@ RayTable build_ray_table(const CameraModel& camera, int supersampling) {
   camera.validate("simulator camera");
   if (supersampling < 1 || supersampling > 16)
     throw_invalid_argument("build_ray_table: supersampling must be 1 to 16");
+  // 2 S^2 + 6 floats per pixel; OpenCL devices need not allocate more than a quarter of their
+  // memory in one buffer, and the tables are rebuilt per camera, so keep them moderate.
+  const double bytes = 4.0 * (2.0 * supersampling * supersampling + 6.0) * camera.width * camera.height;
+  if (bytes > 1024.0 * 1024.0 * 1024.0)
+    throw_invalid_argument("simulator: the ray tables for " + std::to_string(camera.width) + "x" +
+                           std::to_string(camera.height) + " pixels with supersampling " +
+                           std::to_string(supersampling) + " would take " +
+                           std::to_string(static_cast<long long>(bytes / (1024 * 1024))) +
+                           " MiB (at most 1024): lower the supersampling");
   RayTable t;
   t.width = camera.width;
   t.height = camera.height;
