@@ -302,6 +302,11 @@ typedef struct planarvo_sim_options {
 } planarvo_sim_options;
 
 PLANARVO_API void planarvo_sim_options_init(planarvo_sim_options* options);
+/* The simulator's camera for a size and a horizontal field of view (degrees, measured through
+ * the lens distortion between the outermost pixel columns), with its default mild barrel
+ * distortion. */
+PLANARVO_API planarvo_status planarvo_sim_default_camera(int32_t width, int32_t height, double fov_deg,
+                                                         planarvo_camera* camera);
 /* Renders a data set in the layout of planarvo_dataset_open into out_directory (created if
  * missing): camera.yaml, images/, frames.txt, odometry.txt, direction.txt, groundtruth.txt,
  * extrinsics_gt.yaml. Deterministic for a seed on a given device. */

@@ -92,13 +92,9 @@ void apply_simulate_args(const Args& a, planarvo_sim_options* o, std::string* te
   if (a.has("width") || a.has("height") || a.has("fov")) {
     const long long w = a.get_int("width", c.width), h = a.get_int("height", c.height);
     if (w < 8 || h < 8 || w > 16384 || h > 16384) throw UsageError("--width/--height must be 8..16384");
-    const double fov = a.get_double("fov", 2.0 * std::atan(c.cx / c.fx + 0.5 / c.fx) / kDeg);
+    const double fov = a.get_double("fov", 80.0);
     if (!(fov > 1 && fov < 170)) throw UsageError("--fov must be between 1 and 170 degrees");
-    c.width = static_cast<int32_t>(w);
-    c.height = static_cast<int32_t>(h);
-    c.fx = c.fy = 0.5 * static_cast<double>(w) / std::tan(0.5 * fov * kDeg);
-    c.cx = 0.5 * static_cast<double>(w) - 0.5;
-    c.cy = 0.5 * static_cast<double>(h) - 0.5;
+    check(planarvo_sim_default_camera(static_cast<int32_t>(w), static_cast<int32_t>(h), fov, &c));
   }
   if (a.has("distortion")) {
     const auto d = a.get_doubles("distortion", 5);

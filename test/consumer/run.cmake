@@ -1,6 +1,7 @@
 # CTest script: install the built planarvo into a scratch prefix, then configure, build and run
 # test/consumer against it through find_package and through pkg-config.
-# Variables: BUILD_DIR (planarvo's build), SOURCE_DIR (test/consumer), WORK_DIR (scratch).
+# Variables: BUILD_DIR (planarvo's build), SOURCE_DIR (test/consumer), WORK_DIR (scratch),
+# CONSUMER_C_FLAGS (the sanitizer flags when planarvo is built with them).
 file(REMOVE_RECURSE ${WORK_DIR})
 set(prefix ${WORK_DIR}/prefix)
 function(run)
@@ -15,7 +16,7 @@ file(GLOB_RECURSE pcfile ${prefix}/*/planarvo.pc)
 get_filename_component(pcdir "${pcfile}" DIRECTORY)
 run(${CMAKE_COMMAND} -E env PKG_CONFIG_PATH=${pcdir}
     ${CMAKE_COMMAND} -S ${SOURCE_DIR} -B ${WORK_DIR}/build -DCMAKE_PREFIX_PATH=${prefix}
-    -DPKG_CONFIG_ARGN=--define-prefix)
+    -DPKG_CONFIG_ARGN=--define-prefix "-DCMAKE_C_FLAGS=${CONSUMER_C_FLAGS}")
 run(${CMAKE_COMMAND} --build ${WORK_DIR}/build)
 get_filename_component(libdir "${pcdir}" DIRECTORY)
 run(${CMAKE_COMMAND} -E env LD_LIBRARY_PATH=${libdir} ${WORK_DIR}/build/consumer)
