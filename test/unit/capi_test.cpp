@@ -108,3 +108,124 @@ TEST(CApi, ExtrinsicsMatrixFollowsConventions) {
 }
 
 }  // namespace
+
+namespace {
+
+using planarvo::test::ScratchDir;
+
+planarvo_context* make_context() {
+  planarvo_context* c = nullptr;
+  EXPECT_EQ(planarvo_context_create(nullptr, &c), PLANARVO_OK) << planarvo_last_error();
+  return c;
+}
+
+planarvo_sim_options tiny_sim(const std::string& texture) {
+  planarvo_sim_options o;
+  planarvo_sim_options_init(&o);
+  static std::string tex;
+  tex = texture;
+  o.texture = tex.c_str();
+  o.seconds = 0.2;
+  EXPECT_EQ(planarvo_sim_default_camera(96, 64, 80.0, &o.camera), PLANARVO_OK);
+  return o;
+}
+
+TEST(CApiData, MissingDatasetIsInvalidInputNamingIt) {
+  planarvo_dataset* d = nullptr;
+  EXPECT_EQ(planarvo_dataset_open("/nonexistent/planarvo-ds", nullptr, &d), PLANARVO_ERROR_INVALID_INPUT);
+  EXPECT_EQ(d, nullptr);
+  EXPECT_NE(std::string(planarvo_last_error()).find("/nonexistent/planarvo-ds"), std::string::npos);
+}
+
+TEST(CApiData, SimOptionsDefaultToThePapersConfigurationOne) {
+  planarvo_sim_options o;
+  planarvo_sim_options_init(&o);
+  EXPECT_EQ(o.struct_size, sizeof o);
+  EXPECT_DOUBLE_EQ(o.extrinsics.x, 0.2441);
+  EXPECT_NEAR(o.extrinsics.pitch, 17.6 * M_PI / 180, 1e-12);
+  EXPECT_EQ(o.camera.width, 640);
+  EXPECT_DOUBLE_EQ(o.fps, 30.0);
+}
+
+TEST(CApiData, SimulateValidatesItsOptions) {
+  planarvo_context* c = make_context();
+  ScratchDir dir;
+  planarvo_sim_options o;
+  planarvo_sim_options_init(&o);
+  EXPECT_EQ(planarvo_simulate(c, &o, dir.path().c_str()), PLANARVO_ERROR_INVALID_ARGUMENT);  // no texture
+  o = tiny_sim("/nonexistent/texture.png");
+  EXPECT_EQ(planarvo_simulate(c, &o, (dir / "a").c_str()), PLANARVO_ERROR_INVALID_INPUT);
+  EXPECT_NE(std::string(planarvo_last_error()).find("/nonexistent/texture.png"), std::string::npos);
+  o = tiny_sim(planarvo::test::texture("skimage_gravel.png").string());
+  o.fps = -1;
+  EXPECT_EQ(planarvo_simulate(c, &o, (dir / "b").c_str()), PLANARVO_ERROR_INVALID_ARGUMENT);
+  planarvo_context_destroy(c);
+}
+
+TEST(CApiData, ProgressCallbackCancels) {
+  planarvo_context* c = make_context();
+  ScratchDir dir;
+  planarvo_sim_options o = tiny_sim(planarvo::test::texture("skimage_gravel.png").string());
+  int calls = 0;
+  o.progress = [](void* user, double, const char*) { return ++*static_cast<int*>(user) >= 2 ? 1 : 0; };
+  o.progress_user_data = &calls;
+  EXPECT_EQ(planarvo_simulate(c, &o, dir.path().c_str()), PLANARVO_ERROR_CANCELLED);
+  EXPECT_GE(calls, 2);
+  planarvo_context_destroy(c);
+}
+
+TEST(CApiData, SimulatedDatasetReadsBackThroughTheApi) {
+  planarvo_context* c = make_context();
+  ScratchDir dir;
+  planarvo_sim_options o = tiny_sim(planarvo::test::texture("skimage_gravel.png").string());
+  ASSERT_EQ(planarvo_simulate(c, &o, dir.path().c_str()), PLANARVO_OK) << planarvo_last_error();
+  planarvo_dataset* d = nullptr;
+  ASSERT_EQ(planarvo_dataset_open(dir.path().c_str(), nullptr, &d), PLANARVO_OK) << planarvo_last_error();
+  planarvo_dataset_info info{};
+  info.struct_size = sizeof info;
+  ASSERT_EQ(planarvo_dataset_info_get(d, &info), PLANARVO_OK);
+  EXPECT_EQ(info.frame_count, 6);
+  EXPECT_EQ(info.camera.width, 96);
+  EXPECT_DOUBLE_EQ(info.camera.fx, o.camera.fx);
+  EXPECT_TRUE(info.has_groundtruth && info.has_odometry && info.has_direction && info.has_extrinsics_gt);
+  EXPECT_NEAR(info.extrinsics_gt.yaw, o.extrinsics.yaw, 1e-12);
+  planarvo_image img{};
+  ASSERT_EQ(planarvo_dataset_frame(d, 5, &img), PLANARVO_OK);
+  EXPECT_EQ(img.width, 96);
+  EXPECT_EQ(img.height, 64);
+  EXPECT_EQ(img.format, PLANARVO_GRAY8);
+  EXPECT_GE(img.stride, 96u);
+  planarvo_frame_data f{};
+  ASSERT_EQ(planarvo_dataset_frame_data(d, 0, &f), PLANARVO_OK);
+  EXPECT_TRUE(f.has_groundtruth && f.has_odometry);
+  EXPECT_FALSE(f.has_direction);  // frame 0 has no interval before it
+  EXPECT_DOUBLE_EQ(f.groundtruth.x, 0.0);
+  EXPECT_EQ(planarvo_dataset_frame(d, 6, &img), PLANARVO_ERROR_INVALID_ARGUMENT);
+  planarvo_dataset_destroy(d);
+  planarvo_context_destroy(c);
+}
+
+TEST(CApiData, ExtrinsicsAndTumRoundTrip) {
+  ScratchDir dir;
+  const planarvo_extrinsics e{0.25, -0.02, 0.18, 0.2, 0.3, -0.1};
+  double cov[36] = {};
+  cov[0] = 1e-6;
+  cov[35] = 4e-4;
+  const std::string path = (dir / "extrinsics.yaml").string();
+  ASSERT_EQ(planarvo_extrinsics_save(path.c_str(), &e, cov, "x,yaw", "test", "a note"), PLANARVO_OK)
+      << planarvo_last_error();
+  planarvo_extrinsics r{};
+  ASSERT_EQ(planarvo_extrinsics_load(path.c_str(), &r), PLANARVO_OK) << planarvo_last_error();
+  EXPECT_DOUBLE_EQ(r.yaw, e.yaw);
+  EXPECT_DOUBLE_EQ(r.z, e.z);
+  const planarvo_extrinsics bad{0, 0, NAN, 0, 0, 0};
+  EXPECT_EQ(planarvo_extrinsics_save(path.c_str(), &bad, nullptr, nullptr, nullptr, nullptr),
+            PLANARVO_ERROR_INVALID_ARGUMENT);
+  const double t[2] = {0.0, 0.1};
+  const planarvo_se2 p[2] = {{0, 0, 0}, {0.1, 0.02, 0.3}};
+  const std::string tum = (dir / "traj.txt").string();
+  ASSERT_EQ(planarvo_write_tum(tum.c_str(), t, p, 2), PLANARVO_OK) << planarvo_last_error();
+  EXPECT_EQ(planarvo_write_tum("/nonexistent/dir/traj.txt", t, p, 2), PLANARVO_ERROR_IO);
+}
+
+}  // namespace
