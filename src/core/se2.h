@@ -49,29 +49,28 @@ struct SE2 {
   // Exponential map of se(2): (vx, vy, omega) integrated for unit time, i.e. the constant-
   // velocity arc. exp(log(T)) == T.
   static SE2 exp(const Eigen::Vector3d& xi) {
-    const double w = xi.z();
-    double a, b;  // sin(w)/w and (1-cos(w))/w, with series near zero
-    if (std::abs(w) < 1e-6) {
-      a = 1.0 - w * w / 6.0;
-      b = w / 2.0 - w * w * w / 24.0;
-    } else {
-      a = std::sin(w) / w;
-      b = (1.0 - std::cos(w)) / w;
-    }
-    return {a * xi.x() - b * xi.y(), b * xi.x() + a * xi.y(), wrap_angle(w)};
+    double a, b;
+    arc_coefficients(xi.z(), &a, &b);
+    return {a * xi.x() - b * xi.y(), b * xi.x() + a * xi.y(), wrap_angle(xi.z())};
   }
   Eigen::Vector3d log() const {
-    const double w = theta;
     double a, b;
-    if (std::abs(w) < 1e-6) {
-      a = 1.0 - w * w / 6.0;
-      b = w / 2.0 - w * w * w / 24.0;
-    } else {
-      a = std::sin(w) / w;
-      b = (1.0 - std::cos(w)) / w;
-    }
+    arc_coefficients(theta, &a, &b);
     const double det = a * a + b * b;
-    return {(a * x + b * y) / det, (-b * x + a * y) / det, w};
+    return {(a * x + b * y) / det, (-b * x + a * y) / det, theta};
+  }
+
+ private:
+  // sin(w)/w and (1 - cos(w))/w, with their series near zero: the translation of exp((v, w)) is
+  // [[a, -b], [b, a]] v.
+  static void arc_coefficients(double w, double* a, double* b) {
+    if (std::abs(w) < 1e-6) {
+      *a = 1.0 - w * w / 6.0;
+      *b = w / 2.0 - w * w * w / 24.0;
+    } else {
+      *a = std::sin(w) / w;
+      *b = (1.0 - std::cos(w)) / w;
+    }
   }
 };
 
