@@ -167,24 +167,36 @@ PipelineKernels::PipelineKernels(ocl::Runtime& runtime, const ImagePipelineOptio
   }
 }
 
-std::vector<float> PipelineKernels::device_map(const UndistortMap& map) {
+PipelineKernels::DeviceMap PipelineKernels::device_map(const UndistortMap& map) {
   const size_t n = static_cast<size_t>(map.width) * static_cast<size_t>(map.height);
-  std::vector<float> xy(2 * (n + kPixelsPerItem), -1.0f);
+  DeviceMap d;
+  d.index.assign(n + kPixelsPerItem, -1);
+  d.weights.assign(2 * (n + kPixelsPerItem), 0.0f);
   for (size_t i = 0; i < n; ++i) {
     if (!map.valid[i]) continue;
-    xy[2 * i] = map.map_x[i];
-    xy[2 * i + 1] = map.map_y[i];
+    // remap_bilinear's arithmetic: valid coordinates are >= 0, so truncation is floor.
+    const float sx = map.map_x[i], sy = map.map_y[i];
+    const int x0 = static_cast<int>(sx), y0 = static_cast<int>(sy);
+    d.index[i] = y0 * map.width + x0;
+    d.weights[2 * i] = sx - static_cast<float>(x0);
+    d.weights[2 * i + 1] = sy - static_cast<float>(y0);
   }
-  return xy;
+  return d;
 }
 
-void PipelineKernels::undistort(const cl::Buffer& frame, const cl::Buffer& map, int width,
-                                int height, const cl::Buffer& dst) {
+size_t PipelineKernels::frame_buffer_size(int width, int height) {
+  return static_cast<size_t>(width) * static_cast<size_t>(height) + static_cast<size_t>(width) + 1;
+}
+
+void PipelineKernels::undistort(const cl::Buffer& frame, const cl::Buffer& index,
+                                const cl::Buffer& weights, int width, int height,
+                                const cl::Buffer& dst) {
   undistort_.setArg(0, frame);
-  undistort_.setArg(1, map);
-  undistort_.setArg(2, static_cast<cl_int>(width));
-  undistort_.setArg(3, static_cast<cl_int>(height));
-  undistort_.setArg(4, dst);
+  undistort_.setArg(1, index);
+  undistort_.setArg(2, weights);
+  undistort_.setArg(3, static_cast<cl_int>(width));
+  undistort_.setArg(4, static_cast<cl_int>(height));
+  undistort_.setArg(5, dst);
   launch(runtime_.queue(), undistort_, undistort_wg_, width, height);
 }
 
@@ -216,8 +228,8 @@ struct ImagePipeline::Impl {
   UndistortMap map;
   int levels = 0;
   PipelineKernels kernels;
-  cl::Buffer frame;                   // width * height bytes
-  cl::Buffer map_xy;                  // PipelineKernels::device_map
+  cl::Buffer frame;                   // PipelineKernels::frame_buffer_size bytes
+  cl::Buffer map_index, map_weights;  // PipelineKernels::device_map
   std::vector<cl::Buffer> intensity;  // per level, its intensity image
   Impl(ocl::Runtime& r, const ImagePipelineOptions& o) : rt(r), kernels(r, o) {}
 
@@ -256,7 +268,7 @@ struct ImagePipeline::Impl {
     }
   }
 
-  void undistort() { kernels.undistort(frame, map_xy, w(0), h(0), intensity[0]); }
+  void undistort() { kernels.undistort(frame, map_index, map_weights, w(0), h(0), intensity[0]); }
   void pyramid() {
     for (int l = 1; l < levels; ++l)
       kernels.downsample(intensity[static_cast<size_t>(l - 1)], w(l - 1), h(l - 1),
@@ -278,13 +290,15 @@ ImagePipeline::ImagePipeline(ocl::Runtime& runtime, const CameraModel& camera, i
   m.camera = camera;
   m.levels = levels;
   m.map = std::move(map);
-  const std::vector<float> xy = PipelineKernels::device_map(m.map);
+  PipelineKernels::DeviceMap dm = PipelineKernels::device_map(m.map);
+  // Zeroed, so that the bytes after the frame that the kernel reads (with weight 0) are defined.
+  std::vector<uint8_t> zeros(PipelineKernels::frame_buffer_size(camera.width, camera.height), 0);
   try {
     cl::Context& ctx = runtime.context();
-    m.frame = cl::Buffer(ctx, CL_MEM_READ_ONLY,
-                         static_cast<size_t>(camera.width) * static_cast<size_t>(camera.height));
-    m.map_xy = cl::Buffer(ctx, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, xy.size() * sizeof(float),
-                          const_cast<float*>(xy.data()));
+    const cl_mem_flags in = CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR;
+    m.frame = cl::Buffer(ctx, in, zeros.size(), zeros.data());
+    m.map_index = cl::Buffer(ctx, in, dm.index.size() * sizeof(cl_int), dm.index.data());
+    m.map_weights = cl::Buffer(ctx, in, dm.weights.size() * sizeof(float), dm.weights.data());
     for (int l = 0; l < levels; ++l)
       m.intensity.emplace_back(ctx, CL_MEM_READ_WRITE,
                                static_cast<size_t>(m.w(l)) * static_cast<size_t>(m.h(l)) * sizeof(float));

@@ -103,13 +103,23 @@ class PipelineKernels {
   // Registers the build options and builds (or loads) the two programs.
   PipelineKernels(ocl::Runtime& runtime, const ImagePipelineOptions& options = {});
 
-  // The undistortion map as the kernel reads it: (x, y) per pixel, interleaved, (-1, -1) where
-  // not valid, then 8 pixels of (-1, -1) padding: 2 * (width * height + 8) floats.
-  static std::vector<float> device_map(const UndistortMap& map);
+  // The undistortion map as the kernel reads it, computed from an UndistortMap in
+  // remap_bilinear's float arithmetic: per pixel the index y0 * width + x0 of the top-left
+  // source pixel (-1 where not valid) and the weights (ax, ay) of its right and lower
+  // neighbours, interleaved; each padded by 8 pixels (index -1).
+  struct DeviceMap {
+    std::vector<cl_int> index;   // width * height + 8
+    std::vector<float> weights;  // 2 * (width * height + 8)
+  };
+  static DeviceMap device_map(const UndistortMap& map);
+  // The bytes the kernel may read from the frame buffer: the frame, then width + 1 more (the
+  // right/lower neighbours of samples on the last column/row, read with weight 0).
+  static size_t frame_buffer_size(int width, int height);
 
-  // frame: width * height bytes; map: device_map(); dst: the level-0 intensity image.
-  void undistort(const cl::Buffer& frame, const cl::Buffer& map, int width, int height,
-                 const cl::Buffer& dst);
+  // frame: frame_buffer_size() bytes; index, weights: device_map()'s; dst: the level-0
+  // intensity image.
+  void undistort(const cl::Buffer& frame, const cl::Buffer& index, const cl::Buffer& weights,
+                 int width, int height, const cl::Buffer& dst);
   // src: an intensity image of src_width x src_height; dst: the next level's
   // (level_size(src_width, 1) x level_size(src_height, 1)).
   void downsample(const cl::Buffer& src, int src_width, int src_height, const cl::Buffer& dst);

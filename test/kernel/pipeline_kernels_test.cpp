@@ -11,6 +11,7 @@
 // wrong tap or weight errs by tenths of grey levels on random input. Validity comes from the map
 // and from which taps are valid, never from a rounded value, so it must agree exactly: every
 // element is checked, all four components of a float4, with no exclusions.
+#include <algorithm>
 #include <cmath>
 #include <random>
 #include <string>
@@ -123,11 +124,18 @@ TEST(PipelineKernels, UndistortMatchesReference) {
       cv::Mat gray(s[1], s[0], CV_8UC1);
       cv::RNG(seed++).fill(gray, cv::RNG::UNIFORM, 0, 256);
       const size_t n = gray.total();
-      const std::vector<float> xy = PipelineKernels::device_map(map);
-      ASSERT_EQ(xy.size(), 2 * (n + 8));
-      const cl::Buffer frame = upload(rt, gray.ptr(), n), map_buf = upload(rt, xy.data(), xy.size() * 4);
+      const PipelineKernels::DeviceMap dm = PipelineKernels::device_map(map);
+      ASSERT_EQ(dm.index.size(), n + 8);
+      ASSERT_EQ(dm.weights.size(), 2 * (n + 8));
+      // The frame buffer's bytes after the frame are random too: they must not matter.
+      cv::Mat bytes(1, static_cast<int>(PipelineKernels::frame_buffer_size(s[0], s[1])), CV_8UC1);
+      cv::RNG(seed++).fill(bytes, cv::RNG::UNIFORM, 0, 256);
+      std::copy(gray.datastart, gray.dataend, bytes.data);
+      const cl::Buffer frame = upload(rt, bytes.data, bytes.total()),
+                       index = upload(rt, dm.index.data(), dm.index.size() * sizeof(cl_int)),
+                       weights = upload(rt, dm.weights.data(), dm.weights.size() * sizeof(float));
       const cl::Buffer dst = poisoned(rt, n);
-      kernels.undistort(frame, map_buf, s[0], s[1], dst);
+      kernels.undistort(frame, index, weights, s[0], s[1], dst);
       const cv::Mat ref = undistort_reference(gray, map);
       expect_intensity_matches(download(rt, dst, n), ref, what);
       if (d[0] > 0) {
@@ -227,12 +235,15 @@ TEST(PipelineKernels, OtherWorkGroupShapesAgree) {
   const UndistortMap map = compute_undistort_map(cam);
   cv::Mat gray(77, 161, CV_8UC1);
   cv::randu(gray, 0, 256);
-  const std::vector<float> xy = PipelineKernels::device_map(map);
-  const cl::Buffer frame = upload(rt, gray.ptr(), gray.total()),
-                   map_buf = upload(rt, xy.data(), xy.size() * 4);
+  const PipelineKernels::DeviceMap dm = PipelineKernels::device_map(map);
+  std::vector<uint8_t> bytes(PipelineKernels::frame_buffer_size(161, 77), 0);
+  std::copy(gray.datastart, gray.dataend, bytes.begin());
+  const cl::Buffer frame = upload(rt, bytes.data(), bytes.size()),
+                   index = upload(rt, dm.index.data(), dm.index.size() * sizeof(cl_int)),
+                   weights = upload(rt, dm.weights.data(), dm.weights.size() * sizeof(float));
   const cl::Buffer ua = poisoned(rt, gray.total()), ub = poisoned(rt, gray.total());
-  kernels.undistort(frame, map_buf, 161, 77, ua);
-  defaults.undistort(frame, map_buf, 161, 77, ub);
+  kernels.undistort(frame, index, weights, 161, 77, ua);
+  defaults.undistort(frame, index, weights, 161, 77, ub);
   EXPECT_EQ(download(rt, ua, gray.total()), download(rt, ub, gray.total()));
 }
 
