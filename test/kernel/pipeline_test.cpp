@@ -11,6 +11,7 @@
 #include <opencv2/imgproc.hpp>
 #include <gtest/gtest.h>
 
+#include "common/test_util.h"
 #include "core/error.h"
 #include "image/pipeline.h"
 #include "ocl/runtime.h"
@@ -288,6 +289,33 @@ TEST(ImagePipeline, PyramidUploadDownloadRoundTrip) {
   bad[1] = cv::Mat(23, 16, CV_32FC1);
   EXPECT_THROW(upload_pyramid(rt, bad), Error);
   EXPECT_THROW(upload_pyramid(rt, {}), Error);
+}
+
+// The option sets the pipeline registers are the ones it uses: with only the exported binaries
+// (as on an FPGA), a default pipeline runs without compiling and gives the same pyramid.
+TEST(ImagePipeline, RunsFromExportedBinaries) {
+  test::ScratchDir dir;
+  const CameraModel cam = camera(96, 72, -0.12, 0.03);
+  const cv::Mat gray = random_frame(96, 72, 4);
+  std::vector<cv::Mat> compiled;
+  {
+    ocl::Runtime rt;
+    ImagePipeline pipe(rt, cam, 3);
+    Pyramid out;
+    pipe.process(gray, out);
+    compiled = download_pyramid(rt, out);
+    rt.export_binaries(dir.path().string());
+  }
+  ocl::RuntimeOptions o;
+  o.binaries_dir = dir.path().string();
+  ocl::Runtime rt(o);
+  ImagePipeline pipe(rt, cam, 3);
+  Pyramid out;
+  pipe.process(gray, out);
+  const std::vector<cv::Mat> loaded = download_pyramid(rt, out);
+  EXPECT_EQ(rt.stats().built_from_source, 0);
+  EXPECT_EQ(rt.stats().loaded_from_binaries, 2);
+  for (size_t l = 0; l < 3; ++l) EXPECT_EQ(cv::norm(compiled[l], loaded[l], cv::NORM_INF), 0.0) << l;
 }
 
 }  // namespace
