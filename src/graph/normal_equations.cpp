@@ -1,0 +1,656 @@
+#include "graph/normal_equations.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <numeric>
+
+#include <cholmod.h>
+
+#include "core/error.h"
+
+namespace planarvo::graph {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+
+// In-place X ← L·X for an upper-triangular m × m L (column-major) and an m × n X: row i of the
+// product needs rows i..m-1 of X, so ascending rows never read an overwritten one.
+void upper_times_in_place(const double* L, int m, double* X, int n) {
+  for (int c = 0; c < n; ++c) {
+    double* x = X + c * m;
+    for (int i = 0; i < m; ++i) {
+      double s = 0.0;
+      for (int j = i; j < m; ++j) s += L[i + j * m] * x[j];
+      x[i] = s;
+    }
+  }
+}
+
+// J ← J · diag(R(θ), 1) for the RightExp retraction: d(X·exp(δ))/dδ at 0 is diag(R(θ), 1).
+void right_exp_jacobian(double theta, double* J, int m) {
+  const double c = std::cos(theta), s = std::sin(theta);
+  double* j0 = J;
+  double* j1 = J + m;
+  for (int i = 0; i < m; ++i) {
+    const double a = j0[i], b = j1[i];
+    j0[i] = c * a + s * b;
+    j1[i] = -s * a + c * b;
+  }
+}
+
+}  // namespace
+
+double linearize_factor(const FactorGraph& graph, int f, Eigen::VectorXd& residual,
+                        std::vector<Eigen::MatrixXd>& jacobians) {
+  const Factor& fac = graph.factor(f);
+  const auto& vars = fac.variables();
+  const int m = fac.residual_dim();
+  std::vector<const double*> ptrs;
+  std::vector<double*> jptrs;
+  jacobians.resize(vars.size());
+  for (size_t k = 0; k < vars.size(); ++k) {
+    ptrs.push_back(&graph.values()[static_cast<size_t>(graph.offset(vars[k]))]);
+    jacobians[k].resize(m, fac.types()[k].dim);
+    jptrs.push_back(jacobians[k].data());
+  }
+  Eigen::VectorXd e(m);
+  Eigen::MatrixXd L(m, m);
+  fac.evaluate(ptrs.data(), e.data(), jptrs.data());
+  fac.sqrt_information_at(ptrs.data(), L.data());
+  const Eigen::MatrixXd Lu = L.triangularView<Eigen::Upper>();
+  residual = Lu * e;
+  for (auto& J : jacobians) J = Lu * J;
+  const double s = residual.squaredNorm();
+  const RobustKernel* kernel = graph.robust_kernel(f);
+  if (!kernel) return s;
+  double rho[3];
+  kernel->evaluate(s, rho);
+  const double w = std::sqrt(rho[1]);
+  residual *= w;
+  for (auto& J : jacobians) J *= w;
+  return rho[0];
+}
+
+NormalEquations::NormalEquations(const FactorGraph& graph, const LinearSolverOptions& options,
+                                 const std::vector<VariableId>& also_fixed)
+    : options_(options), graph_(&graph), version_(graph.structure_version()) {
+  const auto t0 = Clock::now();
+  cc_ = new cholmod_common;
+  cholmod_start(cc_);
+  cc_->print = 0;
+  cc_->error_handler = nullptr;
+  cc_->quick_return_if_not_posdef = 1;
+  cc_->supernodal = options_.factorization == Factorization::Supernodal   ? CHOLMOD_SUPERNODAL
+                    : options_.factorization == Factorization::Simplicial ? CHOLMOD_SIMPLICIAL
+                                                                          : CHOLMOD_AUTO;
+  cc_->supernodal_switch = options_.supernodal_switch;
+  try {
+    build_pattern(graph, also_fixed);
+    analyze();
+  } catch (...) {
+    release();
+    throw;
+  }
+  analyze_seconds_ = seconds_since(t0);
+}
+
+NormalEquations::~NormalEquations() { release(); }
+
+void NormalEquations::release() {
+  if (!cc_) return;
+  if (L_) cholmod_free_factor(&L_, cc_);
+  if (H_) cholmod_free_sparse(&H_, cc_);
+  if (B_) cholmod_free_dense(&B_, cc_);
+  if (X_) cholmod_free_dense(&X_, cc_);
+  if (Y_) cholmod_free_dense(&Y_, cc_);
+  if (E_) cholmod_free_dense(&E_, cc_);
+  cholmod_finish(cc_);
+  delete cc_;
+  cc_ = nullptr;
+}
+
+bool NormalEquations::matches(const FactorGraph& graph) const {
+  return &graph == graph_ && graph.structure_version() == version_;
+}
+
+int NormalEquations::column(VariableId v, int parameter) const {
+  if (v < 0 || v >= static_cast<int>(col_start_.size())) return -1;
+  const int* fp = free_params_.data() + free_begin_[static_cast<size_t>(v)];
+  for (int i = 0; i < num_free_[static_cast<size_t>(v)]; ++i)
+    if (fp[i] == parameter) return col_start_[static_cast<size_t>(v)] + i;
+  return -1;
+}
+
+void NormalEquations::build_pattern(const FactorGraph& graph,
+                                    const std::vector<VariableId>& also_fixed) {
+  const int nv = graph.num_variables();
+  std::vector<char> forced(static_cast<size_t>(nv), 0);
+  for (VariableId v : also_fixed) {
+    if (v < 0 || v >= nv) throw_invalid_argument("NormalEquations: no variable " + std::to_string(v));
+    forced[static_cast<size_t>(v)] = 1;
+  }
+  col_start_.assign(static_cast<size_t>(nv), -1);
+  num_free_.assign(static_cast<size_t>(nv), 0);
+  free_begin_.assign(static_cast<size_t>(nv), 0);
+  free_params_.clear();
+  block_of_column_.clear();
+  n_ = 0;
+  for (VariableId v = 0; v < nv; ++v) {
+    const auto sv = static_cast<size_t>(v);
+    const VariableType type = graph.type(v);
+    const std::uint64_t mask = forced[sv] ? ~std::uint64_t{0} : graph.fixed_mask(v);
+    free_begin_[sv] = static_cast<int>(free_params_.size());
+    if (options_.retraction == PoseRetraction::RightExp && type.kind == VariableKind::Pose2 &&
+        mask != 0 && mask != 7 && !graph.is_fixed(v) && !forced[sv])
+      throw_invalid_argument("NormalEquations: '" + graph.name(v) +
+                             "' has single fixed parameters, which the RightExp retraction "
+                             "cannot keep; use PoseRetraction::Additive");
+    for (int p = 0; p < type.dim; ++p)
+      if (!((mask >> p) & 1u)) free_params_.push_back(p);
+    num_free_[sv] = static_cast<int>(free_params_.size()) - free_begin_[sv];
+    if (num_free_[sv] > 0) {
+      col_start_[sv] = n_;
+      n_ += num_free_[sv];
+      block_of_column_.insert(block_of_column_.end(), static_cast<size_t>(num_free_[sv]), v);
+    }
+  }
+
+  // Lower neighbours of every free variable: the free variables sharing a factor with it whose
+  // columns come first (they fill the rows above its diagonal block).
+  std::vector<std::vector<int>> lower(static_cast<size_t>(nv));
+  const int nf = graph.num_factors();
+  factors_.clear();
+  factors_.reserve(static_cast<size_t>(nf));
+  slot_var_.clear();
+  slot_value_offset_.clear();
+  slot_jac_offset_.clear();
+  int residual_total = 0, jac_total = 0, max_m = 0, max_slots = 0;
+  for (int f = 0; f < nf; ++f) {
+    const Factor& fac = graph.factor(f);
+    const auto& vars = fac.variables();
+    FactorInfo info{};
+    info.factor = &fac;
+    info.kernel = graph.robust_kernel(f);
+    info.sqrt_info = fac.information_depends_on_state() ? nullptr : fac.sqrt_information().data();
+    info.residual_dim = fac.residual_dim();
+    info.slot_begin = static_cast<int>(slot_var_.size());
+    info.num_slots = static_cast<int>(vars.size());
+    info.residual_offset = residual_total;
+    residual_total += info.residual_dim;
+    for (size_t k = 0; k < vars.size(); ++k) {
+      const auto v = static_cast<size_t>(vars[k]);
+      slot_var_.push_back(vars[k]);
+      slot_value_offset_.push_back(graph.offset(vars[k]));
+      if (num_free_[v] > 0) {
+        slot_jac_offset_.push_back(jac_total);
+        jac_total += info.residual_dim * fac.types()[k].dim;
+      } else {
+        slot_jac_offset_.push_back(-1);
+      }
+      for (size_t l = 0; l < k; ++l) {
+        const auto u = static_cast<size_t>(vars[l]);
+        if (num_free_[u] == 0 || num_free_[v] == 0) continue;
+        if (col_start_[u] < col_start_[v])
+          lower[v].push_back(vars[l]);
+        else
+          lower[u].push_back(vars[k]);
+      }
+    }
+    max_m = std::max(max_m, info.residual_dim);
+    max_slots = std::max(max_slots, info.num_slots);
+    factors_.push_back(info);
+  }
+  std::vector<std::vector<int>> lower_offset(static_cast<size_t>(nv));
+  diag_offset_.assign(static_cast<size_t>(nv), 0);
+  size_t nnz = 0;
+  for (VariableId v = 0; v < nv; ++v) {
+    auto& lv = lower[static_cast<size_t>(v)];
+    std::sort(lv.begin(), lv.end());
+    lv.erase(std::unique(lv.begin(), lv.end()), lv.end());
+    auto& off = lower_offset[static_cast<size_t>(v)];
+    off.resize(lv.size());
+    int above = 0;
+    for (size_t i = 0; i < lv.size(); ++i) {
+      off[i] = above;
+      above += num_free_[static_cast<size_t>(lv[i])];
+    }
+    diag_offset_[static_cast<size_t>(v)] = above;
+    const int fv = num_free_[static_cast<size_t>(v)];
+    nnz += static_cast<size_t>(fv) * static_cast<size_t>(above) +
+           static_cast<size_t>(fv * (fv + 1) / 2);
+  }
+
+  // Block offsets of every pair of a factor's slots (k ≤ l), −1 when either has no column.
+  pair_offset_.clear();
+  for (auto& info : factors_) {
+    info.pair_begin = static_cast<int>(pair_offset_.size());
+    for (int k = 0; k < info.num_slots; ++k) {
+      const int a = slot_var_[static_cast<size_t>(info.slot_begin + k)];
+      for (int l = k; l < info.num_slots; ++l) {
+        const int b = slot_var_[static_cast<size_t>(info.slot_begin + l)];
+        if (num_free_[static_cast<size_t>(a)] == 0 || num_free_[static_cast<size_t>(b)] == 0) {
+          pair_offset_.push_back(-1);
+        } else if (k == l) {
+          pair_offset_.push_back(diag_offset_[static_cast<size_t>(a)]);
+        } else {
+          const int row = col_start_[static_cast<size_t>(a)] < col_start_[static_cast<size_t>(b)] ? a : b;
+          const int col = row == a ? b : a;
+          const auto& lv = lower[static_cast<size_t>(col)];
+          const auto it = std::lower_bound(lv.begin(), lv.end(), row);
+          pair_offset_.push_back(lower_offset[static_cast<size_t>(col)][static_cast<size_t>(it - lv.begin())]);
+        }
+      }
+    }
+  }
+
+  // The CSC pattern.
+  H_ = cholmod_allocate_sparse(static_cast<size_t>(n_), static_cast<size_t>(n_), nnz, 1, 1, 1,
+                               CHOLMOD_REAL, cc_);
+  if (!H_) throw Error(ErrorCode::Failed, "NormalEquations: out of memory for H");
+  int* Hp = static_cast<int*>(H_->p);
+  int* Hi = static_cast<int*>(H_->i);
+  diag_pos_.resize(static_cast<size_t>(n_));
+  int pos = 0;
+  for (VariableId v = 0; v < nv; ++v) {
+    const auto sv = static_cast<size_t>(v);
+    for (int j = 0; j < num_free_[sv]; ++j) {
+      const int col = col_start_[sv] + j;
+      Hp[col] = pos;
+      for (int u : lower[sv])
+        for (int i = 0; i < num_free_[static_cast<size_t>(u)]; ++i)
+          Hi[pos++] = col_start_[static_cast<size_t>(u)] + i;
+      for (int i = 0; i <= j; ++i) Hi[pos++] = col_start_[sv] + i;
+      diag_pos_[static_cast<size_t>(col)] = pos - 1;
+    }
+  }
+  Hp[n_] = pos;
+  std::memset(H_->x, 0, nnz * sizeof(double));
+
+  // Buffers.
+  r_.assign(static_cast<size_t>(residual_total), 0.0);
+  jac_.assign(static_cast<size_t>(jac_total), 0.0);
+  ptr_scratch_.assign(static_cast<size_t>(max_slots), nullptr);
+  jac_ptr_scratch_.assign(static_cast<size_t>(max_slots), nullptr);
+  e_scratch_.assign(static_cast<size_t>(max_m), 0.0);
+  sqrt_info_scratch_.assign(static_cast<size_t>(max_m * max_m), 0.0);
+  g_ = Eigen::VectorXd::Zero(n_);
+  h_diag_ = Eigen::VectorXd::Zero(n_);
+  d_ = Eigen::VectorXd::Zero(n_);
+
+  // The block graph, kept for a block ordering.
+  if (options_.ordering == Ordering::BlockAMD && n_ > 0) {
+    std::vector<int> block_index(static_cast<size_t>(nv), -1);
+    std::vector<int> blocks;
+    for (VariableId v = 0; v < nv; ++v)
+      if (num_free_[static_cast<size_t>(v)] > 0) {
+        block_index[static_cast<size_t>(v)] = static_cast<int>(blocks.size());
+        blocks.push_back(v);
+      }
+    const size_t nb = blocks.size();
+    size_t bnnz = nb;
+    for (int v : blocks) bnnz += lower[static_cast<size_t>(v)].size();
+    cholmod_sparse* A = cholmod_allocate_sparse(nb, nb, bnnz, 1, 1, 1, CHOLMOD_PATTERN, cc_);
+    if (!A) throw Error(ErrorCode::Failed, "NormalEquations: out of memory for the block graph");
+    int* Ap = static_cast<int*>(A->p);
+    int* Ai = static_cast<int*>(A->i);
+    int q = 0;
+    for (size_t b = 0; b < nb; ++b) {
+      Ap[b] = q;
+      for (int u : lower[static_cast<size_t>(blocks[b])]) Ai[q++] = block_index[static_cast<size_t>(u)];
+      Ai[q++] = static_cast<int>(b);
+    }
+    Ap[nb] = q;
+    std::vector<int> block_perm(nb);
+    const int ok = cholmod_amd(A, nullptr, 0, block_perm.data(), cc_);
+    cholmod_free_sparse(&A, cc_);
+    if (!ok) throw Error(ErrorCode::Failed, "NormalEquations: AMD on the block graph failed");
+    user_perm_.clear();
+    user_perm_.reserve(static_cast<size_t>(n_));
+    for (int b : block_perm) {
+      const auto v = static_cast<size_t>(blocks[static_cast<size_t>(b)]);
+      for (int j = 0; j < num_free_[v]; ++j) user_perm_.push_back(col_start_[v] + j);
+    }
+  }
+}
+
+void NormalEquations::analyze() {
+  if (n_ == 0) return;
+  cc_->postorder = 1;
+  switch (options_.ordering) {
+    case Ordering::Automatic:
+      cc_->nmethods = 0;
+      break;
+    case Ordering::AMD:
+      cc_->nmethods = 1;
+      cc_->method[0].ordering = CHOLMOD_AMD;
+      break;
+    case Ordering::METIS:
+      cc_->nmethods = 1;
+      cc_->method[0].ordering = CHOLMOD_METIS;
+      break;
+    case Ordering::Natural:
+      cc_->nmethods = 1;
+      cc_->method[0].ordering = CHOLMOD_NATURAL;
+      cc_->postorder = 0;
+      break;
+    case Ordering::BlockAMD:
+      cc_->nmethods = 1;
+      cc_->method[0].ordering = CHOLMOD_GIVEN;
+      break;
+  }
+  if (options_.ordering == Ordering::BlockAMD)
+    L_ = cholmod_analyze_p(H_, user_perm_.data(), nullptr, 0, cc_);
+  else
+    L_ = cholmod_analyze(H_, cc_);
+  if (!L_ || cc_->status < CHOLMOD_OK)
+    throw Error(ErrorCode::Failed, "NormalEquations: CHOLMOD's symbolic analysis failed (status " +
+                                       std::to_string(cc_->status) + ")");
+  flops_ = cc_->fl;
+  lnz_ = cc_->lnz;
+  B_ = cholmod_zeros(static_cast<size_t>(n_), 1, CHOLMOD_REAL, cc_);
+  if (!B_) throw Error(ErrorCode::Failed, "NormalEquations: out of memory");
+}
+
+double NormalEquations::factor_nonzeros() const { return L_ ? lnz_ : 0.0; }
+double NormalEquations::factor_flops() const { return flops_; }
+
+std::string NormalEquations::ordering_used() const {
+  if (!L_) return "none";
+  std::string s;
+  switch (L_->ordering) {
+    case CHOLMOD_NATURAL: s = "natural"; break;
+    case CHOLMOD_GIVEN: s = "block AMD"; break;
+    case CHOLMOD_AMD: s = "AMD"; break;
+    case CHOLMOD_METIS: s = "METIS"; break;
+    case CHOLMOD_NESDIS: s = "NESDIS"; break;
+    case CHOLMOD_COLAMD: s = "COLAMD"; break;
+    case CHOLMOD_POSTORDERED: s = "natural, postordered"; break;
+    default: s = "ordering " + std::to_string(L_->ordering);
+  }
+  return s + (L_->is_super ? ", supernodal" : ", simplicial");
+}
+
+double NormalEquations::evaluate_cost(const double* values, PhaseTimes* times) {
+  const auto t0 = Clock::now();
+  double cost = 0.0;
+  for (const FactorInfo& info : factors_) {
+    const int m = info.residual_dim;
+    for (int k = 0; k < info.num_slots; ++k)
+      ptr_scratch_[static_cast<size_t>(k)] =
+          values + slot_value_offset_[static_cast<size_t>(info.slot_begin + k)];
+    double* e = e_scratch_.data();
+    info.factor->evaluate(ptr_scratch_.data(), e, nullptr);
+    const double* L = info.sqrt_info;
+    if (!L) {
+      info.factor->sqrt_information_at(ptr_scratch_.data(), sqrt_info_scratch_.data());
+      L = sqrt_info_scratch_.data();
+    }
+    double s = 0.0;
+    for (int i = 0; i < m; ++i) {
+      double ri = 0.0;
+      for (int j = i; j < m; ++j) ri += L[i + j * m] * e[j];
+      s += ri * ri;
+    }
+    if (info.kernel) {
+      double rho[3];
+      info.kernel->evaluate(s, rho);
+      s = rho[0];
+    }
+    cost += s;
+  }
+  if (times) times->evaluate += seconds_since(t0);
+  return cost;
+}
+
+void NormalEquations::linearize_factor_into(int f, const double* values, double& cost) {
+  const FactorInfo& info = factors_[static_cast<size_t>(f)];
+  const int m = info.residual_dim;
+  bool any_free = false;
+  for (int k = 0; k < info.num_slots; ++k) {
+    const auto s = static_cast<size_t>(info.slot_begin + k);
+    ptr_scratch_[static_cast<size_t>(k)] = values + slot_value_offset_[s];
+    const int jo = slot_jac_offset_[s];
+    jac_ptr_scratch_[static_cast<size_t>(k)] = jo >= 0 ? jac_.data() + jo : nullptr;
+    any_free |= jo >= 0;
+  }
+  double* e = r_.data() + info.residual_offset;
+  info.factor->evaluate(ptr_scratch_.data(), e, any_free ? jac_ptr_scratch_.data() : nullptr);
+  const double* L = info.sqrt_info;
+  if (!L) {
+    info.factor->sqrt_information_at(ptr_scratch_.data(), sqrt_info_scratch_.data());
+    L = sqrt_info_scratch_.data();
+  }
+  upper_times_in_place(L, m, e, 1);
+  double s = 0.0;
+  for (int i = 0; i < m; ++i) s += e[i] * e[i];
+  double w = 1.0;
+  if (info.kernel) {
+    double rho[3];
+    info.kernel->evaluate(s, rho);
+    cost += rho[0];
+    w = std::sqrt(rho[1]);
+    for (int i = 0; i < m; ++i) e[i] *= w;
+  } else {
+    cost += s;
+  }
+  if (!any_free) return;
+  const auto& types = info.factor->types();
+  for (int k = 0; k < info.num_slots; ++k) {
+    double* J = jac_ptr_scratch_[static_cast<size_t>(k)];
+    if (!J) continue;
+    const int d = types[static_cast<size_t>(k)].dim;
+    upper_times_in_place(L, m, J, d);
+    if (w != 1.0)
+      for (int i = 0; i < m * d; ++i) J[i] *= w;
+    if (options_.retraction == PoseRetraction::RightExp &&
+        types[static_cast<size_t>(k)].kind == VariableKind::Pose2)
+      right_exp_jacobian(ptr_scratch_[static_cast<size_t>(k)][2], J, m);
+  }
+}
+
+double NormalEquations::linearize(const double* values, PhaseTimes* times) {
+  auto t0 = Clock::now();
+  double cost = 0.0;
+  const int nf = static_cast<int>(factors_.size());
+  for (int f = 0; f < nf; ++f) linearize_factor_into(f, values, cost);
+  if (times) times->linearize += seconds_since(t0);
+
+  t0 = Clock::now();
+  double* Hx = static_cast<double*>(H_ ? H_->x : nullptr);
+  const int* Hp = static_cast<const int*>(H_ ? H_->p : nullptr);
+  if (H_) std::memset(Hx, 0, static_cast<size_t>(Hp[n_]) * sizeof(double));
+  g_.setZero();
+  double* g = g_.data();
+  for (const FactorInfo& info : factors_) {
+    const int m = info.residual_dim;
+    const double* r = r_.data() + info.residual_offset;
+    int pair = info.pair_begin;
+    for (int k = 0; k < info.num_slots; ++k) {
+      const auto sk = static_cast<size_t>(info.slot_begin + k);
+      const int jk = slot_jac_offset_[sk];
+      if (jk < 0) {
+        pair += info.num_slots - k;
+        continue;
+      }
+      const auto a = static_cast<size_t>(slot_var_[sk]);
+      const double* Ja = jac_.data() + jk;
+      const int fa = num_free_[a];
+      const int ca = col_start_[a];
+      const int* pa = free_params_.data() + free_begin_[a];
+      for (int i = 0; i < fa; ++i) {
+        const double* col = Ja + pa[i] * m;
+        double s = 0.0;
+        for (int t = 0; t < m; ++t) s += col[t] * r[t];
+        g[ca + i] += s;
+      }
+      // Diagonal block: upper triangle of J_aᵀJ_a.
+      {
+        const int off = pair_offset_[static_cast<size_t>(pair++)];
+        for (int j = 0; j < fa; ++j) {
+          double* out = Hx + Hp[ca + j] + off;
+          const double* cj = Ja + pa[j] * m;
+          for (int i = 0; i <= j; ++i) {
+            const double* ci = Ja + pa[i] * m;
+            double s = 0.0;
+            for (int t = 0; t < m; ++t) s += ci[t] * cj[t];
+            out[i] += s;
+          }
+        }
+      }
+      for (int l = k + 1; l < info.num_slots; ++l) {
+        const int off = pair_offset_[static_cast<size_t>(pair++)];
+        if (off < 0) continue;
+        const auto sl = static_cast<size_t>(info.slot_begin + l);
+        const auto b = static_cast<size_t>(slot_var_[sl]);
+        const double* Jb = jac_.data() + slot_jac_offset_[sl];
+        // Rows of the lower-column variable, columns of the higher.
+        const bool a_is_row = ca < col_start_[b];
+        const auto row_var = a_is_row ? a : b;
+        const auto col_var = a_is_row ? b : a;
+        const double* Jr = a_is_row ? Ja : Jb;
+        const double* Jc = a_is_row ? Jb : Ja;
+        const int fr = num_free_[row_var], fc = num_free_[col_var];
+        const int* pr = free_params_.data() + free_begin_[row_var];
+        const int* pc = free_params_.data() + free_begin_[col_var];
+        const int cc = col_start_[col_var];
+        for (int j = 0; j < fc; ++j) {
+          double* out = Hx + Hp[cc + j] + off;
+          const double* cj = Jc + pc[j] * m;
+          for (int i = 0; i < fr; ++i) {
+            const double* ci = Jr + pr[i] * m;
+            double s = 0.0;
+            for (int t = 0; t < m; ++t) s += ci[t] * cj[t];
+            out[i] += s;
+          }
+        }
+      }
+    }
+  }
+  for (int c = 0; c < n_; ++c) h_diag_[c] = Hx[diag_pos_[static_cast<size_t>(c)]];
+  if (times) times->build += seconds_since(t0);
+  return cost;
+}
+
+bool NormalEquations::factorize(double lambda, Damping damping, PhaseTimes* times) {
+  factor_ok_ = false;
+  if (n_ == 0) return false;
+  const auto t0 = Clock::now();
+  double* Hx = static_cast<double*>(H_->x);
+  for (int c = 0; c < n_; ++c) {
+    const double h = h_diag_[c];
+    d_[c] = damping == Damping::Marquardt
+                ? std::min(std::max(h, options_.min_diagonal), options_.max_diagonal)
+                : 1.0;
+    Hx[diag_pos_[static_cast<size_t>(c)]] = h + lambda * d_[c];
+  }
+  const int ok = cholmod_factorize(H_, L_, cc_);
+  bool good = ok && cc_->status == CHOLMOD_OK && L_->minor == L_->n;
+  if (good && !L_->is_super && !L_->is_ll) {
+    // Simplicial LDLᵀ accepts negative pivots: positive definite only if D > 0.
+    const int* Lp = static_cast<const int*>(L_->p);
+    const double* Lx = static_cast<const double*>(L_->x);
+    for (int j = 0; j < n_ && good; ++j) good = Lx[Lp[j]] > 0.0;
+  }
+  if (times) times->factorize += seconds_since(t0);
+  factor_ok_ = good;
+  return good;
+}
+
+bool NormalEquations::solve_step(Eigen::VectorXd& delta, PhaseTimes* times) {
+  if (!factor_ok_) return false;
+  const auto t0 = Clock::now();
+  double* b = static_cast<double*>(B_->x);
+  for (int c = 0; c < n_; ++c) b[c] = -g_[c];
+  const int ok = cholmod_solve2(CHOLMOD_A, L_, B_, nullptr, &X_, nullptr, &Y_, &E_, cc_);
+  delta.resize(n_);
+  bool finite = ok != 0;
+  if (finite) {
+    const double* x = static_cast<const double*>(X_->x);
+    for (int c = 0; c < n_; ++c) {
+      delta[c] = x[c];
+      finite &= std::isfinite(x[c]);
+    }
+  }
+  if (times) times->solve += seconds_since(t0);
+  return finite;
+}
+
+Eigen::MatrixXd NormalEquations::solve(const Eigen::MatrixXd& rhs) {
+  if (!factor_ok_) throw Error(ErrorCode::Internal, "NormalEquations::solve without a factor");
+  if (rhs.rows() != n_) throw_invalid_argument("NormalEquations::solve: wrong number of rows");
+  cholmod_dense* B = cholmod_allocate_dense(static_cast<size_t>(n_), static_cast<size_t>(rhs.cols()),
+                                            static_cast<size_t>(n_), CHOLMOD_REAL, cc_);
+  if (!B) throw Error(ErrorCode::Failed, "NormalEquations::solve: out of memory");
+  std::memcpy(B->x, rhs.data(), static_cast<size_t>(rhs.size()) * sizeof(double));
+  cholmod_dense* X = cholmod_solve(CHOLMOD_A, L_, B, cc_);
+  cholmod_free_dense(&B, cc_);
+  if (!X) throw Error(ErrorCode::Failed, "NormalEquations::solve: CHOLMOD's solve failed");
+  Eigen::MatrixXd out = Eigen::Map<const Eigen::MatrixXd>(static_cast<const double*>(X->x), n_, rhs.cols());
+  cholmod_free_dense(&X, cc_);
+  return out;
+}
+
+double NormalEquations::predicted_decrease(const Eigen::VectorXd& delta, double lambda) const {
+  return -g_.dot(delta) + lambda * (d_.array() * delta.array().square()).sum();
+}
+
+void NormalEquations::retract(const double* values, const Eigen::VectorXd& delta,
+                              double* out) const {
+  const int nv = static_cast<int>(col_start_.size());
+  for (int v = 0; v < nv; ++v) {
+    const auto sv = static_cast<size_t>(v);
+    const int fv = num_free_[sv];
+    if (fv == 0) continue;
+    const VariableType type = graph_->type(v);
+    const int o = graph_->offset(v);
+    const double* x = values + o;
+    double* y = out + o;
+    const double* dv = delta.data() + col_start_[sv];
+    if (type.kind == VariableKind::Pose2 && options_.retraction == PoseRetraction::RightExp) {
+      const SE2 moved = SE2(x[0], x[1], x[2]) * SE2::exp(Eigen::Vector3d(dv[0], dv[1], dv[2]));
+      y[0] = moved.x;
+      y[1] = moved.y;
+      y[2] = moved.theta;
+      continue;
+    }
+    for (int p = 0; p < type.dim; ++p) y[p] = x[p];
+    const int* fp = free_params_.data() + free_begin_[sv];
+    for (int i = 0; i < fv; ++i) y[fp[i]] += dv[i];
+    if (type.kind == VariableKind::Pose2) y[2] = wrap_angle(y[2]);
+  }
+}
+
+double NormalEquations::free_values_norm(const double* values) const {
+  double s = 0.0;
+  const int nv = static_cast<int>(col_start_.size());
+  for (int v = 0; v < nv; ++v) {
+    const auto sv = static_cast<size_t>(v);
+    const double* x = values + graph_->offset(v);
+    const int* fp = free_params_.data() + free_begin_[sv];
+    for (int i = 0; i < num_free_[sv]; ++i) s += x[fp[i]] * x[fp[i]];
+  }
+  return std::sqrt(s);
+}
+
+Eigen::MatrixXd NormalEquations::dense_hessian() const {
+  Eigen::MatrixXd H = Eigen::MatrixXd::Zero(n_, n_);
+  if (n_ == 0) return H;
+  const int* Hp = static_cast<const int*>(H_->p);
+  const int* Hi = static_cast<const int*>(H_->i);
+  const double* Hx = static_cast<const double*>(H_->x);
+  for (int c = 0; c < n_; ++c)
+    for (int p = Hp[c]; p < Hp[c + 1]; ++p) {
+      H(Hi[p], c) = Hx[p];
+      H(c, Hi[p]) = Hx[p];
+    }
+  H.diagonal() = h_diag_;
+  return H;
+}
+
+}  // namespace planarvo::graph

@@ -1,0 +1,198 @@
+// The Gauss–Newton normal equations H δ = −g of a factor graph (H = J̃ᵀJ̃, g = J̃ᵀr̃, whitened and
+// robust-weighted) in a CHOLMOD matrix whose pattern is built once, and their sparse Cholesky
+// factorisation.
+//
+// Only the upper triangle of H is stored (CSC, stype = 1). Columns are the free parameters,
+// variable after variable; a fixed variable has no columns and a fixed parameter loses its
+// column. The pattern comes from the graph's block structure; each factor keeps, per pair of its
+// variables, the offset of its block inside the CSC value array, so refilling H is a pass over
+// the factors that adds small dense blocks in place — no triplets, no sort, no allocation.
+// cholmod_analyze (the fill-reducing ordering and the supernodal symbolic factor) runs once in
+// the constructor; factorize() is a numeric factorisation only.
+#pragma once
+#include <cstdint>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "graph/factor_graph.h"
+
+struct cholmod_common_struct;
+struct cholmod_sparse_struct;
+struct cholmod_factor_struct;
+struct cholmod_dense_struct;
+
+namespace planarvo::graph {
+
+// How a pose moves by a step δ = (δx, δy, δθ).
+enum class PoseRetraction {
+  // (x + δx, y + δy, θ + δθ), as g2o's VertexSE2: a fixed pose parameter is an exact world
+  // coordinate, and Jacobians are the factors' own. The default.
+  Additive,
+  // X · exp(δ), δ in the pose's own frame: the Jacobians become J · diag(R(θ), 1). Fixing single
+  // parameters of a pose is refused with this retraction (they would not be world coordinates).
+  RightExp,
+};
+
+// The fill-reducing ordering of cholmod_analyze.
+enum class Ordering {
+  BlockAMD,   // AMD on the variable graph (one node per variable), expanded to parameters
+  Automatic,  // CHOLMOD's default: AMD on parameters, METIS too when AMD fills a lot
+  AMD,        // AMD on parameters
+  METIS,      // METIS nested dissection on parameters
+  Natural,    // none (for tests)
+};
+
+enum class Damping {
+  Marquardt,  // H + λ·diag(H) (diag clamped to [min_diagonal, max_diagonal]): scale invariant
+  Levenberg,  // H + λ·I
+};
+
+// Supernodal (dense BLAS kernels on supernodes) or simplicial (CHOLMOD's own up-looking LDLᵀ).
+// Which is faster depends on the BLAS: with Debian's reference BLAS, simplicial wins on every
+// 2-D pose graph and calibration graph measured (test/bench), supernodal wins with an optimised
+// BLAS on problems with dense fronts.
+enum class Factorization {
+  Automatic,  // supernodal when flops / nnz(L) ≥ supernodal_switch (CHOLMOD's rule)
+  Supernodal,
+  Simplicial,
+};
+
+struct LinearSolverOptions {
+  Ordering ordering = Ordering::BlockAMD;
+  Factorization factorization = Factorization::Automatic;
+  // CHOLMOD's default is 40; 2-D problems reach ~80 (city10000), where the reference BLAS
+  // still loses to simplicial, hence the higher default.
+  double supernodal_switch = 500.0;
+  PoseRetraction retraction = PoseRetraction::Additive;
+  double min_diagonal = 1e-6;  // clamp of diag(H) in Marquardt damping (as Ceres)
+  double max_diagonal = 1e32;
+};
+
+// Time spent in each phase, seconds.
+struct PhaseTimes {
+  double linearize = 0.0;  // factor errors and Jacobians, whitening, robust weights
+  double build = 0.0;      // filling H and g
+  double factorize = 0.0;  // numeric Cholesky
+  double solve = 0.0;      // triangular solves
+  double evaluate = 0.0;   // cost at trial points
+  double analyze = 0.0;    // pattern and symbolic analysis (once)
+};
+
+// One factor's whitened and robust-weighted error r̃ and Jacobians J̃_k (residual_dim × dim_k,
+// stored coordinates) at the graph's values; returns ρ(eᵀΩe). Independent of NormalEquations
+// (tests use it as the dense reference; the covariance code for cross terms).
+double linearize_factor(const FactorGraph& graph, int factor, Eigen::VectorXd& residual,
+                        std::vector<Eigen::MatrixXd>& jacobians);
+
+class NormalEquations {
+ public:
+  // `also_fixed`: variables to treat as fixed on top of the graph's own (the Schur complement
+  // of observability analysis needs the system of all other variables).
+  NormalEquations(const FactorGraph& graph, const LinearSolverOptions& options,
+                  const std::vector<VariableId>& also_fixed = {});
+  ~NormalEquations();
+  NormalEquations(const NormalEquations&) = delete;
+  NormalEquations& operator=(const NormalEquations&) = delete;
+
+  // True while the graph's structure is what this system was built for.
+  bool matches(const FactorGraph& graph) const;
+  int num_columns() const { return n_; }
+  // The column of a free parameter, −1 for a fixed one.
+  int column(VariableId v, int parameter) const;
+  const LinearSolverOptions& options() const { return options_; }
+
+  // Robust cost Σ ρ(eᵀΩe) at `values` (the graph's flat layout).
+  double evaluate_cost(const double* values, PhaseTimes* times = nullptr);
+  // Evaluates all factors with Jacobians at `values`, fills H and g; returns the cost.
+  double linearize(const double* values, PhaseTimes* times = nullptr);
+  const Eigen::VectorXd& gradient() const { return g_; }
+  const Eigen::VectorXd& hessian_diagonal() const { return h_diag_; }
+
+  // Factorises H + λD (D per `damping`). False when the matrix is not positive definite (or
+  // not finite); the factor is then unusable until the next successful factorize().
+  bool factorize(double lambda, Damping damping, PhaseTimes* times = nullptr);
+  // δ = −(H + λD)⁻¹ g with the last successful factorisation; false when δ is not finite.
+  bool solve_step(Eigen::VectorXd& delta, PhaseTimes* times = nullptr);
+  // X = (H + λD)⁻¹ B for a dense n × k right-hand side (covariances).
+  Eigen::MatrixXd solve(const Eigen::MatrixXd& rhs);
+  // The decrease of the quadratic model for a step from solve_step: −gᵀδ − δᵀHδ... written as
+  // −gᵀδ + λ δᵀDδ, which holds because (H + λD)δ = −g.
+  double predicted_decrease(const Eigen::VectorXd& delta, double lambda) const;
+
+  // out = values ⊞ δ (fixed parameters untouched).
+  void retract(const double* values, const Eigen::VectorXd& delta, double* out) const;
+  // Euclidean norm of the free parameters' values (for the relative step tolerance).
+  double free_values_norm(const double* values) const;
+
+  // H (both triangles) and g as dense matrices: tests compare them with a dense reference.
+  Eigen::MatrixXd dense_hessian() const;
+  // Fill-in of the factor: nnz(L), and what CHOLMOD used (ordering, supernodal).
+  double factor_nonzeros() const;
+  double factor_flops() const;  // of one numeric factorisation, from the analysis
+  std::string ordering_used() const;
+  // Seconds spent building the pattern and in cholmod_analyze.
+  double analyze_seconds() const { return analyze_seconds_; }
+
+ private:
+  void build_pattern(const FactorGraph& graph, const std::vector<VariableId>& also_fixed);
+  void analyze();
+  void release();
+  void linearize_factor_into(int f, const double* values, double& cost);
+
+  LinearSolverOptions options_;
+  const FactorGraph* graph_ = nullptr;
+  std::uint64_t version_ = 0;
+  int n_ = 0;  // free parameters
+
+  // Per variable.
+  std::vector<int> col_start_;        // first column, −1 if no free parameter
+  std::vector<int> num_free_;         // number of free parameters
+  std::vector<int> free_begin_;       // into free_params_
+  std::vector<int> free_params_;      // parameter index of each free column, per variable
+  std::vector<int> diag_offset_;      // rows above a variable's diagonal block in its columns
+  std::vector<VariableId> block_of_column_;  // variable of each column (for ordering)
+
+  // Per factor (structure of arrays). A factor's variables are "slots".
+  struct FactorInfo {
+    const Factor* factor;
+    const RobustKernel* kernel;
+    const double* sqrt_info;  // constant information; null when state dependent
+    int residual_dim;
+    int slot_begin, num_slots;
+    int residual_offset;  // into r_
+    int pair_begin;       // into pair_offset_: num_slots·(num_slots+1)/2 entries
+  };
+  std::vector<FactorInfo> factors_;
+  std::vector<int> slot_var_;        // variable of each slot
+  std::vector<int> slot_value_offset_;
+  std::vector<int> slot_jac_offset_;  // into jac_, −1 when the variable has no free parameter
+  std::vector<int> pair_offset_;      // offset of the block within its CSC columns (see .cpp)
+
+  // Buffers, allocated once.
+  std::vector<double> r_;    // whitened residuals
+  std::vector<double> jac_;  // whitened Jacobians (full variable dims), column-major per slot
+  std::vector<const double*> ptr_scratch_;
+  std::vector<double*> jac_ptr_scratch_;
+  std::vector<double> e_scratch_, sqrt_info_scratch_;
+  Eigen::VectorXd g_;
+  Eigen::VectorXd h_diag_;  // diag(H) before damping
+  Eigen::VectorXd d_;       // the damping diagonal D of the last factorize()
+  std::vector<int> diag_pos_;  // index of each diagonal entry in the CSC values
+
+  std::vector<int> user_perm_;  // the block ordering expanded to columns (BlockAMD)
+  double analyze_seconds_ = 0.0;
+  double flops_ = 0.0, lnz_ = 0.0;
+
+  // CHOLMOD.
+  cholmod_common_struct* cc_ = nullptr;
+  cholmod_sparse_struct* H_ = nullptr;
+  cholmod_factor_struct* L_ = nullptr;
+  cholmod_dense_struct* B_ = nullptr;
+  cholmod_dense_struct* X_ = nullptr;
+  cholmod_dense_struct* Y_ = nullptr;
+  cholmod_dense_struct* E_ = nullptr;
+  bool factor_ok_ = false;
+};
+
+}  // namespace planarvo::graph

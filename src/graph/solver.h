@@ -1,0 +1,124 @@
+// Sparse Levenberg–Marquardt on a FactorGraph: minimises Σ ρ(eᵀΩe) (χ² units: no ½).
+//
+// Each iteration factorises (H + λD) with CHOLMOD (symbolic analysis once per graph structure)
+// and solves for the step δ; the gain ratio ρ = actual / predicted decrease decides:
+//   accepted (ρ > min_relative_decrease): λ *= max(1/3, 1 − (2ρ − 1)³), ν = 2   (Nielsen)
+//   rejected, or the factorisation failed: λ *= ν, ν *= 2
+// A factorisation that fails (H + λD not positive definite, e.g. a free gauge with λ = 0) is a
+// rejected step, never an abort. Damping defaults to Marquardt's D = diag(H) (clamped), which is
+// invariant to the units of each parameter (metres, radians, a height scale), with Ceres' start
+// λ₀ = 1e-4; Levenberg's D = I is available (λ₀ = initial_lambda · max diag(H), g2o's τ).
+#pragma once
+#include <functional>
+#include <limits>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "graph/factor_graph.h"
+#include "graph/normal_equations.h"
+
+namespace planarvo::graph {
+
+struct IterationSummary;
+
+struct SolverOptions {
+  // Iterations (factorisations, accepted or not) before giving up. Ceres' default is 50.
+  int max_iterations = 100;
+  // Stop when a step changes the cost by less than this fraction of it (Ceres' default).
+  double function_tolerance = 1e-6;
+  // Stop when the largest gradient component max|J̃ᵀr̃| falls below this (Ceres' default).
+  double gradient_tolerance = 1e-10;
+  // Stop when |δ| ≤ tol·(|x| + tol), x the free parameters (Ceres' default).
+  double parameter_tolerance = 1e-8;
+  // Damping: see the header comment. initial_lambda 1e-4 is Ceres' initial trust-region radius
+  // 1e4; for Levenberg damping it is g2o's τ relative to max diag(H) (g2o uses 1e-5).
+  Damping damping = Damping::Marquardt;
+  double initial_lambda = 1e-4;
+  double min_lambda = 1e-16;  // λ never drops below (Ceres' max trust-region radius 1e16)
+  double max_lambda = 1e32;   // beyond this the solver gives up (TerminationType::DampingLimit)
+  // A step is accepted when ρ exceeds this (Ceres' default).
+  double min_relative_decrease = 1e-3;
+  // Seconds before giving up; infinity for no limit.
+  double max_time_s = std::numeric_limits<double>::infinity();
+  LinearSolverOptions linear;
+  // Called after every iteration; returning false stops the solver (TerminationType::UserStop).
+  std::function<bool(const IterationSummary&)> callback;
+};
+
+enum class TerminationType {
+  FunctionTolerance,   // converged: relative cost change below function_tolerance
+  GradientTolerance,   // converged: gradient max-norm below gradient_tolerance
+  ParameterTolerance,  // converged: step below parameter_tolerance
+  MaxIterations,       // not converged: iteration cap
+  MaxTime,             // not converged: time cap
+  DampingLimit,        // not converged: λ exceeded max_lambda (no step lowers the cost)
+  NothingToOptimize,   // every variable is fixed
+  NumericalFailure,    // the cost is not finite at the initial values
+  UserStop,            // the callback asked to stop
+};
+
+std::string to_string(TerminationType type);
+
+struct IterationSummary {
+  int iteration = 0;             // 0: the initial point
+  double cost = 0.0;             // cost after this iteration (the accepted point)
+  double cost_change = 0.0;      // decrease the trial step achieved (negative: increase)
+  double gradient_max_norm = 0.0;  // at the accepted point
+  double step_norm = 0.0;        // |δ| of the trial step
+  double lambda = 0.0;           // damping the trial step was computed with
+  double relative_decrease = 0.0;  // ρ = actual / predicted decrease
+  bool factorization_ok = true;
+  bool step_accepted = false;
+  double iteration_time_s = 0.0;
+  double cumulative_time_s = 0.0;
+};
+
+struct SolverSummary {
+  TerminationType termination = TerminationType::NothingToOptimize;
+  std::string message;  // why it stopped, with the numbers
+  double initial_cost = 0.0;
+  double final_cost = 0.0;
+  int num_iterations = 0;  // LM iterations (not counting the initial evaluation)
+  int num_accepted = 0;
+  int num_rejected = 0;             // steps that did not lower the cost enough
+  int num_failed_factorizations = 0;  // H + λD not positive definite
+  std::vector<IterationSummary> iterations;  // [0] is the initial point
+  PhaseTimes times;
+  double total_time_s = 0.0;
+  int num_parameters = 0;  // free parameters (columns)
+  int num_factors = 0;
+  double factor_nonzeros = 0.0;  // nnz(L)
+  double factor_flops = 0.0;     // flops of one numeric factorisation
+  std::string linear_solver;      // ordering and factorisation CHOLMOD used
+
+  bool converged() const;
+  // One line: termination, costs, iterations, time.
+  std::string brief_report() const;
+  // The iteration table, phase times and the termination.
+  std::string full_report() const;
+};
+
+class Solver {
+ public:
+  explicit Solver(SolverOptions options = {});
+  ~Solver();
+  Solver(Solver&&) noexcept;
+  Solver& operator=(Solver&&) noexcept;
+
+  // Optimises the graph's values in place. The symbolic analysis is kept and reused by the next
+  // call while the graph's structure and the linear options stay the same.
+  SolverSummary solve(FactorGraph& graph);
+
+  const SolverOptions& options() const { return options_; }
+  SolverOptions& options() { return options_; }
+
+ private:
+  SolverOptions options_;
+  std::unique_ptr<NormalEquations> system_;
+};
+
+// One-shot convenience.
+SolverSummary solve(FactorGraph& graph, const SolverOptions& options = {});
+
+}  // namespace planarvo::graph
