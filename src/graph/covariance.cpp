@@ -157,14 +157,18 @@ ObservabilityReport analyse_observability(const FactorGraph& graph,
   S = 0.5 * (S + S.transpose()).eval();
   rep.information = S;
 
-  // Scale to correlations. A parameter whose information the elimination cancelled (S_ii at
-  // most relative_tolerance of H_bb,ii: all it had is explained by the other variables, as for a
-  // gauge) or that no factor touches is unobservable outright; scaling its roundoff-sized S_ii
-  // up to 1 would hide that.
+  // Scale to correlations. A parameter left with roundoff-sized information is unobservable
+  // outright, as scaling its S_ii up to 1 would hide that: when the elimination cancelled its
+  // information (S_ii at most relative_tolerance of H_bb,ii: the other variables explain all of
+  // it, as for a gauge), or when it has almost none to begin with (S_ii at most
+  // relative_tolerance of the largest diagonal, in SI units: a Jacobian column that is zero
+  // up to rounding).
+  const double max_diag = S.diagonal().maxCoeff();
   Eigen::VectorXd scale(nb);
   std::vector<char> empty(static_cast<size_t>(nb), 0);
   for (int i = 0; i < nb; ++i) {
-    empty[static_cast<size_t>(i)] = !(S(i, i) > relative_tolerance * Hbb(i, i));
+    empty[static_cast<size_t>(i)] =
+        !(S(i, i) > relative_tolerance * Hbb(i, i)) || !(S(i, i) > relative_tolerance * max_diag);
     scale[i] = empty[static_cast<size_t>(i)] ? 1.0 : 1.0 / std::sqrt(S(i, i));
   }
   Eigen::MatrixXd Sn = scale.asDiagonal() * S * scale.asDiagonal();

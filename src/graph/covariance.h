@@ -46,8 +46,10 @@ Eigen::MatrixXd marginal_covariance(const FactorGraph& graph, VariableId v,
 // determined once the block is known (otherwise Error(Failed), e.g. a free gauge).
 //
 // Rank and condition are taken on the correlation-scaled S (D^-½ S D^-½, D = diag S), so that
-// metres, radians and a height scale compare; a parameter with no information of its own left
-// after the elimination (S_ii ≤ relative_tolerance · H_bb,ii) is unobservable outright.
+// metres, radians and a height scale compare. Before scaling, a parameter with roundoff-sized
+// information is declared unobservable outright: S_ii ≤ relative_tolerance · H_bb,ii (the
+// elimination cancelled it, as for a gauge) or S_ii ≤ relative_tolerance · max_j S_jj (SI units).
+// relative_tolerance thus bounds the weakest information called observable.
 struct ObservabilityReport {
   std::vector<std::string> parameter_names;  // "z.x", ... the free parameters of the block
   Eigen::MatrixXd information;               // S, over those parameters

@@ -89,6 +89,8 @@ SE2 random_pose(std::mt19937& rng, double extent = 10.0) {
 
 std::vector<double> coords(const SE2& p) { return {p.x, p.y, p.theta}; }
 
+double angle_distance(double a, double b) { return std::abs(wrap_angle(a - b)); }
+
 TEST(GraphFactors, RelativePoseErrorIsG2oConvention) {
   // e = t2v(Z⁻¹ · (X_i⁻¹ · X_j)) computed with 3×3 matrices.
   std::mt19937 rng(7);
@@ -151,6 +153,156 @@ TEST(GraphFactors, InformationMustBeSymmetricPositiveDefinite) {
   const Eigen::MatrixXd L = ok.sqrt_information();
   EXPECT_LT((L.transpose() * L - info).norm(), 1e-12);
   EXPECT_EQ(L(1, 0), 0.0);  // upper triangular
+}
+
+// ---- calibration factors --------------------------------------------------------------------
+
+// z = (x, y, height, yaw) with a realistic spread: height in [0.1, 2].
+std::vector<double> random_calibration(std::mt19937& rng) {
+  std::uniform_real_distribution<double> u(-1, 1);
+  return {0.5 * u(rng), 0.5 * u(rng), 1.05 + 0.95 * u(rng), M_PI * u(rng)};
+}
+
+// T·S_h(m)·T⁻¹ with 3×3 matrices.
+Eigen::Matrix3d mapped_motion(const SE2& m, const std::vector<double>& z) {
+  const SE2 T(z[0], z[1], z[3]);
+  const SE2 scaled(z[2] * m.x, z[2] * m.y, m.theta);
+  return T.matrix() * scaled.matrix() * T.matrix().inverse();
+}
+
+TEST(GraphCalibrationFactors, SensorToRobotMotionIsTheConjugation) {
+  std::mt19937 rng(17);
+  for (int t = 0; t < 100; ++t) {
+    const SE2 m = random_pose(rng, 1.0);
+    const std::vector<double> z = random_calibration(rng);
+    Eigen::Matrix<double, 2, 4> J;
+    const SE2 r = sensor_to_robot_motion(m, z.data(), J.data());
+    const Eigen::Matrix3d ref = mapped_motion(m, z);
+    EXPECT_NEAR(r.x, ref(0, 2), 1e-12);
+    EXPECT_NEAR(r.y, ref(1, 2), 1e-12);
+    EXPECT_NEAR(angle_distance(r.theta, std::atan2(ref(1, 0), ref(0, 0))), 0.0, 1e-12);
+    for (int k = 0; k < 4; ++k) {
+      std::vector<double> zp = z, zm = z;
+      zp[static_cast<size_t>(k)] += 1e-6;
+      zm[static_cast<size_t>(k)] -= 1e-6;
+      const SE2 a = sensor_to_robot_motion(m, zp.data()), b = sensor_to_robot_motion(m, zm.data());
+      EXPECT_NEAR(J(0, k), (a.x - b.x) / 2e-6, 1e-7);
+      EXPECT_NEAR(J(1, k), (a.y - b.y) / 2e-6, 1e-7);
+    }
+  }
+}
+
+TEST(GraphCalibrationFactors, SensorFactorIsEq26WithProjectedInformation) {
+  std::mt19937 rng(19);
+  for (int t = 0; t < 50; ++t) {
+    const SE2 xi = random_pose(rng), xj = random_pose(rng), m = random_pose(rng, 1.0);
+    const std::vector<double> z = random_calibration(rng);
+    const Eigen::Matrix3d info_s = random_information(rng);
+    SensorMotionFactor f(0, 1, 2, m, info_s);
+    const std::vector<double> a = coords(xi), b = coords(xj);
+    const double* v[3] = {a.data(), b.data(), z.data()};
+    // The robot-frame error of eq. 26, e = t2v(m_r⁻¹·(X_i⁻¹·X_j)), with matrices.
+    const Eigen::Matrix3d E = mapped_motion(m, z).inverse() * xi.matrix().inverse() * xj.matrix();
+    const Eigen::Vector3d e = f.robot_frame_error(v);
+    EXPECT_NEAR(e[0], E(0, 2), 1e-10);
+    EXPECT_NEAR(e[1], E(1, 2), 1e-10);
+    EXPECT_NEAR(e[2], std::atan2(E(1, 0), E(0, 0)), 1e-10);
+    // Its cost under Ω̂ = (Ad·H)⁻ᵀ Ω_s (Ad·H)⁻¹, Ad the adjoint of T_vs found numerically from
+    // T·exp(ξ)·T⁻¹ = exp(Ad·ξ), H = diag(h, h, 1).
+    const SE2 T(z[0], z[1], z[3]);
+    Eigen::Matrix3d Ad;
+    for (int k = 0; k < 3; ++k) {
+      Eigen::Vector3d d = Eigen::Vector3d::Zero();
+      d[k] = 1e-6;
+      Ad.col(k) = ((T * SE2::exp(d) * T.inverse()).log() - (T * SE2::exp(-d) * T.inverse()).log()) / 2e-6;
+    }
+    const Eigen::Matrix3d AH = Ad * Eigen::Vector3d(z[2], z[2], 1).asDiagonal();
+    const Eigen::Matrix3d info_r = AH.inverse().transpose() * info_s * AH.inverse();
+    Eigen::Vector3d et;
+    f.evaluate(v, et.data(), nullptr);
+    EXPECT_NEAR(et.dot(info_s * et), e.dot(info_r * e), 1e-6 * std::max(1.0, e.dot(info_r * e)));
+    expect_jacobians_match(f, {a, b, z});
+  }
+}
+
+TEST(GraphCalibrationFactors, SensorFactorErrorIsTheSensorNoise) {
+  // At a consistent state, perturbing the measured sensor motion by exp(ξ) gives ẽ ≈ −ξ: the
+  // factor's error is in the sensor's units, where Ω_s applies.
+  std::mt19937 rng(23);
+  for (int t = 0; t < 20; ++t) {
+    const std::vector<double> z = random_calibration(rng);
+    const SE2 m = random_pose(rng, 1.0), xi = random_pose(rng);
+    const Eigen::Matrix3d mr = mapped_motion(m, z);
+    const SE2 xj = xi * SE2(mr(0, 2), mr(1, 2), std::atan2(mr(1, 0), mr(0, 0)));
+    const Eigen::Vector3d noise(1e-6, -2e-6, 1.5e-6);
+    SensorMotionFactor f(0, 1, 2, m * SE2::exp(noise), Eigen::Matrix3d::Identity());
+    const std::vector<double> a = coords(xi), b = coords(xj);
+    const double* v[3] = {a.data(), b.data(), z.data()};
+    Eigen::Vector3d e;
+    f.evaluate(v, e.data(), nullptr);
+    EXPECT_LT((e + noise).norm(), 1e-9 + 1e-4 * noise.norm()) << e.transpose();
+  }
+}
+
+TEST(GraphCalibrationFactors, NonholonomicFactorValuesAndJacobians) {
+  std::mt19937 rng(29);
+  std::uniform_real_distribution<double> u(-1, 1);
+  for (int t = 0; t < 50; ++t) {
+    const std::vector<double> z = random_calibration(rng);
+    const SE2 T(z[0], z[1], z[3]);
+    // A differential-drive arc (v, 0, ω) seen by the sensor: m_s = S_{1/h}(T⁻¹·m_r·T).
+    const SE2 arc = SE2::exp(Eigen::Vector3d(u(rng), 0.0, u(rng)));
+    const SE2 ms_h = T.inverse() * arc * T;
+    const SE2 ms(ms_h.x / z[2], ms_h.y / z[2], ms_h.theta);
+    NonholonomicFactor arc_f(0, ms, 1.0), vel_f(0, ms, 1.0, NonholonomicFactor::Form::Velocity);
+    double e = 1.0;
+    std::vector<double> zz = z;
+    const double* v[1] = {zz.data()};
+    arc_f.evaluate(v, &e, nullptr);
+    EXPECT_NEAR(e, 0.0, 1e-12);  // the true z explains an arc
+    // ... whatever y is: the nonholonomic constraint cannot see it.
+    zz[1] += 0.3;
+    arc_f.evaluate(v, &e, nullptr);
+    EXPECT_NEAR(e, 0.0, 1e-12);
+    // Off the truth: the formula of conventions.md, and the lateral motion for the velocity form.
+    zz = random_calibration(rng);
+    v[0] = zz.data();
+    const Eigen::Matrix3d M = mapped_motion(ms, zz);
+    const double th = std::atan2(M(1, 0), M(0, 0));
+    arc_f.evaluate(v, &e, nullptr);
+    EXPECT_NEAR(e, M(1, 2) * std::cos(th / 2) - M(0, 2) * std::sin(th / 2), 1e-12);
+    vel_f.evaluate(v, &e, nullptr);
+    EXPECT_NEAR(e, M(1, 2), 1e-12);
+    expect_jacobians_match(arc_f, {zz});
+    expect_jacobians_match(vel_f, {zz});
+  }
+}
+
+TEST(GraphCalibrationFactors, DirectionPriorPenalisesOnlyTheWrongDirection) {
+  std::vector<double> z = {0.2, -0.1, 1.0, 0.0};
+  const double* v[1] = {z.data()};
+  const SE2 forward(0.5, 0.0, 0.1), backward(-0.5, 0.0, -0.1);
+  double e;
+  DirectionPriorFactor(0, forward, +1, 1.0).evaluate(v, &e, nullptr);
+  EXPECT_EQ(e, 0.0);
+  DirectionPriorFactor(0, forward, -1, 1.0).evaluate(v, &e, nullptr);
+  EXPECT_NEAR(e, sensor_to_robot_motion(forward, z.data()).x, 1e-15);
+  EXPECT_GT(e, 0.0);
+  DirectionPriorFactor(0, backward, -1, 1.0).evaluate(v, &e, nullptr);
+  EXPECT_EQ(e, 0.0);
+  DirectionPriorFactor(0, backward, +1, 1.0).evaluate(v, &e, nullptr);
+  EXPECT_LT(e, 0.0);
+  DirectionPriorFactor(0, forward, 0, 1.0).evaluate(v, &e, nullptr);
+  EXPECT_NEAR(e, sensor_to_robot_motion(forward, z.data()).x, 1e-15);
+  EXPECT_THROW(DirectionPriorFactor(0, forward, 2, 1.0), Error);
+  // Jacobians where the prior is active (away from the kink at m_r,x = 0).
+  std::mt19937 rng(31);
+  for (int t = 0; t < 30; ++t) {
+    const std::vector<double> zz = random_calibration(rng);
+    const SE2 m = random_pose(rng, 1.0);
+    if (std::abs(sensor_to_robot_motion(m, zz.data()).x) < 1e-3) continue;
+    for (int d : {-1, 0, 1}) expect_jacobians_match(DirectionPriorFactor(0, m, d, 2.0), {zz});
+  }
 }
 
 // ---- robust kernels -------------------------------------------------------------------------
