@@ -28,7 +28,8 @@ class FactorGraph {
 
   // A fixed variable keeps its value; a fixed parameter of a variable keeps its value while the
   // others move (the solver drops its column from the normal equations). For a pose, the
-  // parameters are x, y, θ in the world frame (exact under the default additive retraction).
+  // parameters are x, y, θ in the world frame (such a pose steps additively, see
+  // PoseRetraction).
   void set_fixed(VariableId v, bool fixed = true);
   void set_parameter_fixed(VariableId v, int parameter, bool fixed = true);
   bool is_fixed(VariableId v) const;

@@ -136,6 +136,7 @@ void NormalEquations::build_pattern(const FactorGraph& graph,
     forced[static_cast<size_t>(v)] = 1;
   }
   col_start_.assign(static_cast<size_t>(nv), -1);
+  body_frame_.assign(static_cast<size_t>(nv), 0);
   num_free_.assign(static_cast<size_t>(nv), 0);
   free_begin_.assign(static_cast<size_t>(nv), 0);
   free_params_.clear();
@@ -146,11 +147,8 @@ void NormalEquations::build_pattern(const FactorGraph& graph,
     const VariableType type = graph.type(v);
     const std::uint64_t mask = forced[sv] ? ~std::uint64_t{0} : graph.fixed_mask(v);
     free_begin_[sv] = static_cast<int>(free_params_.size());
-    if (options_.retraction == PoseRetraction::RightExp && type.kind == VariableKind::Pose2 &&
-        mask != 0 && mask != 7 && !graph.is_fixed(v) && !forced[sv])
-      throw_invalid_argument("NormalEquations: '" + graph.name(v) +
-                             "' has single fixed parameters, which the RightExp retraction "
-                             "cannot keep; use PoseRetraction::Additive");
+    body_frame_[sv] = options_.retraction == PoseRetraction::RightExp &&
+                      type.kind == VariableKind::Pose2 && mask == 0;
     for (int p = 0; p < type.dim; ++p)
       if (!((mask >> p) & 1u)) free_params_.push_back(p);
     num_free_[sv] = static_cast<int>(free_params_.size()) - free_begin_[sv];
@@ -170,6 +168,7 @@ void NormalEquations::build_pattern(const FactorGraph& graph,
   slot_var_.clear();
   slot_value_offset_.clear();
   slot_jac_offset_.clear();
+  slot_body_frame_.clear();
   int residual_total = 0, jac_total = 0, max_m = 0, max_slots = 0;
   for (int f = 0; f < nf; ++f) {
     const Factor& fac = graph.factor(f);
@@ -187,6 +186,7 @@ void NormalEquations::build_pattern(const FactorGraph& graph,
       const auto v = static_cast<size_t>(vars[k]);
       slot_var_.push_back(vars[k]);
       slot_value_offset_.push_back(graph.offset(vars[k]));
+      slot_body_frame_.push_back(body_frame_[v]);
       if (num_free_[v] > 0) {
         slot_jac_offset_.push_back(jac_total);
         jac_total += info.residual_dim * fac.types()[k].dim;
@@ -360,6 +360,11 @@ void NormalEquations::analyze() {
 double NormalEquations::factor_nonzeros() const { return L_ ? lnz_ : 0.0; }
 double NormalEquations::factor_flops() const { return flops_; }
 
+double NormalEquations::cg_iteration_flops() const {
+  const double nnz_h = H_ ? static_cast<const int*>(H_->p)[n_] : 0.0;
+  return 4.0 * nnz_h + 4.0 * lnz_ + 12.0 * n_;
+}
+
 std::string NormalEquations::ordering_used() const {
   if (!L_) return "none";
   std::string s;
@@ -448,8 +453,7 @@ void NormalEquations::linearize_factor_into(int f, const double* values, double&
     upper_times_in_place(L, m, J, d);
     if (w != 1.0)
       for (int i = 0; i < m * d; ++i) J[i] *= w;
-    if (options_.retraction == PoseRetraction::RightExp &&
-        types[static_cast<size_t>(k)].kind == VariableKind::Pose2)
+    if (slot_body_frame_[static_cast<size_t>(info.slot_begin + k)])
       right_exp_jacobian(ptr_scratch_[static_cast<size_t>(k)][2], J, m);
   }
 }
@@ -537,10 +541,7 @@ double NormalEquations::linearize(const double* values, PhaseTimes* times) {
   return cost;
 }
 
-bool NormalEquations::factorize(double lambda, Damping damping, PhaseTimes* times) {
-  factor_ok_ = false;
-  if (n_ == 0) return false;
-  const auto t0 = Clock::now();
+void NormalEquations::set_damping(double lambda, Damping damping) {
   double* Hx = static_cast<double*>(H_->x);
   for (int c = 0; c < n_; ++c) {
     const double h = h_diag_[c];
@@ -549,6 +550,76 @@ bool NormalEquations::factorize(double lambda, Damping damping, PhaseTimes* time
                 : 1.0;
     Hx[diag_pos_[static_cast<size_t>(c)]] = h + lambda * d_[c];
   }
+  lambda_ = lambda;
+}
+
+void NormalEquations::multiply(const double* x, double* y, bool damped) const {
+  const int* Hp = static_cast<const int*>(H_->p);
+  const int* Hi = static_cast<const int*>(H_->i);
+  const double* Hx = static_cast<const double*>(H_->x);
+  for (int c = 0; c < n_; ++c) y[c] = 0.0;
+  for (int c = 0; c < n_; ++c) {
+    const double xc = x[c];
+    double yc = 0.0;
+    const int end = Hp[c + 1] - 1;  // the last entry of a column is its diagonal
+    for (int p = Hp[c]; p < end; ++p) {
+      const int r = Hi[p];
+      y[r] += Hx[p] * xc;
+      yc += Hx[p] * x[r];
+    }
+    y[c] += yc + (damped ? Hx[end] : h_diag_[c]) * xc;
+  }
+}
+
+void NormalEquations::factor_solve(const double* x, double* y) {
+  std::memcpy(B_->x, x, static_cast<size_t>(n_) * sizeof(double));
+  cholmod_solve2(CHOLMOD_A, L_, B_, nullptr, &X_, nullptr, &Y_, &E_, cc_);
+  std::memcpy(y, X_->x, static_cast<size_t>(n_) * sizeof(double));
+}
+
+int NormalEquations::solve_step_reusing_factor(double lambda, Damping damping,
+                                               Eigen::VectorXd& delta, int max_iterations,
+                                               double tolerance, PhaseTimes* times) {
+  if (!factor_ok_ || n_ == 0) return -1;
+  const auto t0 = Clock::now();
+  set_damping(lambda, damping);
+  cg_r_.resize(n_);
+  cg_z_.resize(n_);
+  cg_p_.resize(n_);
+  cg_q_.resize(n_);
+  delta.setZero(n_);
+  cg_r_ = -g_;
+  const double stop = tolerance * cg_r_.norm();
+  factor_solve(cg_r_.data(), cg_z_.data());
+  cg_p_ = cg_z_;
+  double rz = cg_r_.dot(cg_z_);
+  int result = -1;
+  for (int k = 1; k <= max_iterations; ++k) {
+    multiply(cg_p_.data(), cg_q_.data(), true);
+    const double pq = cg_p_.dot(cg_q_);
+    if (!(pq > 0.0) || !std::isfinite(rz)) break;
+    const double alpha = rz / pq;
+    delta += alpha * cg_p_;
+    cg_r_ -= alpha * cg_q_;
+    if (cg_r_.norm() <= stop) {
+      result = k;
+      break;
+    }
+    factor_solve(cg_r_.data(), cg_z_.data());
+    const double rz_next = cg_r_.dot(cg_z_);
+    cg_p_ = cg_z_ + (rz_next / rz) * cg_p_;
+    rz = rz_next;
+  }
+  if (result > 0 && !delta.allFinite()) result = -1;
+  if (times) times->solve += seconds_since(t0);
+  return result;
+}
+
+bool NormalEquations::factorize(double lambda, Damping damping, PhaseTimes* times) {
+  factor_ok_ = false;
+  if (n_ == 0) return false;
+  const auto t0 = Clock::now();
+  set_damping(lambda, damping);
   const int ok = cholmod_factorize(H_, L_, cc_);
   bool good = ok && cc_->status == CHOLMOD_OK && L_->minor == L_->n;
   if (good && !L_->is_super && !L_->is_ll) {
@@ -596,8 +667,10 @@ Eigen::MatrixXd NormalEquations::solve(const Eigen::MatrixXd& rhs) {
   return out;
 }
 
-double NormalEquations::predicted_decrease(const Eigen::VectorXd& delta, double lambda) const {
-  return -g_.dot(delta) + lambda * (d_.array() * delta.array().square()).sum();
+double NormalEquations::predicted_decrease(const Eigen::VectorXd& delta) {
+  cg_q_.resize(n_);
+  multiply(delta.data(), cg_q_.data(), false);
+  return -2.0 * g_.dot(delta) - delta.dot(cg_q_);
 }
 
 void NormalEquations::retract(const double* values, const Eigen::VectorXd& delta,
@@ -612,7 +685,7 @@ void NormalEquations::retract(const double* values, const Eigen::VectorXd& delta
     const double* x = values + o;
     double* y = out + o;
     const double* dv = delta.data() + col_start_[sv];
-    if (type.kind == VariableKind::Pose2 && options_.retraction == PoseRetraction::RightExp) {
+    if (body_frame_[sv]) {
       const SE2 moved = SE2(x[0], x[1], x[2]) * SE2::exp(Eigen::Vector3d(dv[0], dv[1], dv[2]));
       y[0] = moved.x;
       y[1] = moved.y;

@@ -26,11 +26,14 @@ namespace planarvo::graph {
 
 // How a pose moves by a step δ = (δx, δy, δθ).
 enum class PoseRetraction {
-  // (x + δx, y + δy, θ + δθ), as g2o's VertexSE2: a fixed pose parameter is an exact world
-  // coordinate, and Jacobians are the factors' own. The default.
+  // (x + δx, y + δy, θ + δθ), as g2o's VertexSE2; Jacobians are the factors' own.
   Additive,
-  // X · exp(δ), δ in the pose's own frame: the Jacobians become J · diag(R(θ), 1). Fixing single
-  // parameters of a pose is refused with this retraction (they would not be world coordinates).
+  // X · exp(δ), δ in the pose's own frame; Jacobians become J · diag(R(θ), 1). Measured on the
+  // reference files and calibration chains (test/bench): fewer iterations where rotations
+  // accumulate along chains (ais2klinik 100 → 33, a 10k-pose calibration chain 68 → 27).
+  // A pose with a single fixed parameter always steps additively, so that the fixed parameter
+  // is an exact world coordinate; the retraction is a per-variable choice of step, either is
+  // valid.
   RightExp,
 };
 
@@ -64,7 +67,7 @@ struct LinearSolverOptions {
   // CHOLMOD's default is 40; 2-D problems reach ~80 (city10000), where the reference BLAS
   // still loses to simplicial, hence the higher default.
   double supernodal_switch = 500.0;
-  PoseRetraction retraction = PoseRetraction::Additive;
+  PoseRetraction retraction = PoseRetraction::RightExp;
   double min_diagonal = 1e-6;  // clamp of diag(H) in Marquardt damping (as Ceres)
   double max_diagonal = 1e32;
 };
@@ -114,11 +117,20 @@ class NormalEquations {
   bool factorize(double lambda, Damping damping, PhaseTimes* times = nullptr);
   // δ = −(H + λD)⁻¹ g with the last successful factorisation; false when δ is not finite.
   bool solve_step(Eigen::VectorXd& delta, PhaseTimes* times = nullptr);
+  // δ ≈ −(H + λD)⁻¹ g for the current H by conjugate gradients preconditioned with the last
+  // successful factorisation, which may be of an earlier H and λ: a few sparse products and
+  // triangular solves instead of a numeric factorisation. Stops when ‖(H + λD)δ + g‖ ≤
+  // tolerance·‖g‖; returns the number of CG iterations, or −1 when there is no factor or CG did
+  // not converge within max_iterations (or met a non-positive curvature).
+  int solve_step_reusing_factor(double lambda, Damping damping, Eigen::VectorXd& delta,
+                                int max_iterations, double tolerance,
+                                PhaseTimes* times = nullptr);
+  bool has_factor() const { return factor_ok_; }
   // X = (H + λD)⁻¹ B for a dense n × k right-hand side (covariances).
   Eigen::MatrixXd solve(const Eigen::MatrixXd& rhs);
-  // The decrease of the quadratic model for a step from solve_step: −gᵀδ − δᵀHδ... written as
-  // −gᵀδ + λ δᵀDδ, which holds because (H + λD)δ = −g.
-  double predicted_decrease(const Eigen::VectorXd& delta, double lambda) const;
+  // The decrease of the quadratic model |r̃|² − |r̃ + J̃δ|² = −2gᵀδ − δᵀHδ for any step δ (exact
+  // or not).
+  double predicted_decrease(const Eigen::VectorXd& delta);
 
   // out = values ⊞ δ (fixed parameters untouched).
   void retract(const double* values, const Eigen::VectorXd& delta, double* out) const;
@@ -130,6 +142,8 @@ class NormalEquations {
   // Fill-in of the factor: nnz(L), and what CHOLMOD used (ordering, supernodal).
   double factor_nonzeros() const;
   double factor_flops() const;  // of one numeric factorisation, from the analysis
+  // Of one iteration of solve_step_reusing_factor: a product with H and two triangular solves.
+  double cg_iteration_flops() const;
   std::string ordering_used() const;
   // Seconds spent building the pattern and in cholmod_analyze.
   double analyze_seconds() const { return analyze_seconds_; }
@@ -138,6 +152,11 @@ class NormalEquations {
   void build_pattern(const FactorGraph& graph, const std::vector<VariableId>& also_fixed);
   void analyze();
   void release();
+  void set_damping(double lambda, Damping damping);
+  // y = (H + λD)·x, or H·x without the damping.
+  void multiply(const double* x, double* y, bool damped) const;
+  // y = (last factor)⁻¹·x through B_/X_, allocation-free.
+  void factor_solve(const double* x, double* y);
   void linearize_factor_into(int f, const double* values, double& cost);
 
   LinearSolverOptions options_;
@@ -152,6 +171,7 @@ class NormalEquations {
   std::vector<int> free_params_;      // parameter index of each free column, per variable
   std::vector<int> diag_offset_;      // rows above a variable's diagonal block in its columns
   std::vector<VariableId> block_of_column_;  // variable of each column (for ordering)
+  std::vector<char> body_frame_;      // the pose steps by X·exp(δ) (else additively)
 
   // Per factor (structure of arrays). A factor's variables are "slots".
   struct FactorInfo {
@@ -167,6 +187,7 @@ class NormalEquations {
   std::vector<int> slot_var_;        // variable of each slot
   std::vector<int> slot_value_offset_;
   std::vector<int> slot_jac_offset_;  // into jac_, −1 when the variable has no free parameter
+  std::vector<char> slot_body_frame_;  // body_frame_ of the slot's variable
   std::vector<int> pair_offset_;      // offset of the block within its CSC columns (see .cpp)
 
   // Buffers, allocated once.
@@ -177,7 +198,9 @@ class NormalEquations {
   std::vector<double> e_scratch_, sqrt_info_scratch_;
   Eigen::VectorXd g_;
   Eigen::VectorXd h_diag_;  // diag(H) before damping
-  Eigen::VectorXd d_;       // the damping diagonal D of the last factorize()
+  Eigen::VectorXd d_;       // the damping diagonal D set last
+  double lambda_ = 0.0;     // and its λ
+  Eigen::VectorXd cg_r_, cg_z_, cg_p_, cg_q_;  // conjugate-gradient workspace
   std::vector<int> diag_pos_;  // index of each diagonal entry in the CSC values
 
   std::vector<int> user_perm_;  // the block ordering expanded to columns (BlockAMD)

@@ -72,22 +72,27 @@ std::string SolverSummary::full_report() const {
                 num_parameters, num_factors, linear_solver.c_str(), factor_nonzeros, factor_flops);
   s << buf;
   s << "iter        cost   cost_change  |gradient|      |step|      lambda       rho  "
-       "step      ms  total_ms\n";
+       "step  linear      ms  total_ms\n";
   for (const IterationSummary& it : iterations) {
     const char* what = it.iteration == 0 ? "    "
                        : !it.factorization_ok ? "npd "
                        : it.step_accepted ? "ok  "
                                            : "rej ";
+    char linear[16] = "";
+    if (it.iteration > 0 && it.refactorized) std::snprintf(linear, sizeof linear, "chol");
+    if (it.iteration > 0 && !it.refactorized) std::snprintf(linear, sizeof linear, "cg %d", it.cg_iterations);
     std::snprintf(buf, sizeof buf,
-                  "%4d %11.6g %13.6g %11.4g %11.4g %11.4g %9.3g  %s %7.2f %9.2f\n", it.iteration,
-                  it.cost, it.cost_change, it.gradient_max_norm, it.step_norm, it.lambda,
-                  it.relative_decrease, what, it.iteration_time_s * 1e3,
+                  "%4d %11.6g %13.6g %11.4g %11.4g %11.4g %9.3g  %s  %-6s %7.2f %9.2f\n",
+                  it.iteration, it.cost, it.cost_change, it.gradient_max_norm, it.step_norm,
+                  it.lambda, it.relative_decrease, what, linear, it.iteration_time_s * 1e3,
                   it.cumulative_time_s * 1e3);
     s << buf;
   }
   std::snprintf(buf, sizeof buf,
-                "iterations %d: %d accepted, %d rejected, %d failed factorisations\n",
-                num_iterations, num_accepted, num_rejected, num_failed_factorizations);
+                "iterations %d: %d accepted, %d rejected, %d failed factorisations; "
+                "%d numeric factorisations\n",
+                num_iterations, num_accepted, num_rejected, num_failed_factorizations,
+                num_factorizations);
   s << buf;
   std::snprintf(buf, sizeof buf,
                 "time (ms): analyze %.2f, linearize %.2f, build %.2f, factorize %.2f, "
@@ -162,6 +167,15 @@ SolverSummary Solver::solve(FactorGraph& graph) {
       o.damping == Damping::Levenberg ? std::max(sys.hessian_diagonal().maxCoeff(), 1e-300) : 1.0;
   double lambda = std::max(o.initial_lambda * lambda_scale, o.min_lambda);
   double nu = 2.0;
+  // Factor reuse: CG iterations worth a fraction of a factorisation, and the back-off.
+  const int cg_budget =
+      o.reuse_factorization
+          ? static_cast<int>(std::min<double>(
+                o.reuse_max_cg_iterations,
+                std::floor(o.reuse_cg_budget * sys.factor_flops() /
+                           std::max(sys.cg_iteration_flops(), 1.0))))
+          : 0;
+  int reuse_skip = 0, reuse_backoff = 1;
   Eigen::VectorXd delta;
 
   for (int iter = 1;; ++iter) {
@@ -180,9 +194,26 @@ SolverSummary Solver::solve(FactorGraph& graph) {
     it.lambda = lambda;
     summary.num_iterations = iter;
 
-    bool ok = sys.factorize(lambda, o.damping, &times);
-    if (ok) ok = sys.solve_step(delta, &times);
-    it.factorization_ok = ok;
+    bool ok = false;
+    if (cg_budget >= 2 && sys.has_factor() && reuse_skip-- <= 0) {
+      it.cg_iterations = sys.solve_step_reusing_factor(lambda, o.damping, delta, cg_budget,
+                                                       o.reuse_cg_tolerance, &times);
+      ok = it.cg_iterations > 0;
+      if (ok) {
+        reuse_backoff = 1;
+      } else {
+        // The factor no longer preconditions well: replace it now, and back off.
+        reuse_skip = reuse_backoff;
+        reuse_backoff *= 2;
+      }
+    }
+    if (!ok) {
+      it.cg_iterations = 0;
+      it.refactorized = true;
+      ++summary.num_factorizations;
+      ok = sys.factorize(lambda, o.damping, &times) && sys.solve_step(delta, &times);
+      it.factorization_ok = ok;
+    }
     std::string converged_message;  // set when the function tolerance is met
     if (ok) {
       it.step_norm = delta.norm();
@@ -196,7 +227,7 @@ SolverSummary Solver::solve(FactorGraph& graph) {
       }
       sys.retract(x.data(), delta, trial.data());
       const double new_cost = sys.evaluate_cost(trial.data(), &times);
-      const double predicted = sys.predicted_decrease(delta, lambda);
+      const double predicted = sys.predicted_decrease(delta);
       it.cost_change = cost - new_cost;
       it.relative_decrease = predicted > 0.0 ? it.cost_change / predicted : -1.0;
       it.step_accepted = std::isfinite(new_cost) && predicted > 0.0 &&
@@ -213,7 +244,8 @@ SolverSummary Solver::solve(FactorGraph& graph) {
       cost = sys.linearize(x.data(), &times);
       gmax = sys.gradient().cwiseAbs().maxCoeff();
       const double r = 2.0 * it.relative_decrease - 1.0;
-      lambda = std::max(lambda * std::max(1.0 / 3.0, 1.0 - r * r * r), o.min_lambda);
+      lambda = std::max(lambda * std::max(1.0 / o.lambda_max_decrease, 1.0 - r * r * r),
+                        o.min_lambda);
       nu = 2.0;
     } else {
       if (ok)
