@@ -81,10 +81,13 @@ void VectorPriorFactor::evaluate(const double* const* values, double* e,
 std::vector<std::string> calibration_parameter_names() { return {"x", "y", "height", "yaw"}; }
 
 SE2 sensor_to_robot_motion(const SE2& m, const double* z, double* dt_dz) {
+  return sensor_to_robot_motion(m, std::cos(m.theta), std::sin(m.theta), z, dt_dz);
+}
+
+SE2 sensor_to_robot_motion(const SE2& m, double cp, double sp, const double* z, double* dt_dz) {
   const double x = z[CalibrationIndex::kX], y = z[CalibrationIndex::kY];
   const double h = z[CalibrationIndex::kHeight], yaw = z[CalibrationIndex::kYaw];
   const double cg = std::cos(yaw), sg = std::sin(yaw);
-  const double cp = std::cos(m.theta), sp = std::sin(m.theta);
   // T·S_h(m)·T⁻¹ = (R_φ, (I − R_φ)·p + h·R_γ·v): planar rotations commute.
   const double rvx = cg * m.x - sg * m.y, rvy = sg * m.x + cg * m.y;
   const double tx = (1.0 - cp) * x + sp * y + h * rvx;
@@ -104,7 +107,9 @@ SensorMotionFactor::SensorMotionFactor(VariableId pose_i, VariableId pose_j,
              {VariableType::pose2(), VariableType::pose2(),
               VariableType::vector(CalibrationIndex::kDim)},
              sensor_information),
-      sensor_motion_(sensor_motion) {}
+      sensor_motion_(sensor_motion),
+      cm_(std::cos(sensor_motion.theta)),
+      sm_(std::sin(sensor_motion.theta)) {}
 
 namespace {
 
@@ -116,10 +121,9 @@ struct MotionError {
   Eigen::Matrix<double, 2, 2> Jt;  // d e_t / d t_M (e_θ does not depend on t_M)
 };
 
-MotionError motion_error(const double* a, const double* b, const SE2& M) {
+MotionError motion_error(const double* a, const double* b, const SE2& M, double cz, double sz) {
   MotionError r;
   const double ci = std::cos(a[2]), si = std::sin(a[2]);
-  const double cz = std::cos(M.theta), sz = std::sin(M.theta);
   const double dx = b[0] - a[0], dy = b[1] - a[1];
   const double ax = ci * dx + si * dy, ay = -si * dx + ci * dy;
   const double ux = ax - M.x, uy = ay - M.y;
@@ -134,15 +138,16 @@ MotionError motion_error(const double* a, const double* b, const SE2& M) {
 }  // namespace
 
 Eigen::Vector3d SensorMotionFactor::robot_frame_error(const double* const* values) const {
-  return motion_error(values[0], values[1], sensor_to_robot_motion(sensor_motion_, values[2])).e;
+  const SE2 M = sensor_to_robot_motion(sensor_motion_, cm_, sm_, values[2], nullptr);
+  return motion_error(values[0], values[1], M, cm_, sm_).e;
 }
 
 void SensorMotionFactor::evaluate(const double* const* values, double* error,
                                   double* const* jacobians) const {
   const double* z = values[2];
   Eigen::Matrix<double, 2, 4> dt_dz;
-  const SE2 M = sensor_to_robot_motion(sensor_motion_, z, dt_dz.data());
-  const MotionError me = motion_error(values[0], values[1], M);
+  const SE2 M = sensor_to_robot_motion(sensor_motion_, cm_, sm_, z, dt_dz.data());
+  const MotionError me = motion_error(values[0], values[1], M, cm_, sm_);
   // ẽ = G·e, G = diag(1/h, 1/h, 1)·Ad(T_vs)⁻¹: ẽ_t = (R_γᵀ e_t + e_θ·J·R_γᵀ·p) / h, ẽ_θ = e_θ.
   const double h = z[CalibrationIndex::kHeight], yaw = z[CalibrationIndex::kYaw];
   const Eigen::Vector2d p(z[CalibrationIndex::kX], z[CalibrationIndex::kY]);

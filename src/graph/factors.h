@@ -69,6 +69,9 @@ std::vector<std::string> calibration_parameter_names();
 // m_r for the calibration z (4 values) and, when dt_dz is not null, the 2×4 Jacobian of m_r's
 // translation with respect to z (column-major). m_r's angle is m_s's, whatever z.
 SE2 sensor_to_robot_motion(const SE2& sensor_motion, const double* z, double* dt_dz = nullptr);
+// The same with cos and sin of the sensor motion's angle given (factors keep them).
+SE2 sensor_to_robot_motion(const SE2& sensor_motion, double cos_theta, double sin_theta,
+                           const double* z, double* dt_dz);
 
 // The visual (sensor) odometry factor, eq. 26, between poses r_i, r_{i+1} and the calibration z:
 // the robot's motion r_i⁻¹·r_{i+1} against the mapped sensor motion, e = t2v(m_r⁻¹·(r_i⁻¹·r_{i+1}))
@@ -91,6 +94,7 @@ class SensorMotionFactor final : public Factor {
 
  private:
   SE2 sensor_motion_;
+  double cm_, sm_;  // cos, sin of the measured angle
 };
 
 // The nonholonomic factor on z alone (paper sec. 5.2.2, in this project's conventions): the

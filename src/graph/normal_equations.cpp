@@ -33,8 +33,7 @@ void upper_times_in_place(const double* L, int m, double* X, int n) {
 }
 
 // J ← J · diag(R(θ), 1) for the RightExp retraction: d(X·exp(δ))/dδ at 0 is diag(R(θ), 1).
-void right_exp_jacobian(double theta, double* J, int m) {
-  const double c = std::cos(theta), s = std::sin(theta);
+void right_exp_jacobian(double c, double s, double* J, int m) {
   double* j0 = J;
   double* j1 = J + m;
   for (int i = 0; i < m; ++i) {
@@ -135,12 +134,11 @@ void NormalEquations::build_pattern(const FactorGraph& graph,
     if (v < 0 || v >= nv) throw_invalid_argument("NormalEquations: no variable " + std::to_string(v));
     forced[static_cast<size_t>(v)] = 1;
   }
-  col_start_.assign(static_cast<size_t>(nv), -1);
   body_frame_.assign(static_cast<size_t>(nv), 0);
+  rotation_.assign(2 * static_cast<size_t>(nv), 0.0);
   num_free_.assign(static_cast<size_t>(nv), 0);
   free_begin_.assign(static_cast<size_t>(nv), 0);
   free_params_.clear();
-  block_of_column_.clear();
   n_ = 0;
   for (VariableId v = 0; v < nv; ++v) {
     const auto sv = static_cast<size_t>(v);
@@ -152,16 +150,11 @@ void NormalEquations::build_pattern(const FactorGraph& graph,
     for (int p = 0; p < type.dim; ++p)
       if (!((mask >> p) & 1u)) free_params_.push_back(p);
     num_free_[sv] = static_cast<int>(free_params_.size()) - free_begin_[sv];
-    if (num_free_[sv] > 0) {
-      col_start_[sv] = n_;
-      n_ += num_free_[sv];
-      block_of_column_.insert(block_of_column_.end(), static_cast<size_t>(num_free_[sv]), v);
-    }
+    n_ += num_free_[sv];
   }
 
-  // Lower neighbours of every free variable: the free variables sharing a factor with it whose
-  // columns come first (they fill the rows above its diagonal block).
-  std::vector<std::vector<int>> lower(static_cast<size_t>(nv));
+  // Factors as slots, and the variable graph: free variables sharing a factor.
+  adjacency_.assign(static_cast<size_t>(nv), {});
   const int nf = graph.num_factors();
   factors_.clear();
   factors_.reserve(static_cast<size_t>(nf));
@@ -196,32 +189,72 @@ void NormalEquations::build_pattern(const FactorGraph& graph,
       for (size_t l = 0; l < k; ++l) {
         const auto u = static_cast<size_t>(vars[l]);
         if (num_free_[u] == 0 || num_free_[v] == 0) continue;
-        if (col_start_[u] < col_start_[v])
-          lower[v].push_back(vars[l]);
-        else
-          lower[u].push_back(vars[k]);
+        adjacency_[u].push_back(vars[k]);
+        adjacency_[v].push_back(vars[l]);
       }
     }
     max_m = std::max(max_m, info.residual_dim);
     max_slots = std::max(max_slots, info.num_slots);
     factors_.push_back(info);
   }
-  std::vector<std::vector<int>> lower_offset(static_cast<size_t>(nv));
-  diag_offset_.assign(static_cast<size_t>(nv), 0);
+  for (auto& a : adjacency_) {
+    std::sort(a.begin(), a.end());
+    a.erase(std::unique(a.begin(), a.end()), a.end());
+  }
+
+  // Buffers.
+  r_.assign(static_cast<size_t>(residual_total), 0.0);
+  jac_.assign(static_cast<size_t>(jac_total), 0.0);
+  ptr_scratch_.assign(static_cast<size_t>(max_slots), nullptr);
+  jac_ptr_scratch_.assign(static_cast<size_t>(max_slots), nullptr);
+  e_scratch_.assign(static_cast<size_t>(max_m), 0.0);
+  sqrt_info_scratch_.assign(static_cast<size_t>(max_m * max_m), 0.0);
+  g_ = Eigen::VectorXd::Zero(n_);
+  h_diag_ = Eigen::VectorXd::Zero(n_);
+  d_ = Eigen::VectorXd::Zero(n_);
+
+  // Columns in variable order to begin with; analyze() may renumber them.
+  std::vector<VariableId> order;
+  for (VariableId v = 0; v < nv; ++v)
+    if (num_free_[static_cast<size_t>(v)] > 0) order.push_back(v);
+  number_columns(order);
+}
+
+void NormalEquations::number_columns(const std::vector<VariableId>& order) {
+  const size_t nv = num_free_.size();
+  col_start_.assign(nv, -1);
+  block_of_column_.clear();
+  int c = 0;
+  for (VariableId v : order) {
+    col_start_[static_cast<size_t>(v)] = c;
+    c += num_free_[static_cast<size_t>(v)];
+    block_of_column_.insert(block_of_column_.end(),
+                            static_cast<size_t>(num_free_[static_cast<size_t>(v)]), v);
+  }
+
+  // Rows above each variable's diagonal block: its neighbours with earlier columns, in column
+  // order, each contributing all its free parameters.
+  auto by_column = [&](int a, int b) {
+    return col_start_[static_cast<size_t>(a)] < col_start_[static_cast<size_t>(b)];
+  };
+  std::vector<std::vector<int>> lower(nv), lower_offset(nv);
+  diag_offset_.assign(nv, 0);
   size_t nnz = 0;
-  for (VariableId v = 0; v < nv; ++v) {
-    auto& lv = lower[static_cast<size_t>(v)];
-    std::sort(lv.begin(), lv.end());
-    lv.erase(std::unique(lv.begin(), lv.end()), lv.end());
-    auto& off = lower_offset[static_cast<size_t>(v)];
+  for (VariableId v : order) {
+    const auto sv = static_cast<size_t>(v);
+    auto& lv = lower[sv];
+    for (int u : adjacency_[sv])
+      if (by_column(u, v)) lv.push_back(u);
+    std::sort(lv.begin(), lv.end(), by_column);
+    auto& off = lower_offset[sv];
     off.resize(lv.size());
     int above = 0;
     for (size_t i = 0; i < lv.size(); ++i) {
       off[i] = above;
       above += num_free_[static_cast<size_t>(lv[i])];
     }
-    diag_offset_[static_cast<size_t>(v)] = above;
-    const int fv = num_free_[static_cast<size_t>(v)];
+    diag_offset_[sv] = above;
+    const int fv = num_free_[sv];
     nnz += static_cast<size_t>(fv) * static_cast<size_t>(above) +
            static_cast<size_t>(fv * (fv + 1) / 2);
   }
@@ -239,17 +272,18 @@ void NormalEquations::build_pattern(const FactorGraph& graph,
         } else if (k == l) {
           pair_offset_.push_back(diag_offset_[static_cast<size_t>(a)]);
         } else {
-          const int row = col_start_[static_cast<size_t>(a)] < col_start_[static_cast<size_t>(b)] ? a : b;
+          const int row = by_column(a, b) ? a : b;
           const int col = row == a ? b : a;
           const auto& lv = lower[static_cast<size_t>(col)];
-          const auto it = std::lower_bound(lv.begin(), lv.end(), row);
+          const auto it = std::lower_bound(lv.begin(), lv.end(), row, by_column);
           pair_offset_.push_back(lower_offset[static_cast<size_t>(col)][static_cast<size_t>(it - lv.begin())]);
         }
       }
     }
   }
 
-  // The CSC pattern.
+  // The CSC pattern of the upper triangle.
+  if (H_) cholmod_free_sparse(&H_, cc_);
   H_ = cholmod_allocate_sparse(static_cast<size_t>(n_), static_cast<size_t>(n_), nnz, 1, 1, 1,
                                CHOLMOD_REAL, cc_);
   if (!H_) throw Error(ErrorCode::Failed, "NormalEquations: out of memory for H");
@@ -257,7 +291,7 @@ void NormalEquations::build_pattern(const FactorGraph& graph,
   int* Hi = static_cast<int*>(H_->i);
   diag_pos_.resize(static_cast<size_t>(n_));
   int pos = 0;
-  for (VariableId v = 0; v < nv; ++v) {
+  for (VariableId v : order) {
     const auto sv = static_cast<size_t>(v);
     for (int j = 0; j < num_free_[sv]; ++j) {
       const int col = col_start_[sv] + j;
@@ -271,86 +305,99 @@ void NormalEquations::build_pattern(const FactorGraph& graph,
   }
   Hp[n_] = pos;
   std::memset(H_->x, 0, nnz * sizeof(double));
+}
 
-  // Buffers.
-  r_.assign(static_cast<size_t>(residual_total), 0.0);
-  jac_.assign(static_cast<size_t>(jac_total), 0.0);
-  ptr_scratch_.assign(static_cast<size_t>(max_slots), nullptr);
-  jac_ptr_scratch_.assign(static_cast<size_t>(max_slots), nullptr);
-  e_scratch_.assign(static_cast<size_t>(max_m), 0.0);
-  sqrt_info_scratch_.assign(static_cast<size_t>(max_m * max_m), 0.0);
-  g_ = Eigen::VectorXd::Zero(n_);
-  h_diag_ = Eigen::VectorXd::Zero(n_);
-  d_ = Eigen::VectorXd::Zero(n_);
-
-  // The block graph, kept for a block ordering.
-  if (options_.ordering == Ordering::BlockAMD && n_ > 0) {
-    std::vector<int> block_index(static_cast<size_t>(nv), -1);
-    std::vector<int> blocks;
-    for (VariableId v = 0; v < nv; ++v)
-      if (num_free_[static_cast<size_t>(v)] > 0) {
-        block_index[static_cast<size_t>(v)] = static_cast<int>(blocks.size());
-        blocks.push_back(v);
-      }
-    const size_t nb = blocks.size();
-    size_t bnnz = nb;
-    for (int v : blocks) bnnz += lower[static_cast<size_t>(v)].size();
-    cholmod_sparse* A = cholmod_allocate_sparse(nb, nb, bnnz, 1, 1, 1, CHOLMOD_PATTERN, cc_);
-    if (!A) throw Error(ErrorCode::Failed, "NormalEquations: out of memory for the block graph");
-    int* Ap = static_cast<int*>(A->p);
-    int* Ai = static_cast<int*>(A->i);
-    int q = 0;
-    for (size_t b = 0; b < nb; ++b) {
-      Ap[b] = q;
-      for (int u : lower[static_cast<size_t>(blocks[b])]) Ai[q++] = block_index[static_cast<size_t>(u)];
-      Ai[q++] = static_cast<int>(b);
+std::vector<int> NormalEquations::block_amd_permutation() {
+  // AMD on the variable graph (upper pattern, one node per free variable), expanded to columns.
+  const size_t nv = num_free_.size();
+  std::vector<int> block_index(nv, -1);
+  std::vector<int> blocks;
+  for (size_t v = 0; v < nv; ++v)
+    if (num_free_[v] > 0) {
+      block_index[v] = static_cast<int>(blocks.size());
+      blocks.push_back(static_cast<int>(v));
     }
-    Ap[nb] = q;
-    std::vector<int> block_perm(nb);
-    const int ok = cholmod_amd(A, nullptr, 0, block_perm.data(), cc_);
-    cholmod_free_sparse(&A, cc_);
-    if (!ok) throw Error(ErrorCode::Failed, "NormalEquations: AMD on the block graph failed");
-    user_perm_.clear();
-    user_perm_.reserve(static_cast<size_t>(n_));
-    for (int b : block_perm) {
-      const auto v = static_cast<size_t>(blocks[static_cast<size_t>(b)]);
-      for (int j = 0; j < num_free_[v]; ++j) user_perm_.push_back(col_start_[v] + j);
-    }
+  const size_t nb = blocks.size();
+  size_t bnnz = nb;
+  for (int v : blocks) bnnz += adjacency_[static_cast<size_t>(v)].size();
+  cholmod_sparse* A = cholmod_allocate_sparse(nb, nb, bnnz, 1, 1, 1, CHOLMOD_PATTERN, cc_);
+  if (!A) throw Error(ErrorCode::Failed, "NormalEquations: out of memory for the block graph");
+  int* Ap = static_cast<int*>(A->p);
+  int* Ai = static_cast<int*>(A->i);
+  int q = 0;
+  for (size_t b = 0; b < nb; ++b) {
+    Ap[b] = q;
+    for (int u : adjacency_[static_cast<size_t>(blocks[b])])
+      if (block_index[static_cast<size_t>(u)] < static_cast<int>(b))
+        Ai[q++] = block_index[static_cast<size_t>(u)];
+    Ai[q++] = static_cast<int>(b);
   }
+  Ap[nb] = q;
+  std::vector<int> block_perm(nb);
+  const int ok = cholmod_amd(A, nullptr, 0, block_perm.data(), cc_);
+  cholmod_free_sparse(&A, cc_);
+  if (!ok) throw Error(ErrorCode::Failed, "NormalEquations: AMD on the block graph failed");
+  std::vector<int> perm;
+  perm.reserve(static_cast<size_t>(n_));
+  for (int b : block_perm) {
+    const auto v = static_cast<size_t>(blocks[static_cast<size_t>(b)]);
+    for (int j = 0; j < num_free_[v]; ++j) perm.push_back(col_start_[v] + j);
+  }
+  return perm;
 }
 
 void NormalEquations::analyze() {
   if (n_ == 0) return;
   cc_->postorder = 1;
+  cc_->nmethods = 1;
   switch (options_.ordering) {
-    case Ordering::Automatic:
-      cc_->nmethods = 0;
-      break;
-    case Ordering::AMD:
-      cc_->nmethods = 1;
-      cc_->method[0].ordering = CHOLMOD_AMD;
-      break;
-    case Ordering::METIS:
-      cc_->nmethods = 1;
-      cc_->method[0].ordering = CHOLMOD_METIS;
-      break;
+    case Ordering::Automatic: cc_->nmethods = 0; break;
+    case Ordering::AMD: cc_->method[0].ordering = CHOLMOD_AMD; break;
+    case Ordering::METIS: cc_->method[0].ordering = CHOLMOD_METIS; break;
     case Ordering::Natural:
-      cc_->nmethods = 1;
       cc_->method[0].ordering = CHOLMOD_NATURAL;
       cc_->postorder = 0;
       break;
-    case Ordering::BlockAMD:
-      cc_->nmethods = 1;
-      cc_->method[0].ordering = CHOLMOD_GIVEN;
-      break;
+    case Ordering::BlockAMD: cc_->method[0].ordering = CHOLMOD_GIVEN; break;
   }
-  if (options_.ordering == Ordering::BlockAMD)
-    L_ = cholmod_analyze_p(H_, user_perm_.data(), nullptr, 0, cc_);
-  else
+  if (options_.ordering == Ordering::BlockAMD) {
+    std::vector<int> perm = block_amd_permutation();
+    L_ = cholmod_analyze_p(H_, perm.data(), nullptr, 0, cc_);
+  } else {
     L_ = cholmod_analyze(H_, cc_);
+  }
   if (!L_ || cc_->status < CHOLMOD_OK)
     throw Error(ErrorCode::Failed, "NormalEquations: CHOLMOD's symbolic analysis failed (status " +
                                        std::to_string(cc_->status) + ")");
+  ordering_name_ = ordering_name(L_->ordering);
+
+  // A simplicial factorisation of an upper-stored matrix in its natural order reads H as it is;
+  // with a permutation CHOLMOD transposes H twice per factorisation (cholmod_factorize.c), the
+  // largest single cost after the factorisation itself on sparse graphs. So number the columns
+  // in the (postordered) elimination order, variable by variable, and analyse again without a
+  // permutation: the same factor, no copies.
+  if (!L_->is_super && L_->ordering != CHOLMOD_NATURAL) {
+    const int* P = static_cast<const int*>(L_->Perm);
+    std::vector<VariableId> order;
+    std::vector<char> seen(num_free_.size(), 0);
+    for (int k = 0; k < n_; ++k) {
+      const VariableId v = block_of_column_[static_cast<size_t>(P[k])];
+      if (!seen[static_cast<size_t>(v)]) {
+        seen[static_cast<size_t>(v)] = 1;
+        order.push_back(v);
+      }
+    }
+    cholmod_free_factor(&L_, cc_);
+    number_columns(order);
+    cc_->nmethods = 1;
+    cc_->method[0].ordering = CHOLMOD_NATURAL;
+    cc_->postorder = 0;
+    L_ = cholmod_analyze(H_, cc_);
+    if (!L_ || cc_->status < CHOLMOD_OK)
+      throw Error(ErrorCode::Failed, "NormalEquations: CHOLMOD's symbolic analysis failed "
+                                     "(status " + std::to_string(cc_->status) + ")");
+    ordering_name_ += ", columns pre-permuted";
+  }
   flops_ = cc_->fl;
   lnz_ = cc_->lnz;
   B_ = cholmod_zeros(static_cast<size_t>(n_), 1, CHOLMOD_REAL, cc_);
@@ -360,25 +407,29 @@ void NormalEquations::analyze() {
 double NormalEquations::factor_nonzeros() const { return L_ ? lnz_ : 0.0; }
 double NormalEquations::factor_flops() const { return flops_; }
 
-double NormalEquations::cg_iteration_flops() const {
+double NormalEquations::factor_cost() const { return 0.3 * flops_ + 18.0 * lnz_; }
+
+double NormalEquations::cg_iteration_cost() const {
   const double nnz_h = H_ ? static_cast<const int*>(H_->p)[n_] : 0.0;
-  return 4.0 * nnz_h + 4.0 * lnz_ + 12.0 * n_;
+  return 3.0 * lnz_ + 2.0 * nnz_h + 2.0 * n_;
+}
+
+std::string NormalEquations::ordering_name(int ordering) {
+  switch (ordering) {
+    case CHOLMOD_NATURAL: return "natural";
+    case CHOLMOD_GIVEN: return "block AMD";
+    case CHOLMOD_AMD: return "AMD";
+    case CHOLMOD_METIS: return "METIS";
+    case CHOLMOD_NESDIS: return "NESDIS";
+    case CHOLMOD_COLAMD: return "COLAMD";
+    case CHOLMOD_POSTORDERED: return "natural, postordered";
+    default: return "ordering " + std::to_string(ordering);
+  }
 }
 
 std::string NormalEquations::ordering_used() const {
   if (!L_) return "none";
-  std::string s;
-  switch (L_->ordering) {
-    case CHOLMOD_NATURAL: s = "natural"; break;
-    case CHOLMOD_GIVEN: s = "block AMD"; break;
-    case CHOLMOD_AMD: s = "AMD"; break;
-    case CHOLMOD_METIS: s = "METIS"; break;
-    case CHOLMOD_NESDIS: s = "NESDIS"; break;
-    case CHOLMOD_COLAMD: s = "COLAMD"; break;
-    case CHOLMOD_POSTORDERED: s = "natural, postordered"; break;
-    default: s = "ordering " + std::to_string(L_->ordering);
-  }
-  return s + (L_->is_super ? ", supernodal" : ", simplicial");
+  return ordering_name_ + (L_->is_super ? ", supernodal" : ", simplicial");
 }
 
 double NormalEquations::evaluate_cost(const double* values, PhaseTimes* times) {
@@ -453,13 +504,94 @@ void NormalEquations::linearize_factor_into(int f, const double* values, double&
     upper_times_in_place(L, m, J, d);
     if (w != 1.0)
       for (int i = 0; i < m * d; ++i) J[i] *= w;
-    if (slot_body_frame_[static_cast<size_t>(info.slot_begin + k)])
-      right_exp_jacobian(ptr_scratch_[static_cast<size_t>(k)][2], J, m);
+    const auto sk = static_cast<size_t>(info.slot_begin + k);
+    if (slot_body_frame_[sk]) {
+      const double* cs = &rotation_[2 * static_cast<size_t>(slot_var_[sk])];
+      right_exp_jacobian(cs[0], cs[1], J, m);
+    }
+  }
+}
+
+namespace {
+
+// Σ_t a[t]·b[t] over M rows (M = 0: m rows, known at run time only).
+template <int M>
+inline double dot_rows(const double* a, const double* b, int m) {
+  double s = 0.0;
+  if constexpr (M > 0) {
+    for (int t = 0; t < M; ++t) s += a[t] * b[t];
+  } else {
+    for (int t = 0; t < m; ++t) s += a[t] * b[t];
+  }
+  return s;
+}
+
+}  // namespace
+
+template <int M>
+void NormalEquations::accumulate_factor(const FactorInfo& info) {
+  double* Hx = static_cast<double*>(H_->x);
+  const int* Hp = static_cast<const int*>(H_->p);
+  double* g = g_.data();
+  const int m = info.residual_dim;
+  const double* r = r_.data() + info.residual_offset;
+  int pair = info.pair_begin;
+  for (int k = 0; k < info.num_slots; ++k) {
+    const auto sk = static_cast<size_t>(info.slot_begin + k);
+    const int jk = slot_jac_offset_[sk];
+    if (jk < 0) {
+      pair += info.num_slots - k;
+      continue;
+    }
+    const auto a = static_cast<size_t>(slot_var_[sk]);
+    const double* Ja = jac_.data() + jk;
+    const int fa = num_free_[a];
+    const int ca = col_start_[a];
+    const int* pa = free_params_.data() + free_begin_[a];
+    for (int i = 0; i < fa; ++i) g[ca + i] += dot_rows<M>(Ja + pa[i] * m, r, m);
+    // Diagonal block: the upper triangle of J_aᵀJ_a.
+    {
+      const int off = pair_offset_[static_cast<size_t>(pair++)];
+      for (int j = 0; j < fa; ++j) {
+        double* out = Hx + Hp[ca + j] + off;
+        const double* cj = Ja + pa[j] * m;
+        for (int i = 0; i <= j; ++i) out[i] += dot_rows<M>(Ja + pa[i] * m, cj, m);
+      }
+    }
+    for (int l = k + 1; l < info.num_slots; ++l) {
+      const int off = pair_offset_[static_cast<size_t>(pair++)];
+      if (off < 0) continue;
+      const auto sl = static_cast<size_t>(info.slot_begin + l);
+      const auto b = static_cast<size_t>(slot_var_[sl]);
+      const double* Jb = jac_.data() + slot_jac_offset_[sl];
+      // Rows of the variable with the earlier columns, columns of the other.
+      const bool a_is_row = ca < col_start_[b];
+      const auto row_var = a_is_row ? a : b;
+      const auto col_var = a_is_row ? b : a;
+      const double* Jr = a_is_row ? Ja : Jb;
+      const double* Jc = a_is_row ? Jb : Ja;
+      const int fr = num_free_[row_var], fc = num_free_[col_var];
+      const int* pr = free_params_.data() + free_begin_[row_var];
+      const int* pc = free_params_.data() + free_begin_[col_var];
+      const int cc = col_start_[col_var];
+      for (int j = 0; j < fc; ++j) {
+        double* out = Hx + Hp[cc + j] + off;
+        const double* cj = Jc + pc[j] * m;
+        for (int i = 0; i < fr; ++i) out[i] += dot_rows<M>(Jr + pr[i] * m, cj, m);
+      }
+    }
   }
 }
 
 double NormalEquations::linearize(const double* values, PhaseTimes* times) {
   auto t0 = Clock::now();
+  // cos, sin of each body-frame pose's heading, once per pose rather than once per factor.
+  for (size_t v = 0; v < body_frame_.size(); ++v)
+    if (body_frame_[v]) {
+      const double theta = values[graph_->offset(static_cast<VariableId>(v)) + 2];
+      rotation_[2 * v] = std::cos(theta);
+      rotation_[2 * v + 1] = std::sin(theta);
+    }
   double cost = 0.0;
   const int nf = static_cast<int>(factors_.size());
   for (int f = 0; f < nf; ++f) linearize_factor_into(f, values, cost);
@@ -467,73 +599,15 @@ double NormalEquations::linearize(const double* values, PhaseTimes* times) {
 
   t0 = Clock::now();
   double* Hx = static_cast<double*>(H_ ? H_->x : nullptr);
-  const int* Hp = static_cast<const int*>(H_ ? H_->p : nullptr);
-  if (H_) std::memset(Hx, 0, static_cast<size_t>(Hp[n_]) * sizeof(double));
+  if (H_) std::memset(Hx, 0, static_cast<size_t>(static_cast<const int*>(H_->p)[n_]) * sizeof(double));
   g_.setZero();
-  double* g = g_.data();
   for (const FactorInfo& info : factors_) {
-    const int m = info.residual_dim;
-    const double* r = r_.data() + info.residual_offset;
-    int pair = info.pair_begin;
-    for (int k = 0; k < info.num_slots; ++k) {
-      const auto sk = static_cast<size_t>(info.slot_begin + k);
-      const int jk = slot_jac_offset_[sk];
-      if (jk < 0) {
-        pair += info.num_slots - k;
-        continue;
-      }
-      const auto a = static_cast<size_t>(slot_var_[sk]);
-      const double* Ja = jac_.data() + jk;
-      const int fa = num_free_[a];
-      const int ca = col_start_[a];
-      const int* pa = free_params_.data() + free_begin_[a];
-      for (int i = 0; i < fa; ++i) {
-        const double* col = Ja + pa[i] * m;
-        double s = 0.0;
-        for (int t = 0; t < m; ++t) s += col[t] * r[t];
-        g[ca + i] += s;
-      }
-      // Diagonal block: upper triangle of J_aᵀJ_a.
-      {
-        const int off = pair_offset_[static_cast<size_t>(pair++)];
-        for (int j = 0; j < fa; ++j) {
-          double* out = Hx + Hp[ca + j] + off;
-          const double* cj = Ja + pa[j] * m;
-          for (int i = 0; i <= j; ++i) {
-            const double* ci = Ja + pa[i] * m;
-            double s = 0.0;
-            for (int t = 0; t < m; ++t) s += ci[t] * cj[t];
-            out[i] += s;
-          }
-        }
-      }
-      for (int l = k + 1; l < info.num_slots; ++l) {
-        const int off = pair_offset_[static_cast<size_t>(pair++)];
-        if (off < 0) continue;
-        const auto sl = static_cast<size_t>(info.slot_begin + l);
-        const auto b = static_cast<size_t>(slot_var_[sl]);
-        const double* Jb = jac_.data() + slot_jac_offset_[sl];
-        // Rows of the lower-column variable, columns of the higher.
-        const bool a_is_row = ca < col_start_[b];
-        const auto row_var = a_is_row ? a : b;
-        const auto col_var = a_is_row ? b : a;
-        const double* Jr = a_is_row ? Ja : Jb;
-        const double* Jc = a_is_row ? Jb : Ja;
-        const int fr = num_free_[row_var], fc = num_free_[col_var];
-        const int* pr = free_params_.data() + free_begin_[row_var];
-        const int* pc = free_params_.data() + free_begin_[col_var];
-        const int cc = col_start_[col_var];
-        for (int j = 0; j < fc; ++j) {
-          double* out = Hx + Hp[cc + j] + off;
-          const double* cj = Jc + pc[j] * m;
-          for (int i = 0; i < fr; ++i) {
-            const double* ci = Jr + pr[i] * m;
-            double s = 0.0;
-            for (int t = 0; t < m; ++t) s += ci[t] * cj[t];
-            out[i] += s;
-          }
-        }
-      }
+    // Fixed-size dot products for the common residual sizes.
+    switch (info.residual_dim) {
+      case 1: accumulate_factor<1>(info); break;
+      case 2: accumulate_factor<2>(info); break;
+      case 3: accumulate_factor<3>(info); break;
+      default: accumulate_factor<0>(info); break;
     }
   }
   for (int c = 0; c < n_; ++c) h_diag_[c] = Hx[diag_pos_[static_cast<size_t>(c)]];
@@ -665,6 +739,10 @@ Eigen::MatrixXd NormalEquations::solve(const Eigen::MatrixXd& rhs) {
   Eigen::MatrixXd out = Eigen::Map<const Eigen::MatrixXd>(static_cast<const double*>(X->x), n_, rhs.cols());
   cholmod_free_dense(&X, cc_);
   return out;
+}
+
+double NormalEquations::predicted_decrease_of_solution(const Eigen::VectorXd& delta) const {
+  return -g_.dot(delta) + lambda_ * (d_.array() * delta.array().square()).sum();
 }
 
 double NormalEquations::predicted_decrease(const Eigen::VectorXd& delta) {

@@ -129,8 +129,11 @@ class NormalEquations {
   // X = (H + λD)⁻¹ B for a dense n × k right-hand side (covariances).
   Eigen::MatrixXd solve(const Eigen::MatrixXd& rhs);
   // The decrease of the quadratic model |r̃|² − |r̃ + J̃δ|² = −2gᵀδ − δᵀHδ for any step δ (exact
-  // or not).
+  // or not; one product with H).
   double predicted_decrease(const Eigen::VectorXd& delta);
+  // The same for δ from solve_step, i.e. (H + λD)δ = −g with the λ and D of the last
+  // factorize(): then −2gᵀδ − δᵀHδ = −gᵀδ + λδᵀDδ, no product needed.
+  double predicted_decrease_of_solution(const Eigen::VectorXd& delta) const;
 
   // out = values ⊞ δ (fixed parameters untouched).
   void retract(const double* values, const Eigen::VectorXd& delta, double* out) const;
@@ -142,15 +145,27 @@ class NormalEquations {
   // Fill-in of the factor: nnz(L), and what CHOLMOD used (ordering, supernodal).
   double factor_nonzeros() const;
   double factor_flops() const;  // of one numeric factorisation, from the analysis
-  // Of one iteration of solve_step_reusing_factor: a product with H and two triangular solves.
-  double cg_iteration_flops() const;
+  // Estimated work (ns on the machine the model was fitted on; only ratios matter) of one
+  // numeric factorisation and of one iteration of solve_step_reusing_factor (a product with H
+  // and two triangular solves). A model fitted to CHOLMOD's measured times on the benchmark
+  // graphs (simplicial, reference BLAS): ~0.3 ns per flop plus ~18 ns per nonzero of L for the
+  // factorisation (its per-entry overhead dominates on sparse 2-D problems), ~3 ns per nonzero
+  // of L for a pair of triangular solves and ~2 ns per nonzero of H for a product. Flops alone
+  // would call a 100k-pose calibration chain's factorisation (95 ms) as cheap as a solve (7 ms).
+  double factor_cost() const;
+  double cg_iteration_cost() const;
   std::string ordering_used() const;
   // Seconds spent building the pattern and in cholmod_analyze.
   double analyze_seconds() const { return analyze_seconds_; }
 
  private:
   void build_pattern(const FactorGraph& graph, const std::vector<VariableId>& also_fixed);
+  // Assigns columns to the free variables in `order` and builds H's CSC pattern and the
+  // factors' block offsets for that numbering.
+  void number_columns(const std::vector<VariableId>& order);
+  std::vector<int> block_amd_permutation();
   void analyze();
+  static std::string ordering_name(int cholmod_ordering);
   void release();
   void set_damping(double lambda, Damping damping);
   // y = (H + λD)·x, or H·x without the damping.
@@ -158,6 +173,11 @@ class NormalEquations {
   // y = (last factor)⁻¹·x through B_/X_, allocation-free.
   void factor_solve(const double* x, double* y);
   void linearize_factor_into(int f, const double* values, double& cost);
+  struct FactorInfo;
+  // Adds a linearised factor's J̃ᵀJ̃ blocks to H and J̃ᵀr̃ to g; M: the residual size when fixed
+  // at compile time, 0 for any.
+  template <int M>
+  void accumulate_factor(const FactorInfo& info);
 
   LinearSolverOptions options_;
   const FactorGraph* graph_ = nullptr;
@@ -165,13 +185,15 @@ class NormalEquations {
   int n_ = 0;  // free parameters
 
   // Per variable.
-  std::vector<int> col_start_;        // first column, −1 if no free parameter
+  std::vector<int> col_start_;        // first column, −1 if no free parameter (columns follow
+                                      // the elimination order, not the variable order)
   std::vector<int> num_free_;         // number of free parameters
   std::vector<int> free_begin_;       // into free_params_
   std::vector<int> free_params_;      // parameter index of each free column, per variable
   std::vector<int> diag_offset_;      // rows above a variable's diagonal block in its columns
   std::vector<VariableId> block_of_column_;  // variable of each column (for ordering)
   std::vector<char> body_frame_;      // the pose steps by X·exp(δ) (else additively)
+  std::vector<double> rotation_;      // cos θ, sin θ of body-frame poses at the linearisation
 
   // Per factor (structure of arrays). A factor's variables are "slots".
   struct FactorInfo {
@@ -203,7 +225,8 @@ class NormalEquations {
   Eigen::VectorXd cg_r_, cg_z_, cg_p_, cg_q_;  // conjugate-gradient workspace
   std::vector<int> diag_pos_;  // index of each diagonal entry in the CSC values
 
-  std::vector<int> user_perm_;  // the block ordering expanded to columns (BlockAMD)
+  std::vector<std::vector<int>> adjacency_;  // free variables sharing a factor, per variable
+  std::string ordering_name_;
   double analyze_seconds_ = 0.0;
   double flops_ = 0.0, lnz_ = 0.0;
 

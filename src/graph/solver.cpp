@@ -172,8 +172,8 @@ SolverSummary Solver::solve(FactorGraph& graph) {
       o.reuse_factorization
           ? static_cast<int>(std::min<double>(
                 o.reuse_max_cg_iterations,
-                std::floor(o.reuse_cg_budget * sys.factor_flops() /
-                           std::max(sys.cg_iteration_flops(), 1.0))))
+                std::floor(o.reuse_cg_budget * sys.factor_cost() /
+                           std::max(sys.cg_iteration_cost(), 1.0))))
           : 0;
   int reuse_skip = 0, reuse_backoff = 1;
   Eigen::VectorXd delta;
@@ -227,7 +227,8 @@ SolverSummary Solver::solve(FactorGraph& graph) {
       }
       sys.retract(x.data(), delta, trial.data());
       const double new_cost = sys.evaluate_cost(trial.data(), &times);
-      const double predicted = sys.predicted_decrease(delta);
+      const double predicted = it.refactorized ? sys.predicted_decrease_of_solution(delta)
+                                               : sys.predicted_decrease(delta);
       it.cost_change = cost - new_cost;
       it.relative_decrease = predicted > 0.0 ? it.cost_change / predicted : -1.0;
       it.step_accepted = std::isfinite(new_cost) && predicted > 0.0 &&

@@ -55,11 +55,13 @@ struct SolverOptions {
   // Reuse of the Cholesky factor: while the last factorisation stays a good preconditioner,
   // a step is computed by conjugate gradients on the new H + λD preconditioned with it (sparse
   // products and triangular solves), until ‖residual‖ ≤ reuse_cg_tolerance·‖g‖. CG may spend
-  // at most reuse_cg_budget of a factorisation's flops (and reuse_max_cg_iterations); past
+  // at most reuse_cg_budget of a factorisation's estimated work (NormalEquations::factor_cost)
+  // and reuse_max_cg_iterations; past
   // that H is refactorised, and reuse waits 1, 2, 4, ... iterations before the next attempt.
   // Where the budget allows fewer than 2 CG iterations (small or very sparse factors) reuse is
   // off. Every step still passes the gain-ratio test on the true cost; the choice depends on
-  // flop counts only, so runs are reproducible. false: one factorisation per iteration.
+  // the factor's size only, not on timing, so runs are reproducible. false: one factorisation
+  // per iteration.
   bool reuse_factorization = true;
   double reuse_cg_budget = 0.5;
   int reuse_max_cg_iterations = 10;
