@@ -28,7 +28,7 @@ std::string join_names(const FactorGraph& g, const std::vector<VariableId>& vars
 
 MarginalCovariance::MarginalCovariance(const FactorGraph& graph, std::vector<VariableId> variables,
                                        const LinearSolverOptions& options)
-    : graph_(&graph), variables_(std::move(variables)) {
+    : variables_(std::move(variables)) {
   for (size_t i = 0; i < variables_.size(); ++i)
     for (size_t j = 0; j < i; ++j)
       if (variables_[i] == variables_[j])
@@ -42,7 +42,8 @@ MarginalCovariance::MarginalCovariance(const FactorGraph& graph, std::vector<Var
   int total = 0;
   for (VariableId v : variables_) {
     start_.push_back(total);
-    total += graph.type(v).dim;
+    dims_.push_back(graph.type(v).dim);
+    total += dims_.back();
   }
   // The chosen variables' free columns: solve H X = E for exactly those.
   std::vector<int> rows, cols;  // joint_ row ↔ H column
@@ -68,13 +69,12 @@ MarginalCovariance::MarginalCovariance(const FactorGraph& graph, std::vector<Var
 int MarginalCovariance::index_of(VariableId v) const {
   for (size_t k = 0; k < variables_.size(); ++k)
     if (variables_[k] == v) return static_cast<int>(k);
-  throw_invalid_argument("MarginalCovariance: '" + graph_->name(v) + "' was not chosen");
+  throw_invalid_argument("MarginalCovariance: variable " + std::to_string(v) + " was not chosen");
 }
 
 Eigen::MatrixXd MarginalCovariance::block(VariableId a, VariableId b) const {
-  const int i = index_of(a), j = index_of(b);
-  return joint_.block(start_[static_cast<size_t>(i)], start_[static_cast<size_t>(j)],
-                      graph_->type(a).dim, graph_->type(b).dim);
+  const auto i = static_cast<size_t>(index_of(a)), j = static_cast<size_t>(index_of(b));
+  return joint_.block(start_[i], start_[j], dims_[i], dims_[j]);
 }
 
 Eigen::MatrixXd MarginalCovariance::joint() const { return joint_; }

@@ -29,8 +29,8 @@ class MarginalCovariance {
 
  private:
   int index_of(VariableId v) const;
-  const FactorGraph* graph_;
   std::vector<VariableId> variables_;
+  std::vector<int> dims_;
   std::vector<int> start_;  // row of each chosen variable in joint_
   Eigen::MatrixXd joint_;
 };

@@ -1,5 +1,6 @@
 #include "graph/factor_graph.h"
 
+#include <atomic>
 #include <cmath>
 
 #include "core/error.h"
@@ -10,6 +11,11 @@ namespace {
 constexpr int kMaxVectorDim = 64;  // the fixed-parameter mask is one 64-bit word
 
 }  // namespace
+
+void FactorGraph::touch() {
+  static std::atomic<std::uint64_t> counter{0};
+  version_ = ++counter;
+}
 
 const FactorGraph::Variable& FactorGraph::variable(VariableId v) const {
   if (v < 0 || v >= num_variables())
@@ -46,7 +52,7 @@ VariableId FactorGraph::add_variable(VariableType type, const double* value, std
   values_.insert(values_.end(), value, value + type.dim);
   if (type.kind == VariableKind::Pose2) values_.back() = wrap_angle(values_.back());
   variables_.push_back(std::move(var));
-  ++version_;
+  touch();
   return id;
 }
 
@@ -65,7 +71,7 @@ VariableId FactorGraph::add_vector(const Eigen::VectorXd& value, std::string nam
 
 void FactorGraph::set_fixed(VariableId v, bool fixed) {
   variable(v).fixed = fixed;
-  ++version_;
+  touch();
 }
 
 void FactorGraph::set_parameter_fixed(VariableId v, int parameter, bool fixed) {
@@ -75,7 +81,7 @@ void FactorGraph::set_parameter_fixed(VariableId v, int parameter, bool fixed) {
                            std::to_string(parameter));
   const std::uint64_t bit = std::uint64_t{1} << parameter;
   var.fixed_parameters = fixed ? (var.fixed_parameters | bit) : (var.fixed_parameters & ~bit);
-  ++version_;
+  touch();
 }
 
 bool FactorGraph::is_fixed(VariableId v) const { return variable(v).fixed; }
@@ -119,12 +125,13 @@ int FactorGraph::add_factor(std::unique_ptr<Factor> factor, RobustKernelPtr kern
                                variable(vars[k]).name + "' twice");
   }
   factors_.push_back({std::move(factor), std::move(kernel)});
-  ++version_;
+  touch();
   return num_factors() - 1;
 }
 
 void FactorGraph::set_robust_kernel(int factor, RobustKernelPtr kernel) {
   factors_.at(static_cast<size_t>(factor)).kernel = std::move(kernel);
+  touch();  // the solver holds the kernel's address
 }
 
 SE2 FactorGraph::pose(VariableId v) const {

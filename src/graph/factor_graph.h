@@ -69,8 +69,10 @@ class FactorGraph {
   int offset(VariableId v) const { return variable(v).offset; }
   // Fixed parameters of v as a bit mask (bit i: parameter i), all bits set when v is fixed.
   std::uint64_t fixed_mask(VariableId v) const;
-  // Changes whenever variables, factors or what is fixed change (the solver's symbolic
-  // analysis stays valid while it does not).
+  // Changes whenever variables, factors, robust kernels or what is fixed change (the solver's
+  // symbolic analysis stays valid while it does not). Versions come from one process-wide
+  // counter, so two graphs never share one; a moved graph keeps its version (its factors keep
+  // their addresses).
   std::uint64_t structure_version() const { return version_; }
 
  private:
@@ -94,6 +96,8 @@ class FactorGraph {
   std::vector<Variable> variables_;
   std::vector<double> values_;
   std::vector<Entry> factors_;
+  void touch();  // a new structure version
+
   std::uint64_t version_ = 0;
 };
 

@@ -78,7 +78,7 @@ double linearize_factor(const FactorGraph& graph, int f, Eigen::VectorXd& residu
 
 NormalEquations::NormalEquations(const FactorGraph& graph, const LinearSolverOptions& options,
                                  const std::vector<VariableId>& also_fixed)
-    : options_(options), graph_(&graph), version_(graph.structure_version()) {
+    : options_(options), version_(graph.structure_version()) {
   const auto t0 = Clock::now();
   cc_ = new cholmod_common;
   cholmod_start(cc_);
@@ -115,7 +115,7 @@ void NormalEquations::release() {
 }
 
 bool NormalEquations::matches(const FactorGraph& graph) const {
-  return &graph == graph_ && graph.structure_version() == version_;
+  return graph.structure_version() == version_;
 }
 
 int NormalEquations::column(VariableId v, int parameter) const {
@@ -133,6 +133,12 @@ void NormalEquations::build_pattern(const FactorGraph& graph,
   for (VariableId v : also_fixed) {
     if (v < 0 || v >= nv) throw_invalid_argument("NormalEquations: no variable " + std::to_string(v));
     forced[static_cast<size_t>(v)] = 1;
+  }
+  var_type_.resize(static_cast<size_t>(nv));
+  var_offset_.resize(static_cast<size_t>(nv));
+  for (VariableId v = 0; v < nv; ++v) {
+    var_type_[static_cast<size_t>(v)] = graph.type(v);
+    var_offset_[static_cast<size_t>(v)] = graph.offset(v);
   }
   body_frame_.assign(static_cast<size_t>(nv), 0);
   rotation_.assign(2 * static_cast<size_t>(nv), 0.0);
@@ -588,7 +594,7 @@ double NormalEquations::linearize(const double* values, PhaseTimes* times) {
   // cos, sin of each body-frame pose's heading, once per pose rather than once per factor.
   for (size_t v = 0; v < body_frame_.size(); ++v)
     if (body_frame_[v]) {
-      const double theta = values[graph_->offset(static_cast<VariableId>(v)) + 2];
+      const double theta = values[var_offset_[v] + 2];
       rotation_[2 * v] = std::cos(theta);
       rotation_[2 * v + 1] = std::sin(theta);
     }
@@ -758,8 +764,8 @@ void NormalEquations::retract(const double* values, const Eigen::VectorXd& delta
     const auto sv = static_cast<size_t>(v);
     const int fv = num_free_[sv];
     if (fv == 0) continue;
-    const VariableType type = graph_->type(v);
-    const int o = graph_->offset(v);
+    const VariableType type = var_type_[sv];
+    const int o = var_offset_[sv];
     const double* x = values + o;
     double* y = out + o;
     const double* dv = delta.data() + col_start_[sv];
@@ -782,7 +788,7 @@ double NormalEquations::free_values_norm(const double* values) const {
   const int nv = static_cast<int>(col_start_.size());
   for (int v = 0; v < nv; ++v) {
     const auto sv = static_cast<size_t>(v);
-    const double* x = values + graph_->offset(v);
+    const double* x = values + var_offset_[sv];
     const int* fp = free_params_.data() + free_begin_[sv];
     for (int i = 0; i < num_free_[sv]; ++i) s += x[fp[i]] * x[fp[i]];
   }

@@ -98,7 +98,8 @@ class NormalEquations {
   NormalEquations(const NormalEquations&) = delete;
   NormalEquations& operator=(const NormalEquations&) = delete;
 
-  // True while the graph's structure is what this system was built for.
+  // True while the graph's structure is what this system was built for (a structure version
+  // belongs to one graph only, so another graph never matches).
   bool matches(const FactorGraph& graph) const;
   int num_columns() const { return n_; }
   // The column of a free parameter, −1 for a fixed one.
@@ -180,11 +181,13 @@ class NormalEquations {
   void accumulate_factor(const FactorInfo& info);
 
   LinearSolverOptions options_;
-  const FactorGraph* graph_ = nullptr;
-  std::uint64_t version_ = 0;
+  std::uint64_t version_ = 0;  // the graph's structure version (unique across graphs)
   int n_ = 0;  // free parameters
 
-  // Per variable.
+  // Per variable. Copied from the graph: the system holds no pointer to it (a graph may move;
+  // its Factor objects do not).
+  std::vector<VariableType> var_type_;
+  std::vector<int> var_offset_;       // into the flat value array
   std::vector<int> col_start_;        // first column, −1 if no free parameter (columns follow
                                       // the elimination order, not the variable order)
   std::vector<int> num_free_;         // number of free parameters

@@ -386,6 +386,30 @@ TEST(GraphSolver, ReusesTheAnalysisAndNoticesStructureChanges) {
   EXPECT_NEAR(third.final_cost, s.graph.chi2(), 1e-9 * third.final_cost);
 }
 
+TEST(GraphSolver, NeverMistakesOneGraphForAnother) {
+  // Graphs built the same way, one after another at the same address: each must get its own
+  // analysis (sizes differ, so a stale one would break).
+  Solver solver;
+  for (int round = 0; round < 3; ++round) {
+    Synthetic s = make_circle(10 + 5 * round, 0.0, 0.1, 20);
+    const SolverSummary sum = solver.solve(s.graph);
+    EXPECT_TRUE(sum.converged()) << sum.full_report();
+    EXPECT_EQ(sum.num_parameters, 3 * (2 * (10 + 5 * round) - 1));
+    EXPECT_LT(max_pose_error(s.graph, s), 1e-6);
+  }
+  // A moved graph keeps its factors and may keep the analysis; a kernel change may not.
+  Synthetic s = make_circle(20, 0.0, 0.1, 21);
+  solver.solve(s.graph);
+  FactorGraph moved = std::move(s.graph);
+  moved.set_values(make_circle(20, 0.0, 0.1, 21).graph.values());
+  EXPECT_TRUE(solver.solve(moved).converged());
+  EXPECT_LT(max_pose_error(moved, s), 1e-6);
+  const std::uint64_t before = moved.structure_version();
+  moved.set_robust_kernel(0, std::make_shared<HuberKernel>(1.0));
+  EXPECT_NE(moved.structure_version(), before);
+  EXPECT_GT(solver.solve(moved).times.analyze, 0.0);
+}
+
 // ---- the reference files ---------------------------------------------------------------------
 
 double solve_file(const std::string& name, SolverSummary* summary = nullptr) {
