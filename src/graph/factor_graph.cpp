@@ -17,6 +17,21 @@ void FactorGraph::touch() {
   version_ = ++counter;
 }
 
+FactorGraph::FactorGraph(FactorGraph&& other) noexcept { *this = std::move(other); }
+
+FactorGraph& FactorGraph::operator=(FactorGraph&& other) noexcept {
+  if (this == &other) return *this;
+  variables_ = std::move(other.variables_);
+  values_ = std::move(other.values_);
+  factors_ = std::move(other.factors_);
+  version_ = other.version_;
+  other.variables_.clear();
+  other.values_.clear();
+  other.factors_.clear();
+  other.touch();
+  return *this;
+}
+
 const FactorGraph::Variable& FactorGraph::variable(VariableId v) const {
   if (v < 0 || v >= num_variables())
     throw_invalid_argument("FactorGraph: no variable " + std::to_string(v));

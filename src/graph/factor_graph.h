@@ -17,8 +17,10 @@ namespace planarvo::graph {
 class FactorGraph {
  public:
   FactorGraph() = default;
-  FactorGraph(FactorGraph&&) = default;
-  FactorGraph& operator=(FactorGraph&&) = default;
+  // A moved-from graph is empty and gets a new structure version (a solver must not take it for
+  // the graph its factors went to).
+  FactorGraph(FactorGraph&& other) noexcept;
+  FactorGraph& operator=(FactorGraph&& other) noexcept;
 
   // Variables. Names are for reports ("z", "pose 17"); parameter names for observability reports
   // ("x", "y", "height", "yaw"); both default to something sensible.

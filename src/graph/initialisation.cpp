@@ -183,7 +183,6 @@ int initialise_rotation_first(FactorGraph& graph) {
   // Positions: t_j − t_i = R(θ_i) z_t, weight (R(θ_i + z_θ)) Ω_tt (…)ᵀ.
   std::vector<Eigen::Triplet<double>> trip;
   Eigen::VectorXd rhs = Eigen::VectorXd::Zero(2 * m);
-  auto pos = [&](int v) { return graph.pose(v); };
   for (const Edge& ed : edges) {
     if (!t.reached[static_cast<size_t>(ed.i)] || !t.reached[static_cast<size_t>(ed.j)]) continue;
     const int ui = unknown[static_cast<size_t>(ed.i)], uj = unknown[static_cast<size_t>(ed.j)];
@@ -193,8 +192,8 @@ int initialise_rotation_first(FactorGraph& graph) {
     const Eigen::Matrix2d W = M * ed.information.topLeftCorner<2, 2>() * M.transpose();
     Eigen::Vector2d d = Ri * Eigen::Vector2d(ed.z.x, ed.z.y);
     // residual t_j − t_i − d
-    if (ui < 0) d += Eigen::Vector2d(pos(ed.i).x, pos(ed.i).y);
-    if (uj < 0) d -= Eigen::Vector2d(pos(ed.j).x, pos(ed.j).y);
+    if (ui < 0) d += Eigen::Vector2d(graph.pose(ed.i).x, graph.pose(ed.i).y);
+    if (uj < 0) d -= Eigen::Vector2d(graph.pose(ed.j).x, graph.pose(ed.j).y);
     const Eigen::Vector2d wd = W * d;
     for (int r = 0; r < 2; ++r)
       for (int c = 0; c < 2; ++c) {

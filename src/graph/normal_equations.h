@@ -7,8 +7,10 @@
 // column. The pattern comes from the graph's block structure; each factor keeps, per pair of its
 // variables, the offset of its block inside the CSC value array, so refilling H is a pass over
 // the factors that adds small dense blocks in place — no triplets, no sort, no allocation.
-// cholmod_analyze (the fill-reducing ordering and the supernodal symbolic factor) runs once in
-// the constructor; factorize() is a numeric factorisation only.
+// The symbolic analysis (fill-reducing ordering, symbolic factor) runs once, in the
+// constructor; for a simplicial factor the variables' columns are then renumbered in the
+// elimination order, so that CHOLMOD factorises H as stored, without permuting copies.
+// factorize() is a numeric factorisation only.
 #pragma once
 #include <cstdint>
 #include <vector>
@@ -141,7 +143,7 @@ class NormalEquations {
   // Euclidean norm of the free parameters' values (for the relative step tolerance).
   double free_values_norm(const double* values) const;
 
-  // H (both triangles) and g as dense matrices: tests compare them with a dense reference.
+  // H (both triangles, undamped) as a dense matrix: tests compare it with a dense reference.
   Eigen::MatrixXd dense_hessian() const;
   // Fill-in of the factor: nnz(L), and what CHOLMOD used (ordering, supernodal).
   double factor_nonzeros() const;

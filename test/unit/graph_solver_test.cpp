@@ -404,6 +404,9 @@ TEST(GraphSolver, NeverMistakesOneGraphForAnother) {
   moved.set_values(make_circle(20, 0.0, 0.1, 21).graph.values());
   EXPECT_TRUE(solver.solve(moved).converged());
   EXPECT_LT(max_pose_error(moved, s), 1e-6);
+  // The moved-from graph is empty and no longer matches.
+  EXPECT_EQ(s.graph.num_variables(), 0);
+  EXPECT_NE(s.graph.structure_version(), moved.structure_version());
   const std::uint64_t before = moved.structure_version();
   moved.set_robust_kernel(0, std::make_shared<HuberKernel>(1.0));
   EXPECT_NE(moved.structure_version(), before);
