@@ -128,6 +128,7 @@ SolverSummary Solver::solve(FactorGraph& graph) {
   summary.factor_flops = sys.factor_flops();
   summary.linear_solver = sys.ordering_used();
 
+  summary.iterations.reserve(static_cast<size_t>(std::max(o.max_iterations, 0)) + 1);
   std::vector<double> x = graph.values();
   std::vector<double> trial = x;
   PhaseTimes& times = summary.times;
