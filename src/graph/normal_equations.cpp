@@ -651,10 +651,32 @@ void NormalEquations::multiply(const double* x, double* y, bool damped) const {
   }
 }
 
-void NormalEquations::factor_solve(const double* x, double* y) {
+bool NormalEquations::factor_solve(const double* x, double* y) {
+  if (!L_->is_super && !L_->is_ll && L_->ordering == CHOLMOD_NATURAL) {
+    // L·D·Lᵀ·y = x with the columns already in elimination order: forward substitution with
+    // the unit lower triangle, the diagonal, back substitution. (cholmod_solve2 would do the
+    // same, but reallocates its workspace on every call.)
+    const int* Lp = static_cast<const int*>(L_->p);
+    const int* Li = static_cast<const int*>(L_->i);
+    const int* Lnz = static_cast<const int*>(L_->nz);
+    const double* Lx = static_cast<const double*>(L_->x);
+    if (y != x) std::memcpy(y, x, static_cast<size_t>(n_) * sizeof(double));
+    for (int j = 0; j < n_; ++j) {
+      const double yj = y[j];
+      for (int p = Lp[j] + 1, end = Lp[j] + Lnz[j]; p < end; ++p) y[Li[p]] -= Lx[p] * yj;
+    }
+    for (int j = 0; j < n_; ++j) y[j] /= Lx[Lp[j]];
+    for (int j = n_ - 1; j >= 0; --j) {
+      double yj = y[j];
+      for (int p = Lp[j] + 1, end = Lp[j] + Lnz[j]; p < end; ++p) yj -= Lx[p] * y[Li[p]];
+      y[j] = yj;
+    }
+    return true;
+  }
   std::memcpy(B_->x, x, static_cast<size_t>(n_) * sizeof(double));
-  cholmod_solve2(CHOLMOD_A, L_, B_, nullptr, &X_, nullptr, &Y_, &E_, cc_);
+  if (!cholmod_solve2(CHOLMOD_A, L_, B_, nullptr, &X_, nullptr, &Y_, &E_, cc_)) return false;
   std::memcpy(y, X_->x, static_cast<size_t>(n_) * sizeof(double));
+  return true;
 }
 
 int NormalEquations::solve_step_reusing_factor(double lambda, Damping damping,
@@ -670,7 +692,7 @@ int NormalEquations::solve_step_reusing_factor(double lambda, Damping damping,
   delta.setZero(n_);
   cg_r_ = -g_;
   const double stop = tolerance * cg_r_.norm();
-  factor_solve(cg_r_.data(), cg_z_.data());
+  if (!factor_solve(cg_r_.data(), cg_z_.data())) return -1;
   cg_p_ = cg_z_;
   double rz = cg_r_.dot(cg_z_);
   int result = -1;
@@ -685,7 +707,7 @@ int NormalEquations::solve_step_reusing_factor(double lambda, Damping damping,
       result = k;
       break;
     }
-    factor_solve(cg_r_.data(), cg_z_.data());
+    if (!factor_solve(cg_r_.data(), cg_z_.data())) break;
     const double rz_next = cg_r_.dot(cg_z_);
     cg_p_ = cg_z_ + (rz_next / rz) * cg_p_;
     rz = rz_next;
@@ -716,20 +738,10 @@ bool NormalEquations::factorize(double lambda, Damping damping, PhaseTimes* time
 bool NormalEquations::solve_step(Eigen::VectorXd& delta, PhaseTimes* times) {
   if (!factor_ok_) return false;
   const auto t0 = Clock::now();
-  double* b = static_cast<double*>(B_->x);
-  for (int c = 0; c < n_; ++c) b[c] = -g_[c];
-  const int ok = cholmod_solve2(CHOLMOD_A, L_, B_, nullptr, &X_, nullptr, &Y_, &E_, cc_);
-  delta.resize(n_);
-  bool finite = ok != 0;
-  if (finite) {
-    const double* x = static_cast<const double*>(X_->x);
-    for (int c = 0; c < n_; ++c) {
-      delta[c] = x[c];
-      finite &= std::isfinite(x[c]);
-    }
-  }
+  delta = -g_;
+  const bool ok = factor_solve(delta.data(), delta.data()) && delta.allFinite();
   if (times) times->solve += seconds_since(t0);
-  return finite;
+  return ok;
 }
 
 Eigen::MatrixXd NormalEquations::solve(const Eigen::MatrixXd& rhs) {

@@ -173,8 +173,8 @@ class NormalEquations {
   void set_damping(double lambda, Damping damping);
   // y = (H + λD)·x, or H·x without the damping.
   void multiply(const double* x, double* y, bool damped) const;
-  // y = (last factor)⁻¹·x through B_/X_, allocation-free.
-  void factor_solve(const double* x, double* y);
+  // y = (last factor)⁻¹·x (y may be x), allocation-free for a simplicial factor.
+  bool factor_solve(const double* x, double* y);
   void linearize_factor_into(int f, const double* values, double& cost);
   struct FactorInfo;
   // Adds a linearised factor's J̃ᵀJ̃ blocks to H and J̃ᵀr̃ to g; M: the residual size when fixed
