@@ -9,7 +9,8 @@
 //   bench_posegraph [--file NAME] [--calibration N] [--repeat N] [--verbose]
 //                   [--ordering block-amd|auto|amd|metis] [--simplicial|--supernodal]
 //                   [--damping marquardt|levenberg] [--lambda L] [--decrease F]
-//                   [--retraction additive|rightexp] [--no-reuse] [--iterations N]
+//                   [--retraction additive|rightexp] [--no-reuse] [--cg-budget F]
+//                   [--cg-tolerance T] [--iterations N]
 //                   [--only files|rotation|calibration]
 #include <algorithm>
 #include <chrono>
@@ -82,6 +83,10 @@ int main(int argc, char** argv) {
     } else if (a == "--retraction") {
       options.linear.retraction =
           next() == "rightexp" ? PoseRetraction::RightExp : PoseRetraction::Additive;
+    } else if (a == "--cg-budget") {
+      options.reuse_cg_budget = std::atof(next().c_str());
+    } else if (a == "--cg-tolerance") {
+      options.reuse_cg_tolerance = std::atof(next().c_str());
     } else if (a == "--no-reuse") {
       options.reuse_factorization = false;
     } else if (a == "--iterations") {
