@@ -25,7 +25,8 @@
 // WG_Y); pixels beyond the level are masked out. Row g of the partials belongs to work-group
 // (group_id(0) + num_groups(0) * group_id(1)).
 //
-// Build options (-D): NPARAM (3), WG_X (64), WG_Y (1), PIX (4), HIST_BINS (16, may be 0),
+// Build options (-D): NPARAM (3), WG_X (64), WG_Y (1), PIX (4), STATS (0: 1 adds the
+// statistics below and a histogram of HIST_BINS (16) bins of |r|),
 // DEBUG_OUTPUT (off: when defined, a last argument receives per reference pixel
 // (r, weight, valid, rho); not for the fast path).
 #ifndef NPARAM
@@ -40,6 +41,9 @@
 #ifndef PIX
 #define PIX 4
 #endif
+#ifndef STATS
+#define STATS 0
+#endif
 #ifndef HIST_BINS
 #define HIST_BINS 16
 #endif
@@ -51,21 +55,26 @@
 #define NJ (NPARAM + 2)
 #define NH (NJ * (NJ + 1) / 2)
 #define WG (WG_X * WG_Y)
-// Row layout (ReduceLayout in warp_reduce.h).
+// Row layout (ReduceLayout in warp_reduce.h). The statistics after OUT_REF are only in the
+// STATS variant, which the tracker runs once per level: each extra sum costs every pixel.
 #define OUT_JTJ 0                    // NH: upper triangle of J^T W J, row by row
 #define OUT_JTR (NH)                 // NJ: J^T W r
 #define OUT_COST (NH + NJ)           // sum of Huber costs
 #define OUT_WRR (OUT_COST + 1)       // sum of weight * r^2
-#define OUT_RR (OUT_COST + 2)        // sum of r^2
-#define OUT_VALID (OUT_COST + 3)     // pixels with a valid reference and a valid live sample
-#define OUT_INLIER (OUT_COST + 4)    // of those, |r| <= k
-#define OUT_REF (OUT_COST + 5)       // pixels with a valid reference
+#define OUT_VALID (OUT_COST + 2)     // pixels with a valid reference and a valid live sample
+#define OUT_INLIER (OUT_COST + 3)    // of those, |r| <= k
+#define OUT_REF (OUT_COST + 4)       // pixels with a valid reference
+#if STATS
+#define OUT_RR (OUT_COST + 5)        // sum of r^2
 #define OUT_IREF (OUT_COST + 6)      // sum of (I_r - 128) over valid pairs
 #define OUT_IREF2 (OUT_COST + 7)     // sum of (I_r - 128)^2 over valid pairs
-#define OUT_GLIVE (OUT_COST + 8)     // sum of |∇I_l(w(p))|^2 over valid pairs (live pixels)
-#define OUT_GREF (OUT_COST + 9)      // sum of |∇I_r(p)|^2 over valid pairs
+#define OUT_GLIVE (OUT_COST + 8)     // sum of |grad I_l(w(p))|^2 over valid pairs (live pixels)
+#define OUT_GREF (OUT_COST + 9)      // sum of |grad I_r(p)|^2 over valid pairs
 #define OUT_HIST (OUT_COST + 10)     // HIST_BINS: counts of |r| < 0.25 * 2^(j / 2)
 #define NOUT (OUT_HIST + HIST_BINS)
+#else
+#define NOUT (OUT_COST + 5)
+#endif
 
 // The sample of the live level at (x, y): all four neighbours must lie inside and be valid.
 // Coordinates are clamped before the conversion to int (a NaN or huge value is then simply
@@ -93,6 +102,10 @@ void warp_reduce(__global const float4* ref, const int ref_stride, const int ref
 #pragma unroll
   for (int o = 0; o < NOUT; ++o) acc[o] = 0.0f;
 
+  // Levels are read as plain floats (4 per pixel): LLVM's loop vectorizer, which PoCL uses
+  // across work-items, gives up on loops with vector-typed (float4) values.
+  __global const float* refp = (__global const float*)ref;
+  __global const float* livep = (__global const float*)live;
   const float h0 = params[0], h1 = params[1], h2 = params[2];
   const float h3 = params[3], h4 = params[4], h5 = params[5];
   const float h6 = params[6], h7 = params[7], h8 = params[8];
@@ -102,8 +115,9 @@ void warp_reduce(__global const float4* ref, const int ref_stride, const int ref
   for (int k = 0; k < PIX; ++k) {
     const int x = x0 + k * WG_X;
     const int in_ref = (x < ref_w) & (y < ref_h);
-    const float4 R = ref[in_ref ? y * ref_stride + x : 0];
-    const float mref = in_ref ? R.w : 0.0f;
+    const int ri = in_ref ? 4 * (y * ref_stride + x) : 0;
+    const float rI = refp[ri], rGu = refp[ri + 1], rGv = refp[ri + 2];
+    const float mref = in_ref ? refp[ri + 3] : 0.0f;
     const float fu = (float)x;
 
     // Warp (eq. 5): q = H p.
@@ -117,25 +131,30 @@ void warp_reduce(__global const float4* ref, const int ref_stride, const int ref
     const int iu = (int)bu, iv = (int)bv;
     const int inside = (qz > 1e-12f) & (iu >= 0) & (iv >= 0) & (iu < live_w - 1) &
                        (iv < live_h - 1);
-    const int base = inside ? iv * live_stride + iu : 0;
-    const float4 s00 = live[base], s01 = live[base + 1];
-    const float4 s10 = live[base + live_stride], s11 = live[base + live_stride + 1];
+    const int b00 = inside ? 4 * (iv * live_stride + iu) : 0;
+    const int b10 = b00 + 4 * live_stride;
     const float ax = wu - bu, ay = wv - bv;
-    const float4 top = s00 + ax * (s01 - s00);
-    const float4 bot = s10 + ax * (s11 - s10);
-    const float4 L = top + ay * (bot - top);
-    const float m = inside ? mref * s00.w * s01.w * s10.w * s11.w : 0.0f;
+    const float w00 = (1.0f - ax) * (1.0f - ay), w01 = ax * (1.0f - ay);
+    const float w10 = (1.0f - ax) * ay, w11 = ax * ay;
+    const float lI = w00 * livep[b00] + w01 * livep[b00 + 4] + w10 * livep[b10] + w11 * livep[b10 + 4];
+    const float lGu = w00 * livep[b00 + 1] + w01 * livep[b00 + 5] + w10 * livep[b10 + 1] +
+                      w11 * livep[b10 + 5];
+    const float lGv = w00 * livep[b00 + 2] + w01 * livep[b00 + 6] + w10 * livep[b10 + 2] +
+                      w11 * livep[b10 + 6];
+    const float m = inside ? mref * livep[b00 + 3] * livep[b00 + 7] * livep[b10 + 3] *
+                                 livep[b10 + 7]
+                           : 0.0f;
 
     // Residual with brightness (eq. 7).
-    const float r = m * (gain * L.x + bias - R.x);
+    const float r = m * (gain * lI + bias - rI);
 
     // ESM gradient in reference coordinates (eq. 11): the live gradient through Dw.
     const float d00 = iz * (h0 - wu * h6), d01 = iz * (h1 - wu * h7);
     const float d10 = iz * (h3 - wv * h6), d11 = iz * (h4 - wv * h7);
-    const float glu = L.y * d00 + L.z * d10;
-    const float glv = L.y * d01 + L.z * d11;
-    const float gu = 0.5f * (R.y + gain * glu);
-    const float gv = 0.5f * (R.z + gain * glv);
+    const float glu = lGu * d00 + lGv * d10;
+    const float glv = lGu * d01 + lGv * d11;
+    const float gu = 0.5f * (rGu + gain * glu);
+    const float gv = 0.5f * (rGv + gain * glv);
 
     // Jacobian (eq. 12), zero where masked.
     float J[NJ];
@@ -147,7 +166,7 @@ void warp_reduce(__global const float4* ref, const int ref_stride, const int ref
       const float mz = G[6] * fu + G[7] * fv + G[8];
       J[i] = m * (gu * (mx - fu * mz) + gv * (my - fv * mz));
     }
-    J[NPARAM] = m * gain * L.x;
+    J[NPARAM] = m * gain * lI;
     J[NPARAM + 1] = m;
 
     // Huber weight and cost.
@@ -167,15 +186,16 @@ void warp_reduce(__global const float4* ref, const int ref_stride, const int ref
     for (int i = 0; i < NJ; ++i) acc[OUT_JTR + i] += wgt * J[i] * r;
     acc[OUT_COST] += rho;
     acc[OUT_WRR] += wgt * r * r;
-    acc[OUT_RR] += r * r;
     acc[OUT_VALID] += m;
     acc[OUT_INLIER] += inlier ? m : 0.0f;
     acc[OUT_REF] += mref;
-    const float ic = m * (R.x - 128.0f);
+#if STATS
+    acc[OUT_RR] += r * r;
+    const float ic = m * (rI - 128.0f);
     acc[OUT_IREF] += ic;
     acc[OUT_IREF2] += ic * ic;
-    acc[OUT_GLIVE] += m * (L.y * L.y + L.z * L.z);
-    acc[OUT_GREF] += m * (R.y * R.y + R.z * R.z);
+    acc[OUT_GLIVE] += m * (lGu * lGu + lGv * lGv);
+    acc[OUT_GREF] += m * (rGu * rGu + rGv * rGv);
 #pragma unroll
     for (int j = 0; j < HIST_BINS; ++j) {
       // 0.25 * 2^(j/2): exact powers of two for even j, times sqrt(2) for odd j.
@@ -183,6 +203,7 @@ void warp_reduce(__global const float4* ref, const int ref_stride, const int ref
                               : 0.25f * (float)(1 << (j >> 1));
       acc[OUT_HIST + j] += ar < t ? m : 0.0f;
     }
+#endif
 #ifdef DEBUG_OUTPUT
     if (in_ref) debug[y * ref_w + x] = (float4)(r, wgt, m, rho);
 #endif

@@ -21,15 +21,19 @@ void ReduceSums::assign(const ReduceLayout& L, const double* row) {
   }
   cost = row[L.cost()];
   wrr = row[L.wrr()];
-  rr = row[L.rr()];
   valid = row[L.valid()];
   inlier = row[L.inlier()];
   ref = row[L.ref()];
+  has_stats = L.stats;
+  rr = iref = iref2 = glive = gref = 0.0;
+  hist_bins = L.stats ? L.hist_bins : 0;
+  hist.fill(0.0);
+  if (!L.stats) return;
+  rr = row[L.rr()];
   iref = row[L.iref()];
   iref2 = row[L.iref2()];
   glive = row[L.glive()];
   gref = row[L.gref()];
-  hist_bins = L.hist_bins;
   for (int j = 0; j < L.hist_bins; ++j) hist[static_cast<size_t>(j)] = row[L.hist(j)];
 }
 
@@ -88,11 +92,9 @@ ReduceSums warp_reduce_reference(const LevelView& ref, const LevelView& live,
       if (s00[3] == 0.0f || s01[3] == 0.0f || s10[3] == 0.0f || s11[3] == 0.0f) continue;
       const double ax = wu - bu, ay = wv - bv;
       double Ls[3];
-      for (int c = 0; c < 3; ++c) {
-        const double top = s00[c] + ax * (s01[c] - s00[c]);
-        const double bot = s10[c] + ax * (s11[c] - s10[c]);
-        Ls[c] = top + ay * (bot - top);
-      }
+      for (int c = 0; c < 3; ++c)
+        Ls[c] = (1 - ax) * (1 - ay) * s00[c] + ax * (1 - ay) * s01[c] + (1 - ax) * ay * s10[c] +
+                ax * ay * s11[c];
       const double r = gain * Ls[0] + bias - R[0];
       const double dz = 1.0 / qz;
       const double d00 = dz * (h[0] - wu * h[6]), d01 = dz * (h[1] - wu * h[7]);
@@ -120,9 +122,10 @@ ReduceSums warp_reduce_reference(const LevelView& ref, const LevelView& live,
       }
       row[static_cast<size_t>(L.cost())] += rho;
       row[static_cast<size_t>(L.wrr())] += w * r * r;
-      row[static_cast<size_t>(L.rr())] += r * r;
       row[static_cast<size_t>(L.valid())] += 1.0;
       row[static_cast<size_t>(L.inlier())] += inlier ? 1.0 : 0.0;
+      if (!L.stats) continue;
+      row[static_cast<size_t>(L.rr())] += r * r;
       const double ic = R[0] - 128.0;
       row[static_cast<size_t>(L.iref())] += ic;
       row[static_cast<size_t>(L.iref2())] += ic * ic;
@@ -140,7 +143,8 @@ ReduceSums warp_reduce_reference(const LevelView& ref, const LevelView& live,
 std::string WarpReduce::build_options(int nparam, const WarpReduceOptions& o) {
   std::ostringstream s;
   s << "-D NPARAM=" << nparam << " -D WG_X=" << o.wg_x << " -D WG_Y=" << o.wg_y
-    << " -D PIX=" << o.pixels_per_item << " -D HIST_BINS=" << o.hist_bins;
+    << " -D PIX=" << o.pixels_per_item;
+  if (o.stats) s << " -D STATS=1 -D HIST_BINS=" << o.hist_bins;
   if (o.debug_output) s << " -D DEBUG_OUTPUT";
   if (o.fast_math) s << " -cl-fast-relaxed-math";
   return s.str();
@@ -158,7 +162,8 @@ WarpReduce::WarpReduce(ocl::Runtime& runtime, int nparam, const WarpReduceOption
   if (options.hist_bins < 0 || options.hist_bins > kMaxHistBins)
     throw_invalid_argument("WarpReduce: hist_bins must be 0.." + std::to_string(kMaxHistBins));
   layout_.nparam = nparam;
-  layout_.hist_bins = options.hist_bins;
+  layout_.stats = options.stats;
+  layout_.hist_bins = options.stats ? options.hist_bins : 0;
   build_options_ = build_options(nparam, options);
   ocl::Runtime::register_build_options("warp_reduce", build_options_);
   kernel_ = cl::Kernel(runtime.program("warp_reduce", build_options_), "warp_reduce");

@@ -21,10 +21,12 @@ inline constexpr int kMaxParams = 8;
 inline constexpr int kMaxJacobian = kMaxParams + 2;  // plus brightness (a, b)
 inline constexpr int kMaxHistBins = 24;
 
-// Where each sum sits in a row of partials (mirrors the OUT_* macros of warp_reduce.cl).
+// Where each sum sits in a row of partials (mirrors the OUT_* macros of warp_reduce.cl). The
+// statistics from rr() on exist only in the STATS variant.
 struct ReduceLayout {
   int nparam = 3;
-  int hist_bins = 16;
+  bool stats = false;
+  int hist_bins = 16;  // with stats only
 
   int nj() const { return nparam + 2; }
   int nh() const { return nj() * (nj() + 1) / 2; }
@@ -33,16 +35,16 @@ struct ReduceLayout {
   int jtr(int i) const { return nh() + i; }
   int cost() const { return nh() + nj(); }
   int wrr() const { return cost() + 1; }
-  int rr() const { return cost() + 2; }
-  int valid() const { return cost() + 3; }
-  int inlier() const { return cost() + 4; }
-  int ref() const { return cost() + 5; }
+  int valid() const { return cost() + 2; }
+  int inlier() const { return cost() + 3; }
+  int ref() const { return cost() + 4; }
+  int rr() const { return cost() + 5; }
   int iref() const { return cost() + 6; }
   int iref2() const { return cost() + 7; }
   int glive() const { return cost() + 8; }
   int gref() const { return cost() + 9; }
   int hist(int j) const { return cost() + 10 + j; }
-  int count() const { return hist(0) + hist_bins; }
+  int count() const { return stats ? hist(0) + hist_bins : cost() + 5; }
   // Histogram bin j counts |r| < hist_threshold(j) = 0.25 * 2^(j / 2) grey levels.
   static double hist_threshold(int j);
 };
@@ -56,10 +58,12 @@ struct ReduceSums {
   VectorJ JtWr;      // nj
   double cost = 0;   // sum of Huber costs rho(r)
   double wrr = 0;    // sum of weight * r^2
-  double rr = 0;     // sum of r^2
   double valid = 0;  // pixels with a valid reference and a valid live sample
   double inlier = 0; // of those, |r| <= k
   double ref = 0;    // pixels with a valid reference
+  // The STATS variant's (zero otherwise):
+  bool has_stats = false;
+  double rr = 0;                // sum of r^2
   double iref = 0, iref2 = 0;   // sums of (I_r - 128) and its square over the valid pixels
   double glive = 0, gref = 0;   // sums of |grad I_l(w(p))|^2 and |grad I_r(p)|^2 over them
   int hist_bins = 0;
@@ -90,14 +94,15 @@ struct LevelView {
 
 // The plain C++ reference of the kernel: the same per-pixel formulas, the warp in float in the
 // kernel's order (so validity decisions match), everything after it in double, accumulated in
-// double. Returns the sums for the layout's nparam and hist_bins.
+// double. Returns the sums for the layout's nparam, stats and hist_bins.
 ReduceSums warp_reduce_reference(const LevelView& ref, const LevelView& live,
                                  const WarpInputs& in, const ReduceLayout& layout);
 
 struct WarpReduceOptions {
   int wg_x = 64, wg_y = 1;   // work-group shape (WG_X x WG_Y must be a power of two)
   int pixels_per_item = 4;   // PIX: pixels per work-item along a row, WG_X apart
-  int hist_bins = 16;        // histogram of |r| for the robust scale (0: none)
+  bool stats = false;        // the STATS variant: residual, intensity and gradient statistics
+  int hist_bins = 16;        // and a histogram of |r| for the robust scale (with stats only)
   bool fast_math = true;     // -cl-fast-relaxed-math (measured: see src/track/README.md)
   bool debug_output = false; // per-pixel (r, weight, valid, rho) into a debug buffer
 };
