@@ -56,7 +56,8 @@
 #define NH (NJ * (NJ + 1) / 2)
 #define WG (WG_X * WG_Y)
 // Row layout (ReduceLayout in warp_reduce.h). The statistics after OUT_REF are only in the
-// STATS variant, which the tracker runs once per level: each extra sum costs every pixel.
+// STATS variant, which the tracker runs once per level: each extra sum costs every pixel. The
+// histogram counts only each work-item's first pixel (one in PIX).
 #define OUT_JTJ 0                    // NH: upper triangle of J^T W J, row by row
 #define OUT_JTR (NH)                 // NJ: J^T W r
 #define OUT_COST (NH + NJ)           // sum of Huber costs
@@ -70,7 +71,8 @@
 #define OUT_IREF2 (OUT_COST + 7)     // sum of (I_r - 128)^2 over valid pairs
 #define OUT_GLIVE (OUT_COST + 8)     // sum of |grad I_l(w(p))|^2 over valid pairs (live pixels)
 #define OUT_GREF (OUT_COST + 9)      // sum of |grad I_r(p)|^2 over valid pairs
-#define OUT_HIST (OUT_COST + 10)     // HIST_BINS: counts of |r| < 0.25 * 2^(j / 2)
+#define OUT_HVALID (OUT_COST + 10)   // valid pixels in the histogram's subsample
+#define OUT_HIST (OUT_COST + 11)     // HIST_BINS: counts of |r| < 0.25 * 2^(j / 2) in it
 #define NOUT (OUT_HIST + HIST_BINS)
 #else
 #define NOUT (OUT_COST + 5)
@@ -196,12 +198,17 @@ void warp_reduce(__global const float4* ref, const int ref_stride, const int ref
     acc[OUT_IREF2] += ic * ic;
     acc[OUT_GLIVE] += m * (lGu * lGu + lGv * lGv);
     acc[OUT_GREF] += m * (rGu * rGu + rGv * rGv);
+    // The histogram of |r| for the robust scale: a subsample (each work-item's first pixel)
+    // is plenty for a median and saves most of its cost.
+    if (k == 0) {
+      acc[OUT_HVALID] += m;
 #pragma unroll
-    for (int j = 0; j < HIST_BINS; ++j) {
-      // 0.25 * 2^(j/2): exact powers of two for even j, times sqrt(2) for odd j.
-      const float t = (j & 1) ? 0.35355339059327373f * (float)(1 << (j >> 1))
-                              : 0.25f * (float)(1 << (j >> 1));
-      acc[OUT_HIST + j] += ar < t ? m : 0.0f;
+      for (int j = 0; j < HIST_BINS; ++j) {
+        // 0.25 * 2^(j/2): exact powers of two for even j, times sqrt(2) for odd j.
+        const float t = (j & 1) ? 0.35355339059327373f * (float)(1 << (j >> 1))
+                                : 0.25f * (float)(1 << (j >> 1));
+        acc[OUT_HIST + j] += ar < t ? m : 0.0f;
+      }
     }
 #endif
 #ifdef DEBUG_OUTPUT

@@ -194,9 +194,12 @@ struct Tracker::Impl {
     const LevelRange range = level_range(live);
     Estimate e = init;
     res->iterations.fill(0);
+    res->level_ms.fill(0.0);
     res->levels_used = 0;
-    for (int level = range.coarsest; level >= range.finest; --level) {
+    int finest = range.finest;
+    for (int level = range.coarsest; level >= finest; --level) {
       ++res->levels_used;
+      const auto level_start = std::chrono::steady_clock::now();
       const PyramidLevel& R = keyframe.levels[static_cast<size_t>(level)];
       const Eigen::Matrix3d Kl = level_camera_matrix(K, level);
       evaluate(live, level, e, true, &cur);
@@ -213,7 +216,7 @@ struct Tracker::Impl {
       }
       const double med = cur.median_abs_residual();
       const double measured = std::clamp(kMadToSigma * med, opt.min_sigma, opt.max_sigma);
-      if (level == range.finest) {
+      if (level <= range.finest) {
         finest_stats = cur;
         finest_sigma = measured;
       }
@@ -253,10 +256,16 @@ struct Tracker::Impl {
         }
       }
       sigma[static_cast<size_t>(level)] = measured;
+      res->level_ms[static_cast<size_t>(level)] =
+          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - level_start).count();
       if (!finite(e.T) || !std::isfinite(e.a) || !std::isfinite(e.b)) {
         *reason = kDiverged;
         return false;
       }
+      // A frame about to become the keyframe goes on to full resolution.
+      if (level == finest && finest > 0 && opt.refine_keyframes && cur.ref > 0 &&
+          cur.valid / cur.ref < opt.keyframe_overlap)
+        finest = 0;
     }
     *out = e;
     return true;
@@ -410,7 +419,10 @@ struct Tracker::Impl {
       if (align(live, prev, &est2, &retry, &reason2)) {
         finish(&retry, est2);
         if (retry.status != Status::Lost) {
-          for (size_t l = 0; l < res.iterations.size(); ++l) retry.iterations[l] += res.iterations[l];
+          for (size_t l = 0; l < res.iterations.size(); ++l) {
+            retry.iterations[l] += res.iterations[l];
+            retry.level_ms[l] += res.level_ms[l];
+          }
           res = retry;
           est = est2;
           ok = true;

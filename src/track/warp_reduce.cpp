@@ -25,7 +25,7 @@ void ReduceSums::assign(const ReduceLayout& L, const double* row) {
   inlier = row[L.inlier()];
   ref = row[L.ref()];
   has_stats = L.stats;
-  rr = iref = iref2 = glive = gref = 0.0;
+  rr = iref = iref2 = glive = gref = hist_valid = 0.0;
   hist_bins = L.stats ? L.hist_bins : 0;
   hist.fill(0.0);
   if (!L.stats) return;
@@ -34,12 +34,13 @@ void ReduceSums::assign(const ReduceLayout& L, const double* row) {
   iref2 = row[L.iref2()];
   glive = row[L.glive()];
   gref = row[L.gref()];
+  hist_valid = row[L.hvalid()];
   for (int j = 0; j < L.hist_bins; ++j) hist[static_cast<size_t>(j)] = row[L.hist(j)];
 }
 
 double ReduceSums::median_abs_residual() const {
-  if (hist_bins <= 0 || !(valid > 0)) return std::nan("");
-  const double half = 0.5 * valid;
+  if (hist_bins <= 0 || !(hist_valid > 0)) return std::nan("");
+  const double half = 0.5 * hist_valid;
   if (hist[0] >= half) return 0.5 * ReduceLayout::hist_threshold(0);
   for (int j = 1; j < hist_bins; ++j) {
     const double c1 = hist[static_cast<size_t>(j)];
@@ -55,7 +56,9 @@ double ReduceSums::median_abs_residual() const {
 }
 
 ReduceSums warp_reduce_reference(const LevelView& ref, const LevelView& live,
-                                 const WarpInputs& in, const ReduceLayout& L) {
+                                 const WarpInputs& in, const ReduceLayout& L, int wg_x,
+                                 int pixels_per_item) {
+  const int span = wg_x * pixels_per_item;
   if (in.nparam != L.nparam) throw_invalid_argument("warp_reduce_reference: nparam mismatch");
   const int nj = L.nj();
   std::vector<double> row(static_cast<size_t>(L.count()), 0.0);
@@ -131,6 +134,8 @@ ReduceSums warp_reduce_reference(const LevelView& ref, const LevelView& live,
       row[static_cast<size_t>(L.iref2())] += ic * ic;
       row[static_cast<size_t>(L.glive())] += Ls[1] * Ls[1] + Ls[2] * Ls[2];
       row[static_cast<size_t>(L.gref())] += static_cast<double>(R[1]) * R[1] + static_cast<double>(R[2]) * R[2];
+      if (x % span >= wg_x) continue;
+      row[static_cast<size_t>(L.hvalid())] += 1.0;
       for (int j = 0; j < L.hist_bins; ++j)
         row[static_cast<size_t>(L.hist(j))] += ar < thr[static_cast<size_t>(j)] ? 1.0 : 0.0;
     }

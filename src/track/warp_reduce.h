@@ -43,7 +43,8 @@ struct ReduceLayout {
   int iref2() const { return cost() + 7; }
   int glive() const { return cost() + 8; }
   int gref() const { return cost() + 9; }
-  int hist(int j) const { return cost() + 10 + j; }
+  int hvalid() const { return cost() + 10; }  // valid pixels in the histogram's subsample
+  int hist(int j) const { return cost() + 11 + j; }
   int count() const { return stats ? hist(0) + hist_bins : cost() + 5; }
   // Histogram bin j counts |r| < hist_threshold(j) = 0.25 * 2^(j / 2) grey levels.
   static double hist_threshold(int j);
@@ -67,11 +68,13 @@ struct ReduceSums {
   double iref = 0, iref2 = 0;   // sums of (I_r - 128) and its square over the valid pixels
   double glive = 0, gref = 0;   // sums of |grad I_l(w(p))|^2 and |grad I_r(p)|^2 over them
   int hist_bins = 0;
+  // Over a subsample of the valid pixels (each work-item's first pixel), hist_valid of them:
+  double hist_valid = 0;
   std::array<double, kMaxHistBins> hist{};  // counts of |r| < ReduceLayout::hist_threshold(j)
 
   // Fills the fields from the summed row (layout.count() values).
   void assign(const ReduceLayout& layout, const double* row);
-  // Median of |r| over the valid pixels from the cumulative histogram, interpolated linearly
+  // Median of |r| over the histogram's subsample from the cumulative histogram, interpolated linearly
   // in log |r| between the bins' thresholds; the last threshold when more than half of the
   // residuals lie beyond it, and the first (halved) when more than half lie below it.
   double median_abs_residual() const;
@@ -94,9 +97,13 @@ struct LevelView {
 
 // The plain C++ reference of the kernel: the same per-pixel formulas, the warp in float in the
 // kernel's order (so validity decisions match), everything after it in double, accumulated in
-// double. Returns the sums for the layout's nparam, stats and hist_bins.
+// double. Returns the sums for the layout's nparam, stats and hist_bins; the histogram's
+// subsample is the pixels whose column c satisfies (c mod (wg_x * pix)) < wg_x, as the
+// kernel's work distribution makes it.
+
 ReduceSums warp_reduce_reference(const LevelView& ref, const LevelView& live,
-                                 const WarpInputs& in, const ReduceLayout& layout);
+                                 const WarpInputs& in, const ReduceLayout& layout, int wg_x = 64,
+                                 int pixels_per_item = 4);
 
 struct WarpReduceOptions {
   int wg_x = 64, wg_y = 1;   // work-group shape (WG_X x WG_Y must be a power of two)

@@ -2,8 +2,9 @@
 //   bench_track kernel   [width height]   the fused pass per work-group shape / pixels per
 //                                          work-item / fast math, median ms per pass
 //   bench_track kernel w h wx wy pix hist fast [rounds]   one configuration
-//   bench_track accuracy [seconds] [w h] [finest_level] [textures...]
-//                                          simulated sequences tracked against ground truth
+//   bench_track accuracy [key=value...]     simulated sequences tracked against ground truth
+//       (seconds, w, h, seed, levels, finest, refine_kf, conv, huber, overlap, maxit=l0,l1,..,
+//        textures=a.png,b.png; see main())
 #include <algorithm>
 #include <cmath>
 #include <chrono>
@@ -136,6 +137,8 @@ struct SequenceReport {
   double distance = 0, drift_pct = 0, heading_drift_deg = 0;
   double ms_render = 0, ms_pyramid = 0, ms_track = 0;
   double passes[kMaxLevelsBench] = {};
+  double level_ms[kMaxLevelsBench] = {};
+  double cpu_track = 0;
 };
 
 SequenceReport run_sequence(ocl::Runtime& rt, const SequenceSpec& spec, const track::TrackerOptions& topt,
@@ -163,14 +166,19 @@ SequenceReport run_sequence(ocl::Runtime& rt, const SequenceSpec& spec, const tr
     const Pyramid pyr = test::test_upload(rt, test::test_pyramid(img, &map, topt.levels));
     rt.queue().finish();
     double t2 = now_ms();
+    const double c2 = cpu_ms();
     const track::FrameResult r = tracker.track(pyr, traj.t[k]);
     double t3 = now_ms();
+    rep.cpu_track += cpu_ms() - c2;
     rep.ms_render += t1 - t0;
     rep.ms_pyramid += t2 - t1;
     rep.ms_track += t3 - t2;
     ++rep.frames;
     rep.keyframes += r.keyframe;
-    for (int l = 0; l < kMaxLevelsBench; ++l) rep.passes[l] += r.iterations[static_cast<size_t>(l)];
+    for (int l = 0; l < kMaxLevelsBench; ++l) {
+      rep.passes[l] += r.iterations[static_cast<size_t>(l)];
+      rep.level_ms[l] += r.level_ms[static_cast<size_t>(l)];
+    }
     if (r.status == track::FrameResult::Status::Ok) ++rep.ok;
     if (r.status == track::FrameResult::Status::Degraded) ++rep.degraded;
     if (r.status == track::FrameResult::Status::Lost) ++rep.lost;
@@ -206,7 +214,7 @@ SequenceReport run_sequence(ocl::Runtime& rt, const SequenceSpec& spec, const tr
 }
 
 int bench_accuracy(const std::vector<std::string>& textures, double seconds, int width, int height,
-                   const track::TrackerOptions& topt, bool verbose) {
+                   uint64_t seed, const track::TrackerOptions& topt, bool verbose) {
   ocl::Runtime rt;
   std::printf("device: %s\n", rt.device_info().device_name.c_str());
   std::printf("%dx%d, %.0f s at 30 Hz per texture, mixed motion up to 0.8 m/s and 1.5 rad/s, noise 1, gain +-5%%, "
@@ -220,11 +228,14 @@ int bench_accuracy(const std::vector<std::string>& textures, double seconds, int
     spec.seconds = seconds;
     spec.width = width;
     spec.height = height;
+    spec.seed = seed;
     const SequenceReport r = run_sequence(rt, spec, topt, verbose);
     std::printf("%-20s %6d %4d %4d %4d %4d %8.5f %8.5f %8.4f %8.4f %8.5f %5d %7.3f %7.3f %8.2f %8.2f  ", tex.c_str(),
                 r.frames, r.ok, r.degraded, r.lost, r.keyframes, r.slope_v, r.slope_w, r.rms_mm, r.max_mm, r.rms_deg,
                 r.gross, r.drift_pct, r.heading_drift_deg, r.ms_pyramid / r.frames, r.ms_track / r.frames);
     for (int l = topt.levels - 1; l >= 0; --l) std::printf(" %.2f", r.passes[l] / r.frames);
+    std::printf("\n%-20s cpu ms/frame in track %.2f; wall ms per level:", "", r.cpu_track / r.frames);
+    for (int l = topt.levels - 1; l >= 0; --l) std::printf(" L%d %.2f", l, r.level_ms[l] / r.frames);
     std::printf("\n");
     std::fflush(stdout);
   }
@@ -244,16 +255,50 @@ int main(int argc, char** argv) {
     return bench_kernel(w, h, only, argc > 9 ? std::atoi(argv[9]) : 6);
   }
   if (mode == "accuracy") {
-    // bench_track accuracy [seconds] [width height] [finest_level] [textures...]
-    const double seconds = argc > 2 ? std::atof(argv[2]) : 10.0;
-    const int w = argc > 4 ? std::atoi(argv[3]) : 640, h = argc > 4 ? std::atoi(argv[4]) : 480;
+    // bench_track accuracy [key=value ...]: seconds=10 w=640 h=480 levels=4 finest=0
+    //   refine_kf=0 maxit=a,b,c,d (per level from 0) textures=a.png,b.png seed=1
+    double seconds = 10.0;
+    int w = 640, h = 480;
+    uint64_t seed = 1;
     track::TrackerOptions topt;
-    if (argc > 5) topt.finest_level = std::atoi(argv[5]);
-    std::vector<std::string> tex;
-    for (int i = 6; i < argc; ++i) tex.push_back(argv[i]);
-    if (tex.empty()) tex = {"asphalt_01.png", "anti_skid_tiles.png", "brick_floor.png", "aerial_ground_rock.png"};
-    return bench_accuracy(tex, seconds, w, h, topt, std::getenv("BENCH_VERBOSE") != nullptr);
+    std::vector<std::string> tex = {"asphalt_01.png", "anti_skid_tiles.png", "brick_floor.png",
+                                    "aerial_ground_rock.png"};
+    for (int i = 2; i < argc; ++i) {
+      const std::string a = argv[i];
+      const size_t eq = a.find('=');
+      const std::string k = a.substr(0, eq), v = eq == std::string::npos ? "" : a.substr(eq + 1);
+      auto list = [&](const std::string& x) {
+        std::vector<std::string> out;
+        size_t p = 0;
+        while (p <= x.size()) {
+          const size_t c = x.find(',', p);
+          out.push_back(x.substr(p, c == std::string::npos ? std::string::npos : c - p));
+          if (c == std::string::npos) break;
+          p = c + 1;
+        }
+        return out;
+      };
+      if (k == "seconds") seconds = std::atof(v.c_str());
+      else if (k == "w") w = std::atoi(v.c_str());
+      else if (k == "h") h = std::atoi(v.c_str());
+      else if (k == "seed") seed = std::strtoull(v.c_str(), nullptr, 10);
+      else if (k == "levels") topt.levels = std::atoi(v.c_str());
+      else if (k == "finest") topt.finest_level = std::atoi(v.c_str());
+      else if (k == "refine_kf") topt.refine_keyframes = std::atoi(v.c_str()) != 0;
+      else if (k == "conv") topt.convergence_px = std::atof(v.c_str());
+      else if (k == "huber") topt.huber_factor = std::atof(v.c_str());
+      else if (k == "overlap") topt.keyframe_overlap = std::atof(v.c_str());
+      else if (k == "maxit") {
+        const auto it = list(v);
+        for (size_t l = 0; l < it.size() && l < topt.max_iterations.size(); ++l) topt.max_iterations[l] = std::atoi(it[l].c_str());
+      } else if (k == "textures") tex = list(v);
+      else {
+        std::fprintf(stderr, "unknown option %s\n", a.c_str());
+        return 2;
+      }
+    }
+    return bench_accuracy(tex, seconds, w, h, seed, topt, std::getenv("BENCH_VERBOSE") != nullptr);
   }
-  std::fprintf(stderr, "usage: bench_track kernel [w h] | accuracy [seconds] [w h] [finest_level] [textures...]\n");
+  std::fprintf(stderr, "usage: bench_track kernel [w h [wx wy pix hist fast [rounds]]] | accuracy [key=value...]\n");
   return 2;
 }

@@ -173,6 +173,7 @@ void expect_sums_match(const ReduceSums& k, const ReduceSums& r, int nj, double 
   EXPECT_NEAR(k.glive, r.glive, (rel + 5 * per_pixel) * r.glive + 1e-3);
   EXPECT_NEAR(k.gref, r.gref, (rel + 5 * per_pixel) * r.gref + 1e-3);
   ASSERT_EQ(k.hist_bins, r.hist_bins);
+  EXPECT_NEAR(k.hist_valid, r.hist_valid, flips);
   for (int j = 0; j < r.hist_bins; ++j)
     EXPECT_NEAR(k.hist[static_cast<size_t>(j)], r.hist[static_cast<size_t>(j)], flips + 1) << "bin " << j;
 }
@@ -207,7 +208,8 @@ TEST_F(WarpReduceKernel, MatchesReferenceOnRandomLevels) {
       L.nparam = v.nparam;
       L.stats = v.options.stats;
       L.hist_bins = v.options.stats ? v.options.hist_bins : 0;
-      const ReduceSums r = warp_reduce_reference({ref.data(), rw, rh, rw}, {live.data(), lw, lh, lw}, in, L);
+      const ReduceSums r = warp_reduce_reference({ref.data(), rw, rh, rw}, {live.data(), lw, lh, lw}, in, L,
+                                                  v.options.wg_x, v.options.pixels_per_item);
       ASSERT_GT(r.valid, 0.3 * rw * rh) << "the random warp should keep most pixels inside";
 
       int unwritten = 0, touched = 0;
@@ -269,13 +271,16 @@ TEST_F(WarpReduceKernel, IdentityWarpOfALevelOnItselfHasZeroResidual) {
     }
   EXPECT_EQ(s.valid, expected);
   EXPECT_EQ(s.ref, refs);
-  for (int j = 0; j < s.hist_bins; ++j) EXPECT_EQ(s.hist[static_cast<size_t>(j)], expected);
+  ASSERT_EQ(s.hist_bins, 16);
+  EXPECT_GT(s.hist_valid, 0.0);
+  EXPECT_LT(s.hist_valid, s.valid);  // a subsample
+  for (int j = 0; j < s.hist_bins; ++j) EXPECT_EQ(s.hist[static_cast<size_t>(j)], s.hist_valid);
 }
 
 TEST_F(WarpReduceKernel, MedianFromHistogram) {
   ReduceSums s;
   s.hist_bins = 16;
-  s.valid = 1000;
+  s.hist_valid = 1000;
   // Residuals uniform in log between thresholds: cumulative counts rise linearly per bin.
   for (int j = 0; j < 16; ++j) s.hist[static_cast<size_t>(j)] = 100.0 * j;
   // Half (500) is reached exactly at bin 5.
