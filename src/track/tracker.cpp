@@ -38,6 +38,8 @@ constexpr const char* kDiverged = "diverged";
 constexpr const char* kMismatch = "images do not match";
 constexpr const char* kBrightness = "brightness changed too much";
 constexpr const char* kWrongSize = "frame size differs from the camera's";
+constexpr const char* kTimeGap = "time gap";
+constexpr const char* kBadTime = "timestamp not increasing";
 
 // Mean squared gradient (grey levels^2 per pixel^2) a frame needs at the coarsest level to
 // become a keyframe. A flat or black frame has 0, the pixel noise of a flat frame at level 3
@@ -183,7 +185,13 @@ struct Tracker::Impl {
                      live.levels[static_cast<size_t>(n - 1)].height < kMinLevelSide))
       --n;
     r.coarsest = std::max(0, n - 1);
-    r.finest = std::clamp(opt.finest_level, 0, r.coarsest);
+    int finest = opt.finest_level;
+    if (finest < 0) {
+      finest = 0;
+      while (finest < r.coarsest && live.levels[static_cast<size_t>(finest + 1)].width >= opt.min_finest_width)
+        ++finest;
+    }
+    r.finest = std::clamp(finest, 0, r.coarsest);
     return r;
   }
 
@@ -344,17 +352,22 @@ struct Tracker::Impl {
     FrameResult res;
     res.covariance = lost_covariance();
 
-    // Time: the interval, gaps, and the constant-velocity prediction.
-    double dt = has_t && std::isfinite(t) ? t - last_t : 0.0;
-    bool gap = false;
-    if (has_t && !(dt > 0.0)) {
-      gap = true;  // a repeated, backwards or non-finite timestamp
-      dt = nominal_dt;
-    } else if (has_t && nominal_dt > 0.0 && dt > opt.max_gap_factor * nominal_dt) {
-      gap = true;
+    // Time: the interval, gaps, and the constant-velocity prediction. A timestamp that is not
+    // finite or not after the last one is not used (the usual interval is assumed).
+    double dt = 0.0;
+    const char* time_problem = nullptr;
+    if (has_t) {
+      dt = std::isfinite(t) ? t - last_t : HUGE_VAL;
+      if (!(dt > 0.0) || !std::isfinite(dt)) {
+        time_problem = kBadTime;
+        dt = nominal_dt;
+      } else if (nominal_dt > 0.0 && dt > opt.max_gap_factor * nominal_dt) {
+        time_problem = kTimeGap;
+      } else {
+        nominal_dt = nominal_dt > 0.0 ? 0.9 * nominal_dt + 0.1 * dt : dt;
+      }
     }
-    if (std::isfinite(t)) {
-      if (has_t && !gap && dt > 0.0) nominal_dt = nominal_dt > 0.0 ? 0.9 * nominal_dt + 0.1 * dt : dt;
+    if (std::isfinite(t) && (!has_t || t > last_t)) {
       last_t = t;
       has_t = true;
     }
@@ -431,9 +444,9 @@ struct Tracker::Impl {
     }
     if (!ok) return lost(reason, reason != kNoLiveTexture);
     if (res.status == Status::Lost) return lost(res.reason, true);
-    if (gap && res.status == Status::Ok) {
+    if (time_problem && res.status == Status::Ok) {
       res.status = Status::Degraded;
-      res.reason = "time gap";
+      res.reason = time_problem;
     }
 
     // Frame-to-frame motion from the keyframe-relative estimates.

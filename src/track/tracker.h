@@ -27,8 +27,11 @@ struct TrackerOptions {
   // 8x8 pixels are skipped.
   int levels = 4;
   // The finest level tracked: 0 is full resolution; 1 stops at half resolution, a third of
-  // the time for 5-8 instead of 2-3 micrometres RMS per frame on the simulator (README.md).
-  int finest_level = 1;
+  // the time for 5-8 instead of 2-3 micrometres RMS per frame at 640x480 on the simulator
+  // (README.md). -1 (the default): the coarsest level at least min_finest_width pixels wide
+  // (level 1 at 640x480, level 0 at 320x240).
+  int finest_level = -1;
+  int min_finest_width = 320;
   // With finest_level > 0: a frame that is to become the keyframe is refined down to level 0,
   // so that the chain of keyframes (what the pose drifts by) has full-resolution accuracy.
   bool refine_keyframes = false;
@@ -57,14 +60,16 @@ struct TrackerOptions {
   // not used (zero motion is). Live texture below min_texture_ratio of the keyframe's (mean
   // squared gradient over the overlap) is Lost. Too few valid pixels (min_valid_fraction of
   // the level's pixels) is Lost. The residual's mean square relative to the keyframe's
-  // intensity variance: above lost_residual_ratio Lost, above degraded_residual_ratio Degraded.
+  // intensity variance over the overlap (about 1 for unrelated images after the brightness
+  // fit; 0.02-0.1 on the simulator at 640x480, up to 0.26 at 320x240 where pixel noise
+  // dominates): above lost_residual_ratio Lost, above degraded_residual_ratio Degraded.
   // Inlier fraction below min_inlier_fraction: Degraded. |a| > max_log_gain: Lost.
   double max_gap_factor = 2.5;
   double max_gap_seconds = 0.5;
   double min_texture_ratio = 0.1;
   double min_valid_fraction = 0.05;
-  double lost_residual_ratio = 0.5;
-  double degraded_residual_ratio = 0.25;
+  double lost_residual_ratio = 0.75;
+  double degraded_residual_ratio = 0.5;
   double min_inlier_fraction = 0.5;
   double max_log_gain = 0.7;
   // The fused pass's work-group shape etc. (stats and debug_output are set by the tracker).

@@ -1,0 +1,172 @@
+// The tracker on bad input: black, saturated and textureless frames, a frame of another size,
+// gaps and bad timestamps. Each gives Lost or Degraded with a reason, a finite motion and pose,
+// and tracking recovers on the next good frame; the pose stays close to the truth where the
+// good frames allow it.
+#include <cmath>
+
+#include <gtest/gtest.h>
+#include <opencv2/imgcodecs.hpp>
+
+#include "common/test_util.h"
+#include "io/simulator.h"
+#include "ocl/runtime.h"
+#include "track/tracker.h"
+#include "unit/track_test_pyramid.h"
+
+namespace planarvo::track {
+namespace {
+
+using Status = FrameResult::Status;
+
+class TrackBadInput : public ::testing::Test {
+ protected:
+  TrackBadInput() {
+    options_.texture = test::texture("asphalt_01.png").string();
+    options_.camera = sim::default_camera(320, 240);
+    options_.camera.k1 = options_.camera.k2 = 0.0;
+    renderer_ = std::make_unique<sim::Renderer>(rt_, cv::imread(options_.texture, cv::IMREAD_GRAYSCALE), options_);
+    tracker_ = std::make_unique<Tracker>(rt_, options_.camera, options_.extrinsics);
+  }
+
+  // Constant velocity 0.3 m/s and 0.6 rad/s: frame k at time k / 30 s.
+  static SE2 truth(double t) { return SE2::exp(Eigen::Vector3d(0.3 * t, 0.0, 0.6 * t)); }
+
+  Pyramid good(double t, uint64_t seed = 7) {
+    const cv::Mat u8 = sim::apply_camera(renderer_->render_float(truth(t)), {}, 1.0, seed + static_cast<uint64_t>(t * 1000));
+    return test::test_upload(rt_, test::test_pyramid(u8, nullptr, 4));
+  }
+  Pyramid flat(double value, double noise, int w = 320, int h = 240) {
+    cv::Mat f(h, w, CV_32FC1, cv::Scalar(value));
+    const cv::Mat u8 = sim::apply_camera(f, {}, noise, 3);
+    return test::test_upload(rt_, test::test_pyramid(u8, nullptr, 4));
+  }
+
+  FrameResult track(const Pyramid& p, double t) {
+    const FrameResult r = tracker_->track(p, t);
+    EXPECT_TRUE(std::isfinite(r.motion.x) && std::isfinite(r.motion.y) && std::isfinite(r.motion.theta));
+    EXPECT_TRUE(r.covariance.allFinite());
+    EXPECT_TRUE(std::isfinite(tracker_->pose().x) && std::isfinite(tracker_->pose().theta));
+    if (r.status == Status::Lost || r.status == Status::Degraded) {
+      EXPECT_STRNE(r.reason, "");
+    }
+    return r;
+  }
+  // Distance between the tracker's pose and the truth at t (the first frame at t0).
+  double pose_error_mm(double t0, double t) const {
+    const SE2 rel = truth(t0).inverse() * truth(t);
+    return 1e3 * std::hypot(tracker_->pose().x - rel.x, tracker_->pose().y - rel.y);
+  }
+
+  ocl::Runtime rt_;
+  sim::Options options_;
+  std::unique_ptr<sim::Renderer> renderer_;
+  std::unique_ptr<Tracker> tracker_;
+};
+
+constexpr double dt = 1.0 / 30;
+
+#define EXPECT_STATUS(result, expected)                                              \
+  do {                                                                               \
+    const FrameResult r_ = (result);                                                 \
+    EXPECT_STREQ(status_name(r_.status), status_name(Status::expected)) << r_.reason; \
+  } while (0)
+
+TEST_F(TrackBadInput, BlackAndSaturatedFramesAreLostThenTrackingResumes) {
+  EXPECT_STATUS(track(good(0), 0), First);
+  for (int k = 1; k <= 3; ++k) EXPECT_STATUS(track(good(k * dt), k * dt), Ok);
+  // Black: lost, the motion is the constant-velocity prediction, the keyframe is kept.
+  const FrameResult black = track(flat(0, 0), 4 * dt);
+  EXPECT_STATUS(black, Lost);
+  EXPECT_FALSE(black.keyframe);
+  const SE2 step = truth(3 * dt).inverse() * truth(4 * dt);
+  EXPECT_NEAR(black.motion.x, step.x, 1e-4);
+  EXPECT_NEAR(black.motion.theta, step.theta, 1e-3);
+  // The next good frame is tracked against the keyframe: the pose is right again.
+  EXPECT_STATUS(track(good(5 * dt), 5 * dt), Ok);
+  EXPECT_LT(pose_error_mm(0, 5 * dt), 0.05);
+  // Saturated: the same.
+  const FrameResult white = track(flat(255, 0), 6 * dt);
+  EXPECT_STATUS(white, Lost);
+  for (int k = 7; k <= 9; ++k) EXPECT_STATUS(track(good(k * dt), k * dt), Ok);
+  EXPECT_LT(pose_error_mm(0, 9 * dt), 0.05);
+}
+
+TEST_F(TrackBadInput, TexturelessFrameIsLost) {
+  track(good(0), 0);
+  track(good(dt), dt);
+  const FrameResult r = track(flat(110, 1.0), 2 * dt);
+  EXPECT_STATUS(r, Lost);
+  EXPECT_STATUS(track(good(3 * dt), 3 * dt), Ok);
+  EXPECT_LT(pose_error_mm(0, 3 * dt), 0.05);
+}
+
+TEST_F(TrackBadInput, BadFirstFramesDoNotBecomeTheKeyframe) {
+  EXPECT_STATUS(track(flat(0, 0), 0), Lost);
+  EXPECT_STATUS(track(flat(128, 1.0), dt), Lost);
+  EXPECT_STATUS(track(good(2 * dt), 2 * dt), First);
+  EXPECT_STATUS(track(good(3 * dt), 3 * dt), Ok);
+}
+
+TEST_F(TrackBadInput, FrameOfAnotherSizeIsLost) {
+  track(good(0), 0);
+  track(good(dt), dt);
+  const FrameResult r = track(flat(100, 5.0, 160, 120), 2 * dt);
+  EXPECT_STATUS(r, Lost);
+  EXPECT_FALSE(r.keyframe);
+  EXPECT_STATUS(track(good(3 * dt), 3 * dt), Ok);
+  EXPECT_LT(pose_error_mm(0, 3 * dt), 0.05);
+}
+
+TEST_F(TrackBadInput, ShortGapIsDegradedButTracked) {
+  track(good(0), 0);
+  track(good(dt), dt);
+  track(good(2 * dt), 2 * dt);
+  // Five frames missing: 50 mm and 0.1 rad in one interval, predicted from the velocity.
+  const FrameResult r = track(good(8 * dt), 8 * dt);
+  EXPECT_STATUS(r, Degraded);
+  const SE2 step = truth(2 * dt).inverse() * truth(8 * dt);
+  EXPECT_LT(1e3 * std::hypot(r.motion.x - step.x, r.motion.y - step.y), 0.05);
+  EXPECT_STATUS(track(good(9 * dt), 9 * dt), Ok);
+  EXPECT_LT(pose_error_mm(0, 9 * dt), 0.05);
+}
+
+TEST_F(TrackBadInput, LongGapIsLostThenTheFrameIsTheNewKeyframe) {
+  track(good(0), 0);
+  track(good(dt), dt);
+  // Three seconds later the robot is a metre away: nothing overlaps. Lost, zero motion (no
+  // prediction over so long), and the textured frame becomes the keyframe.
+  const FrameResult r = track(good(3.0), 3.0);
+  EXPECT_STATUS(r, Lost);
+  EXPECT_TRUE(r.keyframe);
+  EXPECT_EQ(r.motion.x, 0.0);
+  EXPECT_EQ(r.motion.theta, 0.0);
+  const FrameResult next = track(good(3.0 + dt), 3.0 + dt);
+  EXPECT_STATUS(next, Ok);
+  const SE2 step = truth(3.0).inverse() * truth(3.0 + dt);
+  EXPECT_LT(1e3 * std::hypot(next.motion.x - step.x, next.motion.y - step.y), 0.02);
+}
+
+TEST_F(TrackBadInput, BadTimestampsAreDegradedNotNaN) {
+  track(good(0), 0);
+  track(good(dt), dt);
+  // Not finite, repeated, backwards: the frame is tracked with the usual interval assumed.
+  for (const double t : {std::nan(""), dt, 0.5 * dt}) {
+    const FrameResult r = track(good(2 * dt), t);
+    EXPECT_STATUS(r, Degraded);
+    EXPECT_STREQ(r.reason, "timestamp not increasing");
+  }
+  EXPECT_STATUS(track(good(3 * dt), 3 * dt), Ok);
+  EXPECT_LT(pose_error_mm(0, 3 * dt), 0.05);
+}
+
+TEST_F(TrackBadInput, ResetStartsOver) {
+  track(good(0), 0);
+  track(good(dt), dt);
+  tracker_->reset();
+  EXPECT_EQ(tracker_->pose().x, 0.0);
+  EXPECT_STATUS(track(good(2 * dt), 2 * dt), First);
+  EXPECT_STATUS(track(good(3 * dt), 3 * dt), Ok);
+}
+
+}  // namespace
+}  // namespace planarvo::track
