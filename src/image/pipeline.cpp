@@ -1,0 +1,370 @@
+// The OpenCL image pipeline (pipeline.h): buffers, kernels and their launch order, and pyramids
+// between host and device.
+#include "image/pipeline.h"
+
+#include <chrono>
+#include <string>
+
+#include "core/error.h"
+#include "ocl/runtime.h"
+
+namespace planarvo {
+namespace {
+
+// Each work-item of the kernels makes this many consecutive pixels of a row.
+constexpr size_t kPixelsPerItem = 8;
+
+std::string size_text(int w, int h) { return std::to_string(w) + "x" + std::to_string(h); }
+
+[[noreturn]] void throw_opencl(const std::string& what, const cl::Error& e) {
+  throw Error(ErrorCode::OpenCL, "image pipeline: " + what + " failed: " + e.what() + " " +
+                                     ocl::error_name(e.err()));
+}
+
+size_t round_up(size_t n, size_t m) { return (n + m - 1) / m * m; }
+
+std::string wg_options(const char* prefix, int x, int y) {
+  std::string s;
+  if (x > 0) s += std::string("-D ") + prefix + "_WG_X=" + std::to_string(x) + " ";
+  if (y > 0) s += std::string("-D ") + prefix + "_WG_Y=" + std::to_string(y) + " ";
+  return s;
+}
+
+void check_levels(int levels, const char* what) {
+  if (levels < 1 || levels > kMaxPyramidLevels)
+    throw_invalid_argument(std::string(what) + ": levels must be 1.." +
+                           std::to_string(kMaxPyramidLevels) + ", not " + std::to_string(levels));
+}
+
+// Enqueues k over a width x height image: kPixelsPerItem pixels per work-item along x, global
+// sizes rounded up to the work-group (the kernels bounds-check).
+void launch(cl::CommandQueue& q, const cl::Kernel& k, const size_t wg[2], int width, int height) {
+  const size_t items = (static_cast<size_t>(width) + kPixelsPerItem - 1) / kPixelsPerItem;
+  q.enqueueNDRangeKernel(k, cl::NullRange,
+                         cl::NDRange(round_up(items, wg[0]), round_up(static_cast<size_t>(height), wg[1])),
+                         cl::NDRange(wg[0], wg[1]));
+}
+
+cl::Kernel make_kernel(cl::Program& program, const char* name, cl::Device& device, size_t wg[2]) {
+  cl::Kernel k(program, name);
+  // Launch with the compiled reqd_work_group_size, so other -D values need no host change.
+  const auto compiled = k.getWorkGroupInfo<CL_KERNEL_COMPILE_WORK_GROUP_SIZE>(device);
+  wg[0] = compiled[0];
+  wg[1] = compiled[1];
+  return k;
+}
+
+double ms_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------------
+
+Pyramid allocate_pyramid(ocl::Runtime& runtime, int width, int height, int levels) {
+  check_levels(levels, "allocate_pyramid");
+  if (width < 1 || height < 1)
+    throw_invalid_argument("allocate_pyramid: the image size " + size_text(width, height) +
+                           " is not positive");
+  Pyramid p;
+  try {
+    for (int l = 0; l < levels; ++l) {
+      PyramidLevel level;
+      level.width = level_size(width, l);
+      level.height = level_size(height, l);
+      level.data = cl::Buffer(runtime.context(), CL_MEM_READ_WRITE,
+                              static_cast<size_t>(level.width) * static_cast<size_t>(level.height) *
+                                  4 * sizeof(float));
+      p.levels.push_back(std::move(level));
+    }
+  } catch (const cl::Error& e) {
+    throw_opencl("allocating a pyramid of " + size_text(width, height), e);
+  }
+  return p;
+}
+
+Pyramid upload_pyramid(ocl::Runtime& runtime, const std::vector<cv::Mat>& levels) {
+  if (levels.empty() || levels.size() > static_cast<size_t>(kMaxPyramidLevels))
+    throw_invalid_argument("upload_pyramid: expected 1.." + std::to_string(kMaxPyramidLevels) +
+                           " levels, got " + std::to_string(levels.size()));
+  for (size_t l = 0; l < levels.size(); ++l) {
+    if (levels[l].type() != CV_32FC4 || levels[l].empty())
+      throw_invalid_argument("upload_pyramid: level " + std::to_string(l) +
+                             " is not a non-empty CV_32FC4 image");
+    const int w = level_size(levels[0].cols, static_cast<int>(l));
+    const int h = level_size(levels[0].rows, static_cast<int>(l));
+    if (levels[l].cols != w || levels[l].rows != h)
+      throw_invalid_argument("upload_pyramid: level " + std::to_string(l) + " is " +
+                             size_text(levels[l].cols, levels[l].rows) + ", expected " +
+                             size_text(w, h) + " (pyramid.h's level_size)");
+  }
+  Pyramid p = allocate_pyramid(runtime, levels[0].cols, levels[0].rows,
+                               static_cast<int>(levels.size()));
+  try {
+    for (size_t l = 0; l < levels.size(); ++l) {
+      const cv::Mat m = levels[l].isContinuous() ? levels[l] : levels[l].clone();
+      runtime.queue().enqueueWriteBuffer(p.levels[l].data, CL_TRUE, 0, m.total() * m.elemSize(),
+                                         m.ptr());
+    }
+  } catch (const cl::Error& e) {
+    throw_opencl("uploading a pyramid", e);
+  }
+  return p;
+}
+
+std::vector<cv::Mat> download_pyramid(ocl::Runtime& runtime, const Pyramid& pyramid) {
+  std::vector<cv::Mat> out;
+  try {
+    for (const PyramidLevel& level : pyramid.levels) {
+      cv::Mat m(level.height, level.width, CV_32FC4);
+      runtime.queue().enqueueReadBuffer(level.data, CL_TRUE, 0, m.total() * m.elemSize(), m.ptr());
+      out.push_back(m);
+    }
+  } catch (const cl::Error& e) {
+    throw_opencl("downloading a pyramid", e);
+  }
+  return out;
+}
+
+// ---------------------------------------------------------------------------------------------
+
+std::string ImagePipeline::undistort_build_options(const ImagePipelineOptions& o) {
+  return ocl::normalize_build_options(wg_options("UNDISTORT", o.undistort_wg_x, o.undistort_wg_y) +
+                                      (o.fast_math ? "-cl-fast-relaxed-math" : ""));
+}
+
+std::string ImagePipeline::pyramid_build_options(const ImagePipelineOptions& o) {
+  return ocl::normalize_build_options(wg_options("PYRAMID", o.pyramid_wg_x, o.pyramid_wg_y) +
+                                      (o.fast_math ? "-cl-fast-relaxed-math" : ""));
+}
+
+namespace {
+// The default option sets, registered before main() so that `planarvo kernels --export`
+// exports them without a pipeline having been made.
+const bool kDefaultOptionsRegistered = [] {
+  ocl::Runtime::register_build_options("undistort", ImagePipeline::undistort_build_options());
+  ocl::Runtime::register_build_options("pyramid", ImagePipeline::pyramid_build_options());
+  return true;
+}();
+}  // namespace
+
+PipelineKernels::PipelineKernels(ocl::Runtime& runtime, const ImagePipelineOptions& options)
+    : runtime_(runtime) {
+  const std::string undistort_opts = ImagePipeline::undistort_build_options(options);
+  const std::string pyramid_opts = ImagePipeline::pyramid_build_options(options);
+  ocl::Runtime::register_build_options("undistort", undistort_opts);
+  ocl::Runtime::register_build_options("pyramid", pyramid_opts);
+  try {
+    cl::Device& dev = runtime.device();
+    undistort_ = make_kernel(runtime.program("undistort", undistort_opts), "undistort", dev,
+                             undistort_wg_);
+    cl::Program& pyramid = runtime.program("pyramid", pyramid_opts);
+    downsample_ = make_kernel(pyramid, "downsample", dev, pyramid_wg_);
+    gradient_ = make_kernel(pyramid, "gradient", dev, pyramid_wg_);
+  } catch (const cl::Error& e) {
+    throw_opencl("creating the kernels", e);
+  }
+}
+
+PipelineKernels::DeviceMap PipelineKernels::device_map(const UndistortMap& map) {
+  const size_t n = static_cast<size_t>(map.width) * static_cast<size_t>(map.height);
+  DeviceMap d;
+  d.index.assign(n + kPixelsPerItem, -1);
+  d.weights.assign(2 * (n + kPixelsPerItem), 0.0f);
+  for (size_t i = 0; i < n; ++i) {
+    if (!map.valid[i]) continue;
+    // remap_bilinear's arithmetic: valid coordinates are >= 0, so truncation is floor.
+    const float sx = map.map_x[i], sy = map.map_y[i];
+    const int x0 = static_cast<int>(sx), y0 = static_cast<int>(sy);
+    d.index[i] = y0 * map.width + x0;
+    d.weights[2 * i] = sx - static_cast<float>(x0);
+    d.weights[2 * i + 1] = sy - static_cast<float>(y0);
+  }
+  return d;
+}
+
+size_t PipelineKernels::frame_buffer_size(int width, int height) {
+  return static_cast<size_t>(width) * static_cast<size_t>(height) + static_cast<size_t>(width) + 1;
+}
+
+void PipelineKernels::undistort(const cl::Buffer& frame, const cl::Buffer& index,
+                                const cl::Buffer& weights, int width, int height,
+                                const cl::Buffer& dst) {
+  undistort_.setArg(0, frame);
+  undistort_.setArg(1, index);
+  undistort_.setArg(2, weights);
+  undistort_.setArg(3, static_cast<cl_int>(width));
+  undistort_.setArg(4, static_cast<cl_int>(height));
+  undistort_.setArg(5, dst);
+  launch(runtime_.queue(), undistort_, undistort_wg_, width, height);
+}
+
+void PipelineKernels::downsample(const cl::Buffer& src, int src_width, int src_height,
+                                 const cl::Buffer& dst) {
+  const int dw = level_size(src_width, 1), dh = level_size(src_height, 1);
+  downsample_.setArg(0, src);
+  downsample_.setArg(1, static_cast<cl_int>(src_width));
+  downsample_.setArg(2, static_cast<cl_int>(src_height));
+  downsample_.setArg(3, dst);
+  downsample_.setArg(4, static_cast<cl_int>(dw));
+  downsample_.setArg(5, static_cast<cl_int>(dh));
+  launch(runtime_.queue(), downsample_, pyramid_wg_, dw, dh);
+}
+
+void PipelineKernels::gradient(const cl::Buffer& src, int width, int height, const cl::Buffer& dst) {
+  gradient_.setArg(0, src);
+  gradient_.setArg(1, static_cast<cl_int>(width));
+  gradient_.setArg(2, static_cast<cl_int>(height));
+  gradient_.setArg(3, dst);
+  launch(runtime_.queue(), gradient_, pyramid_wg_, width, height);
+}
+
+// ---------------------------------------------------------------------------------------------
+
+struct ImagePipeline::Impl {
+  ocl::Runtime& rt;
+  CameraModel camera;
+  UndistortMap map;
+  int levels = 0;
+  PipelineKernels kernels;
+  cl::Buffer frame;                   // PipelineKernels::frame_buffer_size bytes
+  cl::Buffer map_index, map_weights;  // PipelineKernels::device_map
+  std::vector<cl::Buffer> intensity;  // per level, its intensity image
+  Impl(ocl::Runtime& r, const ImagePipelineOptions& o) : rt(r), kernels(r, o) {}
+
+  int w(int l) const { return level_size(camera.width, l); }
+  int h(int l) const { return level_size(camera.height, l); }
+
+  void ensure(Pyramid& out) const {
+    bool ok = out.num_levels() == levels;
+    for (int l = 0; ok && l < levels; ++l) {
+      const PyramidLevel& level = out.levels[static_cast<size_t>(l)];
+      ok = level.width == w(l) && level.height == h(l) && level.data() != nullptr;
+    }
+    if (!ok) out = allocate_pyramid(rt, camera.width, camera.height, levels);
+  }
+
+  void check_frame(const uint8_t* gray, int fw, int fh, size_t stride) const {
+    if (fw != camera.width || fh != camera.height)
+      throw_invalid_argument("image pipeline: the frame is " + size_text(fw, fh) +
+                             ", the camera's images are " + size_text(camera.width, camera.height));
+    if (!gray) throw_invalid_argument("image pipeline: the frame is null");
+    if (stride < static_cast<size_t>(fw))
+      throw_invalid_argument("image pipeline: the frame's stride " + std::to_string(stride) +
+                             " is less than its width " + std::to_string(fw));
+  }
+
+  void upload(const uint8_t* gray, size_t stride) {
+    // Blocking, so the caller may reuse its frame as soon as process() returns.
+    const size_t row = static_cast<size_t>(camera.width), rows = static_cast<size_t>(camera.height);
+    if (stride == row) {
+      rt.queue().enqueueWriteBuffer(frame, CL_TRUE, 0, row * rows, gray);
+    } else {
+      const cl::array<cl::size_type, 3> origin{0, 0, 0};
+      const cl::array<cl::size_type, 3> region{row, rows, 1};
+      rt.queue().enqueueWriteBufferRect(frame, CL_TRUE, origin, origin, region, row, 0, stride, 0,
+                                        gray);
+    }
+  }
+
+  void undistort() { kernels.undistort(frame, map_index, map_weights, w(0), h(0), intensity[0]); }
+  void pyramid() {
+    for (int l = 1; l < levels; ++l)
+      kernels.downsample(intensity[static_cast<size_t>(l - 1)], w(l - 1), h(l - 1),
+                         intensity[static_cast<size_t>(l)]);
+  }
+  void gradients(Pyramid& out) {
+    for (int l = 0; l < levels; ++l)
+      kernels.gradient(intensity[static_cast<size_t>(l)], w(l), h(l),
+                       out.levels[static_cast<size_t>(l)].data);
+  }
+};
+
+ImagePipeline::ImagePipeline(ocl::Runtime& runtime, const CameraModel& camera, int levels,
+                             const ImagePipelineOptions& options) {
+  check_levels(levels, "image pipeline");
+  UndistortMap map = compute_undistort_map(camera);  // validates the camera
+  impl_ = std::make_unique<Impl>(runtime, options);
+  Impl& m = *impl_;
+  m.camera = camera;
+  m.levels = levels;
+  m.map = std::move(map);
+  PipelineKernels::DeviceMap dm = PipelineKernels::device_map(m.map);
+  // Zeroed, so that the bytes after the frame that the kernel reads (with weight 0) are defined.
+  std::vector<uint8_t> zeros(PipelineKernels::frame_buffer_size(camera.width, camera.height), 0);
+  try {
+    cl::Context& ctx = runtime.context();
+    const cl_mem_flags in = CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR;
+    m.frame = cl::Buffer(ctx, in, zeros.size(), zeros.data());
+    m.map_index = cl::Buffer(ctx, in, dm.index.size() * sizeof(cl_int), dm.index.data());
+    m.map_weights = cl::Buffer(ctx, in, dm.weights.size() * sizeof(float), dm.weights.data());
+    for (int l = 0; l < levels; ++l)
+      m.intensity.emplace_back(ctx, CL_MEM_READ_WRITE,
+                               static_cast<size_t>(m.w(l)) * static_cast<size_t>(m.h(l)) * sizeof(float));
+  } catch (const cl::Error& e) {
+    throw_opencl("allocating buffers for " + size_text(camera.width, camera.height), e);
+  }
+}
+
+ImagePipeline::~ImagePipeline() = default;
+
+int ImagePipeline::width() const { return impl_->camera.width; }
+int ImagePipeline::height() const { return impl_->camera.height; }
+int ImagePipeline::levels() const { return impl_->levels; }
+const CameraModel& ImagePipeline::camera() const { return impl_->camera; }
+const UndistortMap& ImagePipeline::map() const { return impl_->map; }
+
+void ImagePipeline::process(const uint8_t* gray, int width, int height, size_t stride, Pyramid& out) {
+  Impl& m = *impl_;
+  m.check_frame(gray, width, height, stride);
+  m.ensure(out);
+  try {
+    m.upload(gray, stride);
+    m.undistort();
+    m.pyramid();
+    m.gradients(out);
+  } catch (const cl::Error& e) {
+    throw_opencl("processing a frame", e);
+  }
+}
+
+void ImagePipeline::process(const cv::Mat& gray, Pyramid& out) {
+  if (gray.type() != CV_8UC1)
+    throw_invalid_argument("image pipeline: the frame must be 8-bit grey (CV_8UC1)");
+  process(gray.ptr<uint8_t>(), gray.cols, gray.rows, gray.step[0], out);
+}
+
+PipelineTimings ImagePipeline::process_timed(const cv::Mat& gray, Pyramid& out) {
+  if (gray.type() != CV_8UC1)
+    throw_invalid_argument("image pipeline: the frame must be 8-bit grey (CV_8UC1)");
+  Impl& m = *impl_;
+  m.check_frame(gray.ptr<uint8_t>(), gray.cols, gray.rows, gray.step[0]);
+  m.ensure(out);
+  PipelineTimings t;
+  try {
+    cl::CommandQueue& q = m.rt.queue();
+    q.finish();
+    auto t0 = std::chrono::steady_clock::now();
+    m.upload(gray.ptr<uint8_t>(), gray.step[0]);
+    q.finish();
+    t.upload_ms = ms_since(t0);
+    t0 = std::chrono::steady_clock::now();
+    m.undistort();
+    q.finish();
+    t.undistort_ms = ms_since(t0);
+    t0 = std::chrono::steady_clock::now();
+    m.pyramid();
+    q.finish();
+    t.pyramid_ms = ms_since(t0);
+    t0 = std::chrono::steady_clock::now();
+    m.gradients(out);
+    q.finish();
+    t.gradient_ms = ms_since(t0);
+  } catch (const cl::Error& e) {
+    throw_opencl("processing a frame", e);
+  }
+  return t;
+}
+
+}  // namespace planarvo
