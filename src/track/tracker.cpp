@@ -7,6 +7,7 @@
 #include <Eigen/Cholesky>
 
 #include "core/error.h"
+#include "image/pipeline.h"
 #include "ocl/runtime.h"
 #include "track/warp_model.h"
 
@@ -86,6 +87,12 @@ struct Tracker::Impl {
 
   Pyramid keyframe;
   bool has_keyframe = false;
+  // The camera-frame path: the pipeline and two pyramids, one the keyframe's (aliased by
+  // `keyframe`), the other filled with each live frame.
+  std::unique_ptr<ImagePipeline> pipeline;
+  Pyramid slots[2];
+  int live_slot = 0;
+  bool keyframe_is_slot = false;
   SE2 pose;             // accumulated robot pose
   Estimate prev;        // the previous frame relative to the keyframe
   Eigen::Vector3d velocity = Eigen::Vector3d::Zero();  // se(2) per second
@@ -319,22 +326,42 @@ struct Tracker::Impl {
     }
   }
 
-  void make_keyframe(const Pyramid& live, const LevelRange&) {
-    if (keyframe.levels.size() != live.levels.size()) keyframe.levels.clear();
-    for (size_t l = 0; l < live.levels.size(); ++l) {
-      const PyramidLevel& src = live.levels[l];
-      if (keyframe.levels.size() <= l) keyframe.levels.push_back(PyramidLevel());
-      PyramidLevel& dst = keyframe.levels[l];
-      const size_t bytes = static_cast<size_t>(src.width) * src.height * 16;
-      if (dst.width != src.width || dst.height != src.height || !dst.data()) {
-        dst.width = src.width;
-        dst.height = src.height;
-        dst.data = cl::Buffer(rt.context(), CL_MEM_READ_WRITE, bytes);
+  // The live frame becomes the keyframe: a pyramid of ours (`slots`) by swapping, one of the
+  // caller's by copying on the device.
+  void make_keyframe(const Pyramid& live) {
+    if (&live == &slots[live_slot]) {
+      keyframe = live;
+      keyframe_is_slot = true;
+      live_slot ^= 1;
+    } else {
+      if (keyframe_is_slot || keyframe.levels.size() != live.levels.size()) keyframe.levels.clear();
+      keyframe_is_slot = false;
+      for (size_t l = 0; l < live.levels.size(); ++l) {
+        const PyramidLevel& src = live.levels[l];
+        if (keyframe.levels.size() <= l) keyframe.levels.push_back(PyramidLevel());
+        PyramidLevel& dst = keyframe.levels[l];
+        const size_t bytes = static_cast<size_t>(src.width) * src.height * 16;
+        if (dst.width != src.width || dst.height != src.height || !dst.data()) {
+          dst.width = src.width;
+          dst.height = src.height;
+          dst.data = cl::Buffer(rt.context(), CL_MEM_READ_WRITE, bytes);
+        }
+        rt.queue().enqueueCopyBuffer(src.data, dst.data, 0, 0, bytes);
       }
-      rt.queue().enqueueCopyBuffer(src.data, dst.data, 0, 0, bytes);
     }
     has_keyframe = true;
     prev = Estimate();
+  }
+
+  FrameResult track_gray(const uint8_t* gray, int width, int height, size_t stride, double t) {
+    if (!gray) throw_invalid_argument("Tracker::track: the image is null");
+    if (width > 0 && stride < static_cast<size_t>(width))
+      throw_invalid_argument("Tracker::track: stride " + std::to_string(stride) + " < width " +
+                             std::to_string(width));
+    if (width != camera.width || height != camera.height) return track(Pyramid(), t);
+    if (!pipeline) pipeline = std::make_unique<ImagePipeline>(rt, camera, opt.levels);
+    pipeline->process(gray, width, height, stride, slots[live_slot]);
+    return track(slots[live_slot], t);
   }
 
   bool right_size(const Pyramid& live) const {
@@ -386,7 +413,7 @@ struct Tracker::Impl {
       res.covariance = lost_covariance();
       pose = pose * predicted;
       if (can_be_keyframe) {
-        make_keyframe(live, level_range(live));
+        make_keyframe(live);
         res.keyframe = true;
       } else {
         prev.T = prev.T * predicted;
@@ -409,7 +436,7 @@ struct Tracker::Impl {
         res.reason = kNoTexture;
         return done(res);
       }
-      make_keyframe(live, level_range(live));
+      make_keyframe(live);
       res.status = Status::First;
       res.keyframe = true;
       since_good = 0.0;
@@ -455,7 +482,7 @@ struct Tracker::Impl {
     if (dt > 0.0) velocity = res.motion.log() / dt;
     since_good = 0.0;
     if (res.overlap < opt.keyframe_overlap) {
-      make_keyframe(live, level_range(live));
+      make_keyframe(live);
       res.keyframe = true;
     } else {
       prev = est;
@@ -471,6 +498,9 @@ Tracker::Tracker(ocl::Runtime& runtime, const CameraModel& camera, const Extrins
 Tracker::~Tracker() = default;
 
 FrameResult Tracker::track(const Pyramid& live, double timestamp) { return impl_->track(live, timestamp); }
+FrameResult Tracker::track(const uint8_t* gray, int width, int height, size_t stride, double timestamp) {
+  return impl_->track_gray(gray, width, height, stride, timestamp);
+}
 void Tracker::reset() { impl_->reset(); }
 const SE2& Tracker::pose() const { return impl_->pose; }
 const TrackerOptions& Tracker::options() const { return impl_->opt; }

@@ -4,6 +4,8 @@
 // and measurements: src/track/README.md.
 #pragma once
 #include <array>
+#include <cstddef>
+#include <cstdint>
 #include <memory>
 
 #include <Eigen/Core>
@@ -118,10 +120,18 @@ class Tracker {
   Tracker(const Tracker&) = delete;
   Tracker& operator=(const Tracker&) = delete;
 
-  // Tracks one frame's device pyramid (pyramid.h: level 0 of the camera's size; at least
-  // options.levels levels, or as many as it has). The pyramid is only read; when the frame
-  // becomes the keyframe its levels are copied on the device. timestamp in seconds.
-  // A pyramid of another size is Lost (not an exception).
+  // Tracks one camera frame: 8-bit grey, width x height (the camera's size), rows `stride`
+  // bytes apart, timestamp in seconds. The image pipeline (image/pipeline.h: upload,
+  // undistortion, pyramid, gradients; created on the first frame) fills one of two device
+  // pyramids that the tracker swaps with the keyframe's, so nothing is copied. A frame of
+  // another size is Lost (not an exception); a null image or stride < width is
+  // InvalidArgument.
+  FrameResult track(const uint8_t* gray, int width, int height, size_t stride, double timestamp);
+
+  // Tracks one frame's device pyramid made elsewhere (pyramid.h: level 0 of the camera's
+  // size; options.levels levels, or as many as it has). The pyramid is only read; when the
+  // frame becomes the keyframe its levels are copied on the device. A pyramid of another
+  // size is Lost.
   FrameResult track(const Pyramid& live, double timestamp);
 
   // Forgets the keyframe, the pose, the velocity and the residual scales.
