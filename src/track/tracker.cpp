@@ -359,9 +359,17 @@ struct Tracker::Impl {
       throw_invalid_argument("Tracker::track: stride " + std::to_string(stride) + " < width " +
                              std::to_string(width));
     if (width != camera.width || height != camera.height) return track(Pyramid(), t);
+    const auto t0 = std::chrono::steady_clock::now();
     if (!pipeline) pipeline = std::make_unique<ImagePipeline>(rt, camera, opt.levels);
     pipeline->process(gray, width, height, stride, slots[live_slot]);
-    return track(slots[live_slot], t);
+    // Waiting here costs one synchronisation (the first pass would wait anyway) and splits
+    // the frame's time between the pipeline and the tracker.
+    rt.queue().finish();
+    const auto t1 = std::chrono::steady_clock::now();
+    FrameResult r = track(slots[live_slot], t);
+    r.pipeline_ms = std::chrono::duration<double, std::milli>(t1 - t0).count();
+    r.ms += r.pipeline_ms;
+    return r;
   }
 
   bool right_size(const Pyramid& live) const {

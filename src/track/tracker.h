@@ -106,6 +106,7 @@ struct FrameResult {
   double log_gain = 0, bias = 0;  // brightness relative to the keyframe
   bool keyframe = false;       // this frame became the keyframe
   double ms = 0;               // wall time of track(), milliseconds
+  double pipeline_ms = 0;      // of which the image pipeline (camera-frame API only)
 };
 
 const char* status_name(FrameResult::Status s);

@@ -2,6 +2,7 @@
 //   bench_track kernel   [width height]   the fused pass per work-group shape / pixels per
 //                                          work-item / fast math, median ms per pass
 //   bench_track kernel w h wx wy pix hist fast [rounds]   one configuration
+//   bench_track speed [w h] [seconds] [rounds]   ms per frame through the camera-frame API
 //   bench_track accuracy [key=value...]     simulated sequences tracked against ground truth
 //       (seconds, w, h, seed, levels, finest, refine_kf, conv, huber, overlap, maxit=l0,l1,..,
 //        textures=a.png,b.png; see main())
@@ -21,6 +22,7 @@
 #include "image/undistort.h"
 #include "io/simulator.h"
 #include "ocl/runtime.h"
+#include "track/evaluation.h"
 #include "track/tracker.h"
 #include "track/warp_model.h"
 #include "track/warp_reduce.h"
@@ -123,93 +125,69 @@ int bench_kernel(int width, int height, const std::vector<KernelConfig>& only, i
   return 0;
 }
 
-struct SequenceSpec {
-  std::string texture;
-  double seconds = 10.0;
-  int width = 640, height = 480;
-  uint64_t seed = 1;
+// The simulator's frames of a sequence: 8-bit camera images, times and true poses.
+struct Sequence {
+  sim::Options options;
+  sim::Trajectory trajectory;
+  std::vector<cv::Mat> frames;  // rendered on demand when not kept
 };
+
+sim::Options sequence_options(const std::string& texture, double seconds, int width, int height, uint64_t seed) {
+  sim::Options so;
+  so.texture = texture_path(texture);
+  so.camera = sim::default_camera(width, height);
+  so.seconds = seconds;
+  so.seed = seed;
+  return so;
+}
 
 struct SequenceReport {
   int frames = 0, ok = 0, degraded = 0, lost = 0, keyframes = 0;
-  double slope_v = 0, slope_w = 0, rms_mm = 0, max_mm = 0, rms_deg = 0;
-  int gross = 0;
-  double distance = 0, drift_pct = 0, heading_drift_deg = 0;
-  double ms_render = 0, ms_pyramid = 0, ms_track = 0;
+  track::MotionAccuracy acc;
+  double ms_frame = 0, ms_pipeline = 0, cpu_frame = 0;
   double passes[kMaxLevelsBench] = {};
   double level_ms[kMaxLevelsBench] = {};
-  double cpu_track = 0;
 };
 
-SequenceReport run_sequence(ocl::Runtime& rt, const SequenceSpec& spec, const track::TrackerOptions& topt,
+// Renders and tracks a sequence frame by frame through the camera-frame API.
+SequenceReport run_sequence(ocl::Runtime& rt, const sim::Options& so, const track::TrackerOptions& topt,
                             bool verbose) {
-  sim::Options so;
-  so.texture = texture_path(spec.texture);
-  so.camera = sim::default_camera(spec.width, spec.height);
-  so.seconds = spec.seconds;
-  so.seed = spec.seed;
   const sim::Trajectory traj = sim::generate_trajectory(so);
   const std::vector<sim::Exposure> exposure = sim::exposure_series(so, traj.t);
   sim::Renderer renderer(rt, cv::imread(so.texture, cv::IMREAD_GRAYSCALE), so);
-  const UndistortMap map = compute_undistort_map(so.camera);
   track::Tracker tracker(rt, so.camera, so.extrinsics, topt);
-
   SequenceReport rep;
-  double sxx_v = 0, sxy_v = 0, sxx_w = 0, sxy_w = 0, se2 = 0, sr2 = 0;
-  int n = 0;
-  SE2 est_pose;
+  std::vector<SE2> est, truth;
+  std::vector<double> dts;
   for (size_t k = 0; k < traj.t.size(); ++k) {
-    double t0 = now_ms();
     const cv::Mat img = sim::apply_camera(renderer.render_float(traj.pose[k]), exposure[k], so.pixel_noise,
                                           sim::derive_seed(so.seed, 1000 + k));
-    double t1 = now_ms();
-    const Pyramid pyr = test::test_upload(rt, test::test_pyramid(img, &map, topt.levels));
-    rt.queue().finish();
-    double t2 = now_ms();
-    const double c2 = cpu_ms();
-    const track::FrameResult r = tracker.track(pyr, traj.t[k]);
-    double t3 = now_ms();
-    rep.cpu_track += cpu_ms() - c2;
-    rep.ms_render += t1 - t0;
-    rep.ms_pyramid += t2 - t1;
-    rep.ms_track += t3 - t2;
+    const double c0 = cpu_ms();
+    const track::FrameResult r = tracker.track(img.data, img.cols, img.rows, img.step, traj.t[k]);
+    rep.cpu_frame += cpu_ms() - c0;
+    rep.ms_frame += r.ms;
+    rep.ms_pipeline += r.pipeline_ms;
     ++rep.frames;
     rep.keyframes += r.keyframe;
     for (int l = 0; l < kMaxLevelsBench; ++l) {
       rep.passes[l] += r.iterations[static_cast<size_t>(l)];
       rep.level_ms[l] += r.level_ms[static_cast<size_t>(l)];
     }
-    if (r.status == track::FrameResult::Status::Ok) ++rep.ok;
-    if (r.status == track::FrameResult::Status::Degraded) ++rep.degraded;
-    if (r.status == track::FrameResult::Status::Lost) ++rep.lost;
+    rep.ok += r.status == track::FrameResult::Status::Ok;
+    rep.degraded += r.status == track::FrameResult::Status::Degraded;
+    rep.lost += r.status == track::FrameResult::Status::Lost;
     if (k == 0) continue;
-    const SE2 truth = traj.pose[k - 1].inverse() * traj.pose[k];
-    const double dt = traj.t[k] - traj.t[k - 1];
-    est_pose = est_pose * r.motion;
-    const double e = std::hypot(r.motion.x - truth.x, r.motion.y - truth.y);
-    const double er = wrap_angle(r.motion.theta - truth.theta);
-    se2 += e * e;
-    sr2 += er * er;
-    rep.max_mm = std::max(rep.max_mm, e * 1e3);
-    rep.gross += e > 1e-3;
-    rep.distance += std::hypot(truth.x, truth.y);
-    sxx_v += truth.x * truth.x / (dt * dt);
-    sxy_v += truth.x * r.motion.x / (dt * dt);
-    sxx_w += truth.theta * truth.theta / (dt * dt);
-    sxy_w += truth.theta * r.motion.theta / (dt * dt);
-    ++n;
+    const SE2 t = traj.pose[k - 1].inverse() * traj.pose[k];
+    est.push_back(r.motion);
+    truth.push_back(t);
+    dts.push_back(traj.t[k] - traj.t[k - 1]);
+    const double e = std::hypot(r.motion.x - t.x, r.motion.y - t.y);
     if (verbose && (e > 1e-3 || r.status != track::FrameResult::Status::Ok))
       std::printf("  frame %zu: %s %s err %.3f mm, truth (%.4f %.4f %.4f) est (%.4f %.4f %.4f) overlap %.2f\n", k,
-                  track::status_name(r.status), r.reason, e * 1e3, truth.x, truth.y, truth.theta, r.motion.x,
-                  r.motion.y, r.motion.theta, r.overlap);
+                  track::status_name(r.status), r.reason, e * 1e3, t.x, t.y, t.theta, r.motion.x, r.motion.y,
+                  r.motion.theta, r.overlap);
   }
-  const SE2 true_end = traj.pose.front().inverse() * traj.pose.back();
-  rep.slope_v = sxx_v > 0 ? sxy_v / sxx_v : 0;
-  rep.slope_w = sxx_w > 0 ? sxy_w / sxx_w : 0;
-  rep.rms_mm = n ? 1e3 * std::sqrt(se2 / n) : 0;
-  rep.rms_deg = n ? std::sqrt(sr2 / n) * 180 / M_PI : 0;
-  rep.drift_pct = rep.distance > 0 ? 100 * std::hypot(est_pose.x - true_end.x, est_pose.y - true_end.y) / rep.distance : 0;
-  rep.heading_drift_deg = wrap_angle(est_pose.theta - true_end.theta) * 180 / M_PI;
+  rep.acc = track::evaluate_motions(est, truth, dts);
   return rep;
 }
 
@@ -217,29 +195,92 @@ int bench_accuracy(const std::vector<std::string>& textures, double seconds, int
                    uint64_t seed, const track::TrackerOptions& topt, bool verbose) {
   ocl::Runtime rt;
   std::printf("device: %s\n", rt.device_info().device_name.c_str());
-  std::printf("%dx%d, %.0f s at 30 Hz per texture, mixed motion up to 0.8 m/s and 1.5 rad/s, noise 1, gain +-5%%, "
-              "configuration 1; levels %d..%d\n", width, height, seconds, topt.levels - 1, topt.finest_level);
-  std::printf("%-20s %6s %4s %4s %4s %4s %8s %8s %8s %8s %8s %5s %7s %7s %8s %8s   %s\n", "texture", "frames", "ok",
-              "deg", "lost", "kf", "slope_v", "slope_w", "rms_mm", "max_mm", "rms_deg", "gross", "drift%", "head_dg",
-              "ms_pyr*", "ms_track", "passes/frame by level");
+  std::printf("%dx%d, %.0f s at 30 Hz per texture (seed %llu), mixed motion up to 0.8 m/s and 1.5 rad/s, noise 1 grey "
+              "level, gain/offset drift 5%%, configuration 1, lens distortion; tracker levels %d, finest %d "
+              "(-1: auto)\n", width, height, seconds, static_cast<unsigned long long>(seed), topt.levels,
+              topt.finest_level);
+  std::printf("%-22s %6s %4s %4s %4s %4s %8s %8s %7s %7s %8s %5s %7s %7s %7s %7s  %s\n", "texture", "frames", "ok",
+              "deg", "lost", "kf", "slope_v", "slope_w", "rms_mm", "max_mm", "rms_deg", "gross", "drift%", "ms/fr",
+              "ms_pipe", "cpu/fr", "passes per frame, coarse to fine");
   for (const std::string& tex : textures) {
-    SequenceSpec spec;
-    spec.texture = tex;
-    spec.seconds = seconds;
-    spec.width = width;
-    spec.height = height;
-    spec.seed = seed;
-    const SequenceReport r = run_sequence(rt, spec, topt, verbose);
-    std::printf("%-20s %6d %4d %4d %4d %4d %8.5f %8.5f %8.4f %8.4f %8.5f %5d %7.3f %7.3f %8.2f %8.2f  ", tex.c_str(),
-                r.frames, r.ok, r.degraded, r.lost, r.keyframes, r.slope_v, r.slope_w, r.rms_mm, r.max_mm, r.rms_deg,
-                r.gross, r.drift_pct, r.heading_drift_deg, r.ms_pyramid / r.frames, r.ms_track / r.frames);
-    for (int l = topt.levels - 1; l >= 0; --l) std::printf(" %.2f", r.passes[l] / r.frames);
-    std::printf("\n%-20s cpu ms/frame in track %.2f; wall ms per level:", "", r.cpu_track / r.frames);
-    for (int l = topt.levels - 1; l >= 0; --l) std::printf(" L%d %.2f", l, r.level_ms[l] / r.frames);
+    const SequenceReport r = run_sequence(rt, sequence_options(tex, seconds, width, height, seed), topt, verbose);
+    const double n = r.frames;
+    std::printf("%-22s %6d %4d %4d %4d %4d %8.5f %8.5f %7.4f %7.4f %8.5f %5d %7.3f %7.2f %7.2f %7.2f ", tex.c_str(),
+                r.frames, r.ok, r.degraded, r.lost, r.keyframes, r.acc.slope_linear, r.acc.slope_angular,
+                r.acc.rms_translation * 1e3, r.acc.max_translation * 1e3, r.acc.rms_rotation * 180 / M_PI,
+                r.acc.gross_errors, r.acc.endpoint_drift * 100, r.ms_frame / n, r.ms_pipeline / n, r.cpu_frame / n);
+    for (int l = topt.levels - 1; l >= 0; --l) std::printf(" %.2f", r.passes[l] / n);
     std::printf("\n");
     std::fflush(stdout);
   }
-  std::printf("* ms_pyr: the tests' host-side pyramid and upload (not the OpenCL image pipeline)\n");
+  return 0;
+}
+
+// Speed: frames rendered once into memory, then tracked repeatedly with each configuration,
+// the configurations interleaved so that load from other processes spreads over all of them.
+int bench_speed(int width, int height, double seconds, int rounds) {
+  ocl::Runtime rt;
+  std::printf("device: %s\n", rt.device_info().device_name.c_str());
+  const sim::Options so = sequence_options("asphalt_01.png", seconds, width, height, 1);
+  const sim::Trajectory traj = sim::generate_trajectory(so);
+  const std::vector<sim::Exposure> exposure = sim::exposure_series(so, traj.t);
+  std::vector<cv::Mat> frames;
+  {
+    sim::Renderer renderer(rt, cv::imread(so.texture, cv::IMREAD_GRAYSCALE), so);
+    for (size_t k = 0; k < traj.t.size(); ++k)
+      frames.push_back(sim::apply_camera(renderer.render_float(traj.pose[k]), exposure[k], so.pixel_noise,
+                                         sim::derive_seed(so.seed, 1000 + k)));
+  }
+  struct Config {
+    const char* name;
+    track::TrackerOptions opt;
+  };
+  std::vector<Config> configs;
+  {
+    track::TrackerOptions o;
+    configs.push_back({"default (finest auto)", o});
+    o.finest_level = 0;
+    configs.push_back({"finest level 0", o});
+    o.finest_level = -1;
+    o.refine_keyframes = true;
+    configs.push_back({"auto + refine keyframes", o});
+    o.refine_keyframes = false;
+    o.levels = 3;
+    configs.push_back({"3 levels", o});
+  }
+  struct Stats {
+    std::vector<double> frame, pipe, track;
+    double cpu = 0, passes = 0;
+    int n = 0;
+  };
+  std::vector<Stats> stats(configs.size());
+  for (int round = 0; round < rounds; ++round)
+    for (size_t c = 0; c < configs.size(); ++c) {
+      track::Tracker tracker(rt, so.camera, so.extrinsics, configs[c].opt);
+      for (size_t k = 0; k < frames.size(); ++k) {
+        const double c0 = cpu_ms();
+        const track::FrameResult r = tracker.track(frames[k].data, frames[k].cols, frames[k].rows, frames[k].step, traj.t[k]);
+        if (k == 0) continue;  // the first frame builds the pipeline
+        stats[c].cpu += cpu_ms() - c0;
+        stats[c].frame.push_back(r.ms);
+        stats[c].pipe.push_back(r.pipeline_ms);
+        stats[c].track.push_back(r.ms - r.pipeline_ms);
+        for (int p : r.iterations) stats[c].passes += p;
+        ++stats[c].n;
+      }
+    }
+  std::printf("%dx%d, %zu frames of asphalt_01 (mixed motion) x %d rounds, camera-frame API (upload, undistortion, "
+              "pyramid, tracking)\n", width, height, frames.size(), rounds);
+  std::printf("%-26s %9s %9s %9s %9s %9s %8s %7s\n", "configuration", "med_frame", "mean_frame", "med_pipe",
+              "med_track", "cpu/frame", "passes", "fps");
+  for (size_t c = 0; c < configs.size(); ++c) {
+    const Stats& s = stats[c];
+    double mean = 0;
+    for (double v : s.frame) mean += v;
+    mean /= std::max<size_t>(1, s.frame.size());
+    std::printf("%-26s %9.2f %9.2f %9.2f %9.2f %9.2f %8.2f %7.0f\n", configs[c].name, median(s.frame), mean,
+                median(s.pipe), median(s.track), s.cpu / s.n, s.passes / s.n, 1000.0 / mean);
+  }
   return 0;
 }
 
@@ -253,6 +294,11 @@ int main(int argc, char** argv) {
     if (argc > 8)
       only.push_back({std::atoi(argv[4]), std::atoi(argv[5]), std::atoi(argv[6]), std::atoi(argv[7]), std::atoi(argv[8]) != 0});
     return bench_kernel(w, h, only, argc > 9 ? std::atoi(argv[9]) : 6);
+  }
+  if (mode == "speed") {
+    // bench_track speed [w h] [seconds] [rounds]
+    const int w = argc > 3 ? std::atoi(argv[2]) : 640, h = argc > 3 ? std::atoi(argv[3]) : 480;
+    return bench_speed(w, h, argc > 4 ? std::atof(argv[4]) : 5.0, argc > 5 ? std::atoi(argv[5]) : 3);
   }
   if (mode == "accuracy") {
     // bench_track accuracy [key=value ...]: seconds=10 w=640 h=480 levels=4 finest=0
@@ -299,6 +345,7 @@ int main(int argc, char** argv) {
     }
     return bench_accuracy(tex, seconds, w, h, seed, topt, std::getenv("BENCH_VERBOSE") != nullptr);
   }
-  std::fprintf(stderr, "usage: bench_track kernel [w h [wx wy pix hist fast [rounds]]] | accuracy [key=value...]\n");
+  std::fprintf(stderr, "usage: bench_track kernel [w h [wx wy pix hist fast [rounds]]] | speed [w h [seconds [rounds]]]"
+                       " | accuracy [key=value...]\n");
   return 2;
 }
