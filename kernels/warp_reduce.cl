@@ -25,7 +25,7 @@
 // WG_Y); pixels beyond the level are masked out. Row g of the partials belongs to work-group
 // (group_id(0) + num_groups(0) * group_id(1)).
 //
-// Build options (-D): NPARAM (3), WG_X (64), WG_Y (1), PIX (4), STATS (0: 1 adds the
+// Build options (-D): NPARAM (3), WG_X (16), WG_Y (1), PIX (8), STATS (0: 1 adds the
 // statistics below and a histogram of HIST_BINS (16) bins of |r|),
 // DEBUG_OUTPUT (off: when defined, a last argument receives per reference pixel
 // (r, weight, valid, rho); not for the fast path).
@@ -33,13 +33,13 @@
 #define NPARAM 3
 #endif
 #ifndef WG_X
-#define WG_X 64
+#define WG_X 16
 #endif
 #ifndef WG_Y
 #define WG_Y 1
 #endif
 #ifndef PIX
-#define PIX 4
+#define PIX 8
 #endif
 #ifndef STATS
 #define STATS 0

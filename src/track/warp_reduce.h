@@ -102,15 +102,15 @@ struct LevelView {
 // kernel's work distribution makes it.
 
 ReduceSums warp_reduce_reference(const LevelView& ref, const LevelView& live,
-                                 const WarpInputs& in, const ReduceLayout& layout, int wg_x = 64,
-                                 int pixels_per_item = 4);
+                                 const WarpInputs& in, const ReduceLayout& layout, int wg_x = 16,
+                                 int pixels_per_item = 8);
 
 struct WarpReduceOptions {
-  int wg_x = 64, wg_y = 1;   // work-group shape (WG_X x WG_Y must be a power of two)
-  int pixels_per_item = 4;   // PIX: pixels per work-item along a row, WG_X apart
+  int wg_x = 16, wg_y = 1;   // work-group shape (WG_X x WG_Y must be a power of two)
+  int pixels_per_item = 8;   // PIX: pixels per work-item along a row, WG_X apart
   bool stats = false;        // the STATS variant: residual, intensity and gradient statistics
   int hist_bins = 16;        // and a histogram of |r| for the robust scale (with stats only)
-  bool fast_math = true;     // -cl-fast-relaxed-math (measured: see src/track/README.md)
+  bool fast_math = false;    // -cl-fast-relaxed-math (no faster on PoCL: src/track/README.md)
   bool debug_output = false; // per-pixel (r, weight, valid, rho) into a debug buffer
 };
 

@@ -277,6 +277,41 @@ TEST_F(WarpReduceKernel, IdentityWarpOfALevelOnItselfHasZeroResidual) {
   for (int j = 0; j < s.hist_bins; ++j) EXPECT_EQ(s.hist[static_cast<size_t>(j)], s.hist_valid);
 }
 
+TEST_F(WarpReduceKernel, DebugVariantWritesEveryPixelConsistentWithTheSums) {
+  // The debug variant's per-pixel (r, weight, valid, rho), poisoned first: every reference
+  // pixel written, and their sums equal to the reduced sums.
+  std::mt19937 rng(99);
+  const int w = 75, h = 31;
+  const std::vector<float> ref = random_level(rng, w, h), live = random_level(rng, w + 3, h + 2);
+  const WarpInputs in = random_inputs(rng, 3, w + 3, h + 2);
+  WarpReduceOptions o;
+  o.debug_output = true;
+  WarpReduce wr(rt_, 3, o);
+  cl::Buffer bref(rt_.context(), CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, ref.size() * 4, const_cast<float*>(ref.data()));
+  cl::Buffer blive(rt_.context(), CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, live.size() * 4, const_cast<float*>(live.data()));
+  std::vector<float> dbg(static_cast<size_t>(w) * h * 4 + 16, poison());
+  cl::Buffer bdbg(rt_.context(), CL_MEM_READ_WRITE | CL_MEM_COPY_HOST_PTR, dbg.size() * 4, dbg.data());
+  ReduceSums s;
+  wr.run(bref, w, h, blive, w + 3, h + 2, in, &s, &bdbg);
+  rt_.queue().enqueueReadBuffer(bdbg, CL_TRUE, 0, dbg.size() * 4, dbg.data());
+  double sum_r2 = 0, sum_wr2 = 0, sum_valid = 0, sum_rho = 0;
+  int unwritten = 0;
+  for (int i = 0; i < w * h; ++i) {
+    const float* d = &dbg[4 * static_cast<size_t>(i)];
+    if (std::isnan(d[0]) || std::isnan(d[1]) || std::isnan(d[2]) || std::isnan(d[3])) ++unwritten;
+    sum_r2 += static_cast<double>(d[0]) * d[0];
+    sum_wr2 += static_cast<double>(d[1]) * d[0] * d[0];
+    sum_valid += d[2];
+    sum_rho += d[3];
+  }
+  EXPECT_EQ(unwritten, 0);
+  for (size_t i = static_cast<size_t>(w) * h * 4; i < dbg.size(); ++i) EXPECT_TRUE(std::isnan(dbg[i]));
+  EXPECT_EQ(sum_valid, s.valid);
+  EXPECT_NEAR(sum_rho, s.cost, 1e-5 * s.cost);
+  EXPECT_NEAR(sum_wr2, s.wrr, 1e-5 * s.wrr);
+  EXPECT_GT(sum_r2, sum_wr2);  // the random levels have outliers
+}
+
 TEST_F(WarpReduceKernel, MedianFromHistogram) {
   ReduceSums s;
   s.hist_bins = 16;
