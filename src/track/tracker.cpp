@@ -224,8 +224,19 @@ struct Tracker::Impl {
         *reason = kNoLiveTexture;
         return false;
       }
-      const double med = cur.median_abs_residual();
-      const double measured = std::clamp(kMadToSigma * med, opt.min_sigma, opt.max_sigma);
+      // The level's robust scale from this pass's residuals. The threshold in use came from the
+      // previous frame; when the scale has moved by more than rescale_ratio (the robot starts
+      // moving after standing still, the exposure jumps, something covers the ground), the
+      // level restarts with the new threshold: one more pass, and the cost stays one function
+      // within the level.
+      const double measured =
+          std::clamp(kMadToSigma * cur.median_abs_residual(), opt.min_sigma, opt.max_sigma);
+      double& used = sigma[static_cast<size_t>(level)];
+      if (!(measured <= used * opt.rescale_ratio && measured >= used / opt.rescale_ratio)) {
+        used = measured;
+        evaluate(live, level, e, true, &cur);
+        ++passes;
+      }
       if (level <= range.finest) {
         finest_stats = cur;
         finest_sigma = measured;
@@ -265,7 +276,7 @@ struct Tracker::Impl {
           lambda = lambda == 0.0 ? opt.lambda_min : lambda * opt.lambda_up;
         }
       }
-      sigma[static_cast<size_t>(level)] = measured;
+      used = measured;
       res->level_ms[static_cast<size_t>(level)] =
           std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - level_start).count();
       if (!finite(e.T) || !std::isfinite(e.a) || !std::isfinite(e.b)) {

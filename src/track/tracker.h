@@ -43,11 +43,14 @@ struct TrackerOptions {
   // Convergence: a step that moves no pixel of the level (its corners and centre) by more than
   // this many pixels of that level ends the level.
   double convergence_px = 0.05;
-  // Huber threshold k = huber_factor * sigma, sigma = 1.4826 * median |r| per level, measured
-  // at the level's first pass and used from the next frame on (so the cost stays one function
-  // within a frame), clamped to [min_sigma, max_sigma]; initial_sigma until measured.
+  // Huber threshold k = huber_factor * sigma, sigma = 1.4826 * median |r| per level (clamped
+  // to [min_sigma, max_sigma]), measured at the level's first pass. That pass is weighted
+  // with the previous frame's sigma (initial_sigma at first); when the new one differs by
+  // more than a factor rescale_ratio the level restarts with it (one more pass), so that the
+  // cost is one function within a level.
   double huber_factor = 2.0;
   double initial_sigma = 8.0, min_sigma = 0.5, max_sigma = 40.0;  // grey levels
+  double rescale_ratio = 1.25;
   // Estimate the affine brightness change (r = e^a I_l + b - I_r) jointly with the motion.
   bool estimate_brightness = true;
   // Levenberg damping: H + lambda diag(H); lambda starts at 0 (Gauss-Newton) and grows by
@@ -65,14 +68,16 @@ struct TrackerOptions {
   // intensity variance over the overlap (about 1 for unrelated images after the brightness
   // fit; 0.02-0.1 on the simulator at 640x480, up to 0.26 at 320x240 where pixel noise
   // dominates): above lost_residual_ratio Lost, above degraded_residual_ratio Degraded.
-  // Inlier fraction below min_inlier_fraction: Degraded. |a| > max_log_gain: Lost.
+  // Inlier fraction below min_inlier_fraction: Degraded (with k = 2 sigma of this frame's own
+  // residuals, Gaussian residuals give 0.95; a heavy tail of unexplained pixels, fewer).
+  // |a| > max_log_gain: Lost.
   double max_gap_factor = 2.5;
   double max_gap_seconds = 0.5;
   double min_texture_ratio = 0.1;
   double min_valid_fraction = 0.05;
   double lost_residual_ratio = 0.75;
   double degraded_residual_ratio = 0.5;
-  double min_inlier_fraction = 0.5;
+  double min_inlier_fraction = 0.6;
   double max_log_gain = 0.7;
   // The fused pass's work-group shape etc. (stats and debug_output are set by the tracker).
   WarpReduceOptions kernel = default_kernel_options();

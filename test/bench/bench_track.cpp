@@ -4,8 +4,8 @@
 //   bench_track kernel w h wx wy pix hist fast [rounds]   one configuration
 //   bench_track speed [w h] [seconds] [rounds]   ms per frame through the camera-frame API
 //   bench_track accuracy [key=value...]     simulated sequences tracked against ground truth
-//       (seconds, w, h, seed, levels, finest, refine_kf, conv, huber, overlap, maxit=l0,l1,..,
-//        textures=a.png,b.png; see main())
+//       (seconds, w, h, seed, motion=mixed|straight|circle|spin, levels, finest, refine_kf, conv,
+//        huber, overlap, maxit=l0,l1,.., textures=a.png,b.png or textures=all; see main())
 #include <algorithm>
 #include <cmath>
 #include <chrono>
@@ -192,7 +192,7 @@ SequenceReport run_sequence(ocl::Runtime& rt, const sim::Options& so, const trac
 }
 
 int bench_accuracy(const std::vector<std::string>& textures, double seconds, int width, int height,
-                   uint64_t seed, const track::TrackerOptions& topt, bool verbose) {
+                   uint64_t seed, sim::MotionProfile motion, const track::TrackerOptions& topt, bool verbose) {
   ocl::Runtime rt;
   std::printf("device: %s\n", rt.device_info().device_name.c_str());
   std::printf("%dx%d, %.0f s at 30 Hz per texture (seed %llu), mixed motion up to 0.8 m/s and 1.5 rad/s, noise 1 grey "
@@ -203,7 +203,9 @@ int bench_accuracy(const std::vector<std::string>& textures, double seconds, int
               "deg", "lost", "kf", "slope_v", "slope_w", "rms_mm", "max_mm", "rms_deg", "gross", "drift%", "ms/fr",
               "ms_pipe", "cpu/fr", "passes per frame, coarse to fine");
   for (const std::string& tex : textures) {
-    const SequenceReport r = run_sequence(rt, sequence_options(tex, seconds, width, height, seed), topt, verbose);
+    sim::Options so = sequence_options(tex, seconds, width, height, seed);
+    so.motion = motion;
+    const SequenceReport r = run_sequence(rt, so, topt, verbose);
     const double n = r.frames;
     std::printf("%-22s %6d %4d %4d %4d %4d %8.5f %8.5f %7.4f %7.4f %8.5f %5d %7.3f %7.2f %7.2f %7.2f ", tex.c_str(),
                 r.frames, r.ok, r.degraded, r.lost, r.keyframes, r.acc.slope_linear, r.acc.slope_angular,
@@ -306,6 +308,7 @@ int main(int argc, char** argv) {
     double seconds = 10.0;
     int w = 640, h = 480;
     uint64_t seed = 1;
+    sim::MotionProfile motion = sim::MotionProfile::Mixed;
     track::TrackerOptions topt;
     std::vector<std::string> tex = {"asphalt_01.png", "anti_skid_tiles.png", "brick_floor.png",
                                     "aerial_ground_rock.png"};
@@ -328,6 +331,11 @@ int main(int argc, char** argv) {
       else if (k == "w") w = std::atoi(v.c_str());
       else if (k == "h") h = std::atoi(v.c_str());
       else if (k == "seed") seed = std::strtoull(v.c_str(), nullptr, 10);
+      else if (k == "motion")
+        motion = v == "straight" ? sim::MotionProfile::Straight
+                 : v == "circle" ? sim::MotionProfile::Circle
+                 : v == "spin"   ? sim::MotionProfile::Spin
+                                 : sim::MotionProfile::Mixed;
       else if (k == "levels") topt.levels = std::atoi(v.c_str());
       else if (k == "finest") topt.finest_level = std::atoi(v.c_str());
       else if (k == "refine_kf") topt.refine_keyframes = std::atoi(v.c_str()) != 0;
@@ -343,7 +351,12 @@ int main(int argc, char** argv) {
         return 2;
       }
     }
-    return bench_accuracy(tex, seconds, w, h, seed, topt, std::getenv("BENCH_VERBOSE") != nullptr);
+    if (tex.size() == 1 && tex[0] == "all")
+      tex = {"aerial_asphalt_01.png", "aerial_ground_rock.png", "anti_skid_tiles.png", "anti_slip_concrete.png",
+             "asphalt_01.png", "asphalt_02.png", "black_painted_planks.png", "blue_floor_tiles_01.png",
+             "brick_floor.png", "brown_mud_rocks_01.png", "brushed_concrete.png", "skimage_brick.png",
+             "skimage_grass.png", "skimage_gravel.png"};
+    return bench_accuracy(tex, seconds, w, h, seed, motion, topt, std::getenv("BENCH_VERBOSE") != nullptr);
   }
   std::fprintf(stderr, "usage: bench_track kernel [w h [wx wy pix hist fast [rounds]]] | speed [w h [seconds [rounds]]]"
                        " | accuracy [key=value...]\n");
