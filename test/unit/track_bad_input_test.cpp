@@ -8,6 +8,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "common/test_util.h"
+#include "core/error.h"
 #include "io/simulator.h"
 #include "ocl/runtime.h"
 #include "track/tracker.h"
@@ -157,6 +158,35 @@ TEST_F(TrackBadInput, BadTimestampsAreDegradedNotNaN) {
   }
   EXPECT_STATUS(track(good(3 * dt), 3 * dt), Ok);
   EXPECT_LT(pose_error_mm(0, 3 * dt), 0.05);
+}
+
+TEST_F(TrackBadInput, CameraFrameApi) {
+  // The same through track(gray, ...): the image pipeline makes the pyramids. A frame of
+  // another size is Lost, not an exception; a null image or a short stride is a caller error.
+  auto frame = [&](double t) {
+    return sim::apply_camera(renderer_->render_float(truth(t)), {}, 1.0, 11 + static_cast<uint64_t>(t * 1000));
+  };
+  Tracker tr(rt_, options_.camera, options_.extrinsics);
+  cv::Mat f = frame(0);
+  EXPECT_STATUS(tr.track(f.data, f.cols, f.rows, f.step, 0.0), First);
+  f = frame(dt);
+  const FrameResult r1 = tr.track(f.data, f.cols, f.rows, f.step, dt);
+  EXPECT_STATUS(r1, Ok);
+  EXPECT_GT(r1.pipeline_ms, 0.0);
+  EXPECT_GE(r1.ms, r1.pipeline_ms);
+  cv::Mat small(120, 160, CV_8UC1, cv::Scalar(90));
+  cv::randu(small, 0, 255);
+  EXPECT_STATUS(tr.track(small.data, small.cols, small.rows, small.step, 2 * dt), Lost);
+  // A frame inside a larger buffer (stride > width).
+  f = frame(3 * dt);
+  cv::Mat padded(f.rows, f.cols + 13, CV_8UC1, cv::Scalar(0));
+  f.copyTo(padded(cv::Rect(0, 0, f.cols, f.rows)));
+  const FrameResult r3 = tr.track(padded.data, f.cols, f.rows, padded.step, 3 * dt);
+  EXPECT_STATUS(r3, Ok);
+  const SE2 rel = truth(0).inverse() * truth(3 * dt);
+  EXPECT_LT(1e3 * std::hypot(tr.pose().x - rel.x, tr.pose().y - rel.y), 0.05);
+  EXPECT_THROW(tr.track(nullptr, f.cols, f.rows, f.step, 4 * dt), Error);
+  EXPECT_THROW(tr.track(f.data, f.cols, f.rows, f.cols - 1, 4 * dt), Error);
 }
 
 TEST_F(TrackBadInput, ResetStartsOver) {
