@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
 
 #include "core/error.h"
 #include "image/pipeline.h"
@@ -40,6 +41,7 @@ constexpr const char* kMismatch = "images do not match";
 constexpr const char* kBrightness = "brightness changed too much";
 constexpr const char* kWrongSize = "frame size differs from the camera's";
 constexpr const char* kTimeGap = "time gap";
+constexpr const char* kWeak = "motion poorly constrained";
 constexpr const char* kBadTime = "timestamp not increasing";
 
 // Mean squared gradient (grey levels^2 per pixel^2) a frame needs at the coarsest level to
@@ -292,6 +294,15 @@ struct Tracker::Impl {
     return true;
   }
 
+  // The position covariance too large, or much longer along one axis than the other (texture
+  // that constrains the motion in one direction only), or the heading too uncertain.
+  bool weakly_constrained(const Eigen::Matrix3d& cov) const {
+    const Eigen::Vector2d ev =
+        Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(cov.topLeftCorner<2, 2>()).eigenvalues();
+    return !(std::sqrt(ev(1)) <= opt.max_position_std) || !(ev(1) <= opt.max_std_ratio * opt.max_std_ratio * ev(0)) ||
+           !(std::sqrt(cov(2, 2)) <= opt.max_heading_std);
+  }
+
   // Fills covariance, cost, inliers, overlap and the status from the finest level's sums.
   void finish(FrameResult* res, const Estimate& e) {
     const ReduceSums& s = cur;
@@ -302,7 +313,8 @@ struct Tracker::Impl {
     res->bias = e.b;
     const int n = opt.estimate_brightness ? 5 : 3;
     const double dof = std::max(1.0, s.valid - n);
-    const double s2 = s.wrr / dof;
+    // Floored at min_sigma: noise-free synthetic images would otherwise claim zero variance.
+    const double s2 = std::max(s.wrr / dof, opt.min_sigma * opt.min_sigma);
     res->sigma = finest_sigma;
     MatrixJ A = s.JtWJ.topLeftCorner(n, n);
     Eigen::LDLT<MatrixJ> ldlt(A);
@@ -326,6 +338,9 @@ struct Tracker::Impl {
     } else if (res->inlier_fraction < opt.min_inlier_fraction) {
       res->status = Status::Degraded;
       res->reason = "few inliers";
+    } else if (weakly_constrained(res->covariance)) {
+      res->status = Status::Degraded;
+      res->reason = kWeak;
     } else {
       res->status = Status::Ok;
       res->reason = "";

@@ -70,7 +70,10 @@ struct TrackerOptions {
   // dominates): above lost_residual_ratio Lost, above degraded_residual_ratio Degraded.
   // Inlier fraction below min_inlier_fraction: Degraded (with k = 2 sigma of this frame's own
   // residuals, Gaussian residuals give 0.95; a heavy tail of unexplained pixels, fewer).
-  // |a| > max_log_gain: Lost.
+  // |a| > max_log_gain: Lost. Degraded when the covariance's position standard deviation
+  // (larger axis) exceeds max_position_std, its axes differ by more than max_std_ratio (texture
+  // that constrains the motion in one direction only, e.g. stripes: 21; the shared textures:
+  // 1.9-3.5), or the heading's exceeds max_heading_std (typical: 2-10 um, 1e-5 rad).
   double max_gap_factor = 2.5;
   double max_gap_seconds = 0.5;
   double min_texture_ratio = 0.1;
@@ -79,6 +82,9 @@ struct TrackerOptions {
   double degraded_residual_ratio = 0.5;
   double min_inlier_fraction = 0.6;
   double max_log_gain = 0.7;
+  double max_position_std = 1e-4;  // metres
+  double max_std_ratio = 10.0;
+  double max_heading_std = 1e-3;   // radians
   // The fused pass's work-group shape etc. (stats and debug_output are set by the tracker).
   WarpReduceOptions kernel = default_kernel_options();
 
@@ -98,8 +104,10 @@ struct FrameResult {
   // (T_{k-1}^-1 T_k, conventions.md), metres and radians.
   SE2 motion;
   // Covariance of the right perturbation xi of the motion (motion = m̂ exp(xi)) from this frame's
-  // alignment: sigma^2 (J^T W J)^-1 of the finest level, brightness marginalised; (x, y) in
-  // metres, theta in radians. Large (1 m^2, 1 rad^2 on the diagonal) when Lost or First.
+  // alignment: sigma^2 (J^T W J)^-1 of the finest level, brightness marginalised, sigma^2 the
+  // weighted residual variance (at least min_sigma^2); (x, y) in metres, theta in radians.
+  // Pixels are treated as independent, so it is optimistic as an absolute (README.md).
+  // Large (1 m^2, 1 rad^2 on the diagonal) when Lost or First.
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Identity();
   std::array<int, kMaxLevels> iterations{};  // fused passes per level
   std::array<double, kMaxLevels> level_ms{};  // wall time per level (passes and solves), ms

@@ -16,6 +16,8 @@
 
 #include <sys/resource.h>
 
+#include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
 #include <opencv2/imgcodecs.hpp>
 
 #include "core/se2.h"
@@ -147,6 +149,7 @@ struct SequenceReport {
   double ms_frame = 0, ms_pipeline = 0, cpu_frame = 0;
   double passes[kMaxLevelsBench] = {};
   double level_ms[kMaxLevelsBench] = {};
+  double std_pos_median = 0, std_pos_max = 0, std_head_median = 0, nees = 0, aniso_max = 0;
 };
 
 // Renders and tracks a sequence frame by frame through the camera-frame API.
@@ -158,7 +161,9 @@ SequenceReport run_sequence(ocl::Runtime& rt, const sim::Options& so, const trac
   track::Tracker tracker(rt, so.camera, so.extrinsics, topt);
   SequenceReport rep;
   std::vector<SE2> est, truth;
-  std::vector<double> dts;
+  std::vector<double> dts, std_pos, std_head;
+  double nees = 0;
+  int nees_n = 0;
   for (size_t k = 0; k < traj.t.size(); ++k) {
     const cv::Mat img = sim::apply_camera(renderer.render_float(traj.pose[k]), exposure[k], so.pixel_noise,
                                           sim::derive_seed(so.seed, 1000 + k));
@@ -182,12 +187,27 @@ SequenceReport run_sequence(ocl::Runtime& rt, const sim::Options& so, const trac
     truth.push_back(t);
     dts.push_back(traj.t[k] - traj.t[k - 1]);
     const double e = std::hypot(r.motion.x - t.x, r.motion.y - t.y);
+    if (r.status == track::FrameResult::Status::Ok) {
+      std_pos.push_back(std::sqrt(std::max(r.covariance(0, 0), r.covariance(1, 1))));
+      std_head.push_back(std::sqrt(r.covariance(2, 2)));
+      const Eigen::Vector2d ev = Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(r.covariance.topLeftCorner<2, 2>()).eigenvalues();
+      rep.aniso_max = std::max(rep.aniso_max, std::sqrt(ev(1) / ev(0)));
+      // Normalised error of the frames tracked directly against the keyframe's own frame
+      // (the previous frame was the keyframe), where the covariance is that of the motion.
+      const Eigen::Vector3d xi = (r.motion.inverse() * t).log();
+      nees += xi.dot(r.covariance.ldlt().solve(xi));
+      ++nees_n;
+    }
     if (verbose && (e > 1e-3 || r.status != track::FrameResult::Status::Ok))
       std::printf("  frame %zu: %s %s err %.3f mm, truth (%.4f %.4f %.4f) est (%.4f %.4f %.4f) overlap %.2f\n", k,
                   track::status_name(r.status), r.reason, e * 1e3, t.x, t.y, t.theta, r.motion.x, r.motion.y,
                   r.motion.theta, r.overlap);
   }
   rep.acc = track::evaluate_motions(est, truth, dts);
+  rep.std_pos_median = median(std_pos);
+  rep.std_pos_max = std_pos.empty() ? 0 : *std::max_element(std_pos.begin(), std_pos.end());
+  rep.std_head_median = median(std_head);
+  rep.nees = nees_n ? nees / nees_n : 0;
   return rep;
 }
 
@@ -213,6 +233,10 @@ int bench_accuracy(const std::vector<std::string>& textures, double seconds, int
                 r.acc.gross_errors, r.acc.endpoint_drift * 100, r.ms_frame / n, r.ms_pipeline / n, r.cpu_frame / n);
     for (int l = topt.levels - 1; l >= 0; --l) std::printf(" %.2f", r.passes[l] / n);
     std::printf("\n");
+    if (verbose)
+      std::printf("  covariance: position std median %.2g m (max %.2g), heading std median %.2g rad; "
+                  "mean NEES %.1f (3 if calibrated); largest std ratio of the position axes %.1f\n", r.std_pos_median,
+                  r.std_pos_max, r.std_head_median, r.nees, r.aniso_max);
     std::fflush(stdout);
   }
   return 0;

@@ -3,6 +3,7 @@
 // and tracking recovers on the next good frame; the pose stays close to the truth where the
 // good frames allow it.
 #include <cmath>
+#include <cstdio>
 
 #include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
@@ -187,6 +188,39 @@ TEST_F(TrackBadInput, CameraFrameApi) {
   EXPECT_LT(1e3 * std::hypot(tr.pose().x - rel.x, tr.pose().y - rel.y), 0.05);
   EXPECT_THROW(tr.track(nullptr, f.cols, f.rows, f.step, 4 * dt), Error);
   EXPECT_THROW(tr.track(f.data, f.cols, f.rows, f.cols - 1, 4 * dt), Error);
+}
+
+TEST(TrackWeakTexture, StripesLeaveTheMotionAlongThemUnconstrained) {
+  // Straight stripes on the ground: motion along them changes nothing in the image. The frame
+  // is Degraded ("motion poorly constrained"), the covariance says which direction is free,
+  // and nothing is NaN.
+  ocl::Runtime rt;
+  test::ScratchDir dir;
+  cv::Mat tex(512, 512, CV_8UC1);
+  for (int y = 0; y < tex.rows; ++y)
+    for (int x = 0; x < tex.cols; ++x)
+      tex.at<uint8_t>(y, x) = static_cast<uint8_t>(128 + 60 * std::sin(2 * M_PI * x / 32.0));
+  sim::Options so;
+  so.camera = sim::default_camera(320, 240);
+  so.camera.k1 = so.camera.k2 = 0.0;
+  sim::Renderer renderer(rt, tex, so);
+  Tracker tr(rt, so.camera, so.extrinsics);
+  // Stripes run along the world y axis (texture v); the robot faces +y and drives along them.
+  const SE2 a(0.0, 0.0, M_PI / 2), m(0.01, 0.0, 0.0);
+  auto frame = [&](const SE2& p) {
+    return test::test_upload(rt, test::test_pyramid(renderer.render_float(p), nullptr, 4));
+  };
+  tr.track(frame(a), 0.0);
+  const FrameResult r = tr.track(frame(a * m), dt);
+  std::printf("status %s (%s), motion %.5f %.5f %.5f, std x %.3g m, y %.3g m, theta %.3g rad\n",
+              status_name(r.status), r.reason, r.motion.x, r.motion.y, r.motion.theta,
+              std::sqrt(r.covariance(0, 0)), std::sqrt(r.covariance(1, 1)), std::sqrt(r.covariance(2, 2)));
+  EXPECT_STATUS(r, Degraded);
+  EXPECT_STREQ(r.reason, "motion poorly constrained");
+  // Forward (x, along the stripes) is free, sideways and the heading are not.
+  EXPECT_GT(r.covariance(0, 0), 100 * r.covariance(1, 1));
+  EXPECT_LT(std::abs(r.motion.y - m.y), 1e-4);
+  EXPECT_LT(std::abs(r.motion.theta - m.theta), 1e-3);
 }
 
 TEST_F(TrackBadInput, ResetStartsOver) {
