@@ -1,0 +1,234 @@
+// The tracker's fused pass (paper section 4, eqs. 5-13): for every valid pixel p of a reference
+// pyramid level, warp it into the live level through the homography H, sample the live level
+// bilinearly, form the photometric residual with an affine brightness model, its ESM Jacobian,
+// a Huber weight, and reduce J^T W J, J^T W r, the cost and counts into one row of partial sums
+// per work-group (local-memory tree reduction; the host sums the rows in double). The layout
+// of a row is mirrored by src/track/warp_reduce.h (ReduceLayout); the plain C++ reference is
+// warp_reduce_reference() in src/track/warp_reduce.cpp.
+//
+// Per pixel p = (u, v) with reference sample R = ref(p) = (I_r, dI_r/du, dI_r/dv, valid):
+//   q = H (u, v, 1); w(p) = (q.x / q.z, q.y / q.z)
+//   L = bilinear sample of the live level at w(p) (intensity and gradient), valid only when
+//       all four neighbours are inside and valid
+//   r = gain * I_l(w(p)) + bias - I_r(p)          (gain = e^a: brightness (a, b), r of eq. 7)
+//   gradient in reference coordinates, the ESM mean of the reference gradient and the warped
+//   live gradient chained through the warp's 2x2 derivative Dw = ∂π/∂h|q H[:, 0:2] (eq. 11):
+//       g = 0.5 * (∇I_r(p) + gain * ∇I_l(w(p)) Dw)
+//   J_i = g . (m_i.x, m_i.y),  m_i = ∂π/∂h|(u,v,1) G_i (u, v, 1), i < NPARAM              (eq. 12)
+//       G_i = H^-1 ∂H/∂x_i, the derivative of the warp on the reference side (warp_model.h)
+//   J_NPARAM = gain * I_l(w(p))  (∂r/∂a),  J_NPARAM+1 = 1  (∂r/∂b)
+//   Huber: weight = min(1, k / |r|), cost rho = r^2 / 2 or k (|r| - k / 2).
+//
+// Work distribution: 2-D range; a work-group is WG_X x WG_Y work-items, each handles PIX pixels
+// of one row, WG_X apart (so that neighbouring work-items read neighbouring pixels, which is
+// what PoCL vectorises across). Global size: (ceil(width / (WG_X PIX)) WG_X, ceil(height / WG_Y)
+// WG_Y); pixels beyond the level are masked out. Row g of the partials belongs to work-group
+// (group_id(0) + num_groups(0) * group_id(1)).
+//
+// Build options (-D): NPARAM (3), WG_X (16), WG_Y (1), PIX (8), STATS (0: 1 adds the
+// statistics below and a histogram of HIST_BINS (16) bins of |r|),
+// DEBUG_OUTPUT (off: when defined, a last argument receives per reference pixel
+// (r, weight, valid, rho); not for the fast path).
+#ifndef NPARAM
+#define NPARAM 3
+#endif
+#ifndef WG_X
+#define WG_X 16
+#endif
+#ifndef WG_Y
+#define WG_Y 1
+#endif
+#ifndef PIX
+#define PIX 8
+#endif
+#ifndef STATS
+#define STATS 0
+#endif
+#ifndef HIST_BINS
+#define HIST_BINS 16
+#endif
+
+#if (WG_X * WG_Y) & (WG_X * WG_Y - 1)
+#error "warp_reduce: WG_X * WG_Y must be a power of two (tree reduction)"
+#endif
+
+#define NJ (NPARAM + 2)
+#define NH (NJ * (NJ + 1) / 2)
+#define WG (WG_X * WG_Y)
+// Row layout (ReduceLayout in warp_reduce.h). The statistics after OUT_REF are only in the
+// STATS variant, which the tracker runs once per level: each extra sum costs every pixel. The
+// histogram counts only each work-item's first pixel (one in PIX).
+#define OUT_JTJ 0                    // NH: upper triangle of J^T W J, row by row
+#define OUT_JTR (NH)                 // NJ: J^T W r
+#define OUT_COST (NH + NJ)           // sum of Huber costs
+#define OUT_WRR (OUT_COST + 1)       // sum of weight * r^2
+#define OUT_VALID (OUT_COST + 2)     // pixels with a valid reference and a valid live sample
+#define OUT_INLIER (OUT_COST + 3)    // of those, |r| <= k
+#define OUT_REF (OUT_COST + 4)       // pixels with a valid reference
+#if STATS
+#define OUT_RR (OUT_COST + 5)        // sum of r^2
+#define OUT_IREF (OUT_COST + 6)      // sum of (I_r - 128) over valid pairs
+#define OUT_IREF2 (OUT_COST + 7)     // sum of (I_r - 128)^2 over valid pairs
+#define OUT_GLIVE (OUT_COST + 8)     // sum of |grad I_l(w(p))|^2 over valid pairs (live pixels)
+#define OUT_GREF (OUT_COST + 9)      // sum of |grad I_r(p)|^2 over valid pairs
+#define OUT_HVALID (OUT_COST + 10)   // valid pixels in the histogram's subsample
+#define OUT_HIST (OUT_COST + 11)     // HIST_BINS: counts of |r| < 0.25 * 2^(j / 2) in it
+#define NOUT (OUT_HIST + HIST_BINS)
+#else
+#define NOUT (OUT_COST + 5)
+#endif
+
+// The sample of the live level at (x, y): all four neighbours must lie inside and be valid.
+// Coordinates are clamped before the conversion to int (a NaN or huge value is then simply
+// outside) and the addresses are clamped, so nothing is read out of bounds.
+#define SAMPLE_CLAMP 1.0e6f
+
+__kernel __attribute__((reqd_work_group_size(WG_X, WG_Y, 1)))
+void warp_reduce(__global const float4* ref, const int ref_stride, const int ref_w,
+                 const int ref_h, __global const float4* live, const int live_stride,
+                 const int live_w, const int live_h,
+                 __constant float* params,  // H (9, row-major), then G_0 .. G_{NPARAM-1} (9 each)
+                 const float gain, const float bias, const float huber_k,
+                 __global float* partials
+#ifdef DEBUG_OUTPUT
+                 , __global float4* debug
+#endif
+) {
+  const int lx = (int)get_local_id(0);
+  const int ly = (int)get_local_id(1);
+  const int lid = ly * WG_X + lx;
+  const int y = (int)get_global_id(1);
+  const int x0 = (int)get_group_id(0) * (WG_X * PIX) + lx;
+
+  float acc[NOUT];
+#pragma unroll
+  for (int o = 0; o < NOUT; ++o) acc[o] = 0.0f;
+
+  // Levels are read as plain floats (4 per pixel): LLVM's loop vectorizer, which PoCL uses
+  // across work-items, gives up on loops with vector-typed (float4) values.
+  __global const float* refp = (__global const float*)ref;
+  __global const float* livep = (__global const float*)live;
+  const float h0 = params[0], h1 = params[1], h2 = params[2];
+  const float h3 = params[3], h4 = params[4], h5 = params[5];
+  const float h6 = params[6], h7 = params[7], h8 = params[8];
+  const float fv = (float)y;
+
+#pragma unroll
+  for (int k = 0; k < PIX; ++k) {
+    const int x = x0 + k * WG_X;
+    const int in_ref = (x < ref_w) & (y < ref_h);
+    const int ri = in_ref ? 4 * (y * ref_stride + x) : 0;
+    const float rI = refp[ri], rGu = refp[ri + 1], rGv = refp[ri + 2];
+    const float mref = in_ref ? refp[ri + 3] : 0.0f;
+    const float fu = (float)x;
+
+    // Warp (eq. 5): q = H p.
+    const float qx = h0 * fu + h1 * fv + h2;
+    const float qy = h3 * fu + h4 * fv + h5;
+    const float qz = h6 * fu + h7 * fv + h8;
+    const float iz = qz > 1e-12f ? 1.0f / qz : 0.0f;
+    const float wu = clamp(qx * iz, -SAMPLE_CLAMP, SAMPLE_CLAMP);
+    const float wv = clamp(qy * iz, -SAMPLE_CLAMP, SAMPLE_CLAMP);
+    const float bu = floor(wu), bv = floor(wv);
+    const int iu = (int)bu, iv = (int)bv;
+    const int inside = (qz > 1e-12f) & (iu >= 0) & (iv >= 0) & (iu < live_w - 1) &
+                       (iv < live_h - 1);
+    const int b00 = inside ? 4 * (iv * live_stride + iu) : 0;
+    const int b10 = b00 + 4 * live_stride;
+    const float ax = wu - bu, ay = wv - bv;
+    const float w00 = (1.0f - ax) * (1.0f - ay), w01 = ax * (1.0f - ay);
+    const float w10 = (1.0f - ax) * ay, w11 = ax * ay;
+    const float lI = w00 * livep[b00] + w01 * livep[b00 + 4] + w10 * livep[b10] + w11 * livep[b10 + 4];
+    const float lGu = w00 * livep[b00 + 1] + w01 * livep[b00 + 5] + w10 * livep[b10 + 1] +
+                      w11 * livep[b10 + 5];
+    const float lGv = w00 * livep[b00 + 2] + w01 * livep[b00 + 6] + w10 * livep[b10 + 2] +
+                      w11 * livep[b10 + 6];
+    const float m = inside ? mref * livep[b00 + 3] * livep[b00 + 7] * livep[b10 + 3] *
+                                 livep[b10 + 7]
+                           : 0.0f;
+
+    // Residual with brightness (eq. 7).
+    const float r = m * (gain * lI + bias - rI);
+
+    // ESM gradient in reference coordinates (eq. 11): the live gradient through Dw.
+    const float d00 = iz * (h0 - wu * h6), d01 = iz * (h1 - wu * h7);
+    const float d10 = iz * (h3 - wv * h6), d11 = iz * (h4 - wv * h7);
+    const float glu = lGu * d00 + lGv * d10;
+    const float glv = lGu * d01 + lGv * d11;
+    const float gu = 0.5f * (rGu + gain * glu);
+    const float gv = 0.5f * (rGv + gain * glv);
+
+    // Jacobian (eq. 12), zero where masked.
+    float J[NJ];
+#pragma unroll
+    for (int i = 0; i < NPARAM; ++i) {
+      __constant const float* G = params + 9 + 9 * i;
+      const float mx = G[0] * fu + G[1] * fv + G[2];
+      const float my = G[3] * fu + G[4] * fv + G[5];
+      const float mz = G[6] * fu + G[7] * fv + G[8];
+      J[i] = m * (gu * (mx - fu * mz) + gv * (my - fv * mz));
+    }
+    J[NPARAM] = m * gain * lI;
+    J[NPARAM + 1] = m;
+
+    // Huber weight and cost.
+    const float ar = fabs(r);
+    const int inlier = ar <= huber_k;
+    const float wgt = m * (inlier ? 1.0f : huber_k / ar);
+    const float rho = m * (inlier ? 0.5f * r * r : huber_k * (ar - 0.5f * huber_k));
+
+    int o = 0;
+#pragma unroll
+    for (int i = 0; i < NJ; ++i) {
+      const float wj = wgt * J[i];
+#pragma unroll
+      for (int j = i; j < NJ; ++j) acc[o++] += wj * J[j];
+    }
+#pragma unroll
+    for (int i = 0; i < NJ; ++i) acc[OUT_JTR + i] += wgt * J[i] * r;
+    acc[OUT_COST] += rho;
+    acc[OUT_WRR] += wgt * r * r;
+    acc[OUT_VALID] += m;
+    acc[OUT_INLIER] += inlier ? m : 0.0f;
+    acc[OUT_REF] += mref;
+#if STATS
+    acc[OUT_RR] += r * r;
+    const float ic = m * (rI - 128.0f);
+    acc[OUT_IREF] += ic;
+    acc[OUT_IREF2] += ic * ic;
+    acc[OUT_GLIVE] += m * (lGu * lGu + lGv * lGv);
+    acc[OUT_GREF] += m * (rGu * rGu + rGv * rGv);
+    // The histogram of |r| for the robust scale: a subsample (each work-item's first pixel)
+    // is plenty for a median and saves most of its cost.
+    if (k == 0) {
+      acc[OUT_HVALID] += m;
+#pragma unroll
+      for (int j = 0; j < HIST_BINS; ++j) {
+        // 0.25 * 2^(j/2): exact powers of two for even j, times sqrt(2) for odd j.
+        const float t = (j & 1) ? 0.35355339059327373f * (float)(1 << (j >> 1))
+                                : 0.25f * (float)(1 << (j >> 1));
+        acc[OUT_HIST + j] += ar < t ? m : 0.0f;
+      }
+    }
+#endif
+#ifdef DEBUG_OUTPUT
+    if (in_ref) debug[y * ref_w + x] = (float4)(r, wgt, m, rho);
+#endif
+  }
+
+  // Tree reduction in local memory, one column of WG values per output.
+  __local float scratch[NOUT * WG];
+#pragma unroll
+  for (int o = 0; o < NOUT; ++o) scratch[o * WG + lid] = acc[o];
+#pragma unroll
+  for (int s = WG / 2; s > 0; s >>= 1) {
+    barrier(CLK_LOCAL_MEM_FENCE);
+    if (lid < s) {
+#pragma unroll
+      for (int o = 0; o < NOUT; ++o) scratch[o * WG + lid] += scratch[o * WG + lid + s];
+    }
+  }
+  barrier(CLK_LOCAL_MEM_FENCE);
+  const int group = (int)get_group_id(0) + (int)get_num_groups(0) * (int)get_group_id(1);
+  for (int o = lid; o < NOUT; o += WG) partials[group * NOUT + o] = scratch[o * WG];
+}

@@ -1,0 +1,537 @@
+#include "track/tracker.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+#include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
+
+#include "core/error.h"
+#include "image/pipeline.h"
+#include "ocl/runtime.h"
+#include "track/warp_model.h"
+
+namespace planarvo::track {
+
+namespace {
+
+using Status = FrameResult::Status;
+using Vector5d = Eigen::Matrix<double, 5, 1>;
+
+constexpr int kMinLevelSide = 8;
+constexpr double kMadToSigma = 1.4826;
+
+bool finite(const SE2& m) { return std::isfinite(m.x) && std::isfinite(m.y) && std::isfinite(m.theta); }
+
+// The estimate: live pose in the keyframe's robot frame and brightness relative to it.
+struct Estimate {
+  SE2 T;
+  double a = 0.0, b = 0.0;
+};
+
+Eigen::Matrix3d lost_covariance() { return Eigen::Matrix3d::Identity(); }
+
+// Reasons (compared by address).
+constexpr const char* kNoLiveTexture = "no texture in the live frame";
+constexpr const char* kNoTexture = "no texture";
+constexpr const char* kFewValid = "too few valid pixels";
+constexpr const char* kDiverged = "diverged";
+constexpr const char* kMismatch = "images do not match";
+constexpr const char* kBrightness = "brightness changed too much";
+constexpr const char* kWrongSize = "frame size differs from the camera's";
+constexpr const char* kTimeGap = "time gap";
+constexpr const char* kWeak = "motion poorly constrained";
+constexpr const char* kBadTime = "timestamp not increasing";
+
+// Mean squared gradient (grey levels^2 per pixel^2) a frame needs at the coarsest level to
+// become a keyframe. A flat or black frame has 0, the pixel noise of a flat frame at level 3
+// about 0.01; the shared ground textures have 5 (anti_skid_tiles) to 400.
+constexpr double kMinSelfTexture = 0.25;
+
+CameraModel validated(const CameraModel& c, const Extrinsics& e, const TrackerOptions& o) {
+  if (o.levels < 1 || o.levels > kMaxLevels)
+    throw_invalid_argument("TrackerOptions::levels must be 1.." + std::to_string(kMaxLevels));
+  if (!(e.z > 0.0)) throw_invalid_argument("Tracker: the camera height z must be positive");
+  c.validate("Tracker camera");
+  return c;
+}
+
+}  // namespace
+
+const char* status_name(FrameResult::Status s) {
+  switch (s) {
+    case Status::First: return "first";
+    case Status::Ok: return "ok";
+    case Status::Degraded: return "degraded";
+    case Status::Lost: return "lost";
+  }
+  return "?";
+}
+
+WarpReduceOptions TrackerOptions::default_kernel_options() {
+  // WarpReduceOptions' defaults are the measured best on PoCL (README.md).
+  return WarpReduceOptions();
+}
+
+struct Tracker::Impl {
+  ocl::Runtime& rt;
+  CameraModel camera;
+  Extrinsics ext;
+  TrackerOptions opt;
+  Eigen::Matrix3d K;
+  WarpReduce pass, stats_pass;
+
+  Pyramid keyframe;
+  bool has_keyframe = false;
+  // The camera-frame path: the pipeline and two pyramids, one the keyframe's (aliased by
+  // `keyframe`), the other filled with each live frame.
+  std::unique_ptr<ImagePipeline> pipeline;
+  Pyramid slots[2];
+  int live_slot = 0;
+  bool keyframe_is_slot = false;
+  SE2 pose;             // accumulated robot pose
+  Estimate prev;        // the previous frame relative to the keyframe
+  Eigen::Vector3d velocity = Eigen::Vector3d::Zero();  // se(2) per second
+  double last_t = 0.0, nominal_dt = 0.0, since_good = 0.0;
+  bool has_t = false;
+  std::array<double, kMaxLevels> sigma{};
+  double finest_sigma = 0.0;
+  ReduceSums cur, next, finest_stats;
+
+  Impl(ocl::Runtime& r, const CameraModel& c, const Extrinsics& e, const TrackerOptions& o)
+      : rt(r), camera(validated(c, e, o)), ext(e), opt(o), K(c.K()),
+        pass(r, 3, kernel_options(o, false)), stats_pass(r, 3, kernel_options(o, true)) {
+    reset();
+  }
+
+  static WarpReduceOptions kernel_options(const TrackerOptions& o, bool stats) {
+    WarpReduceOptions k = o.kernel;
+    k.stats = stats;
+    k.debug_output = false;
+    return k;
+  }
+
+  void reset() {
+    has_keyframe = false;
+    pose = SE2();
+    prev = Estimate();
+    velocity.setZero();
+    has_t = false;
+    nominal_dt = 0.0;
+    since_good = 0.0;
+    sigma.fill(opt.initial_sigma);
+  }
+
+  double huber_k(int level) const { return opt.huber_factor * sigma[static_cast<size_t>(level)]; }
+
+  void evaluate(const Pyramid& live, int level, const Estimate& e, bool stats, ReduceSums* out) {
+    const PyramidLevel& R = keyframe.levels[static_cast<size_t>(level)];
+    const PyramidLevel& L = live.levels[static_cast<size_t>(level)];
+    const MotionHomography mh = motion_homography(level_camera_matrix(K, level), ext, e.T);
+    WarpInputs in;
+    in.H = mh.H;
+    in.nparam = 3;
+    for (size_t i = 0; i < 3; ++i) in.G[i] = mh.G[i];
+    in.gain = std::exp(e.a);
+    in.bias = e.b;
+    in.huber_k = huber_k(level);
+    (stats ? stats_pass : pass).run(R.data, R.width, R.height, L.data, L.width, L.height, in, out);
+  }
+
+  // The damped Gauss-Newton step for the motion (and brightness); false when singular.
+  bool solve(const ReduceSums& s, double lambda, Vector5d* delta) const {
+    const int n = opt.estimate_brightness ? 5 : 3;
+    MatrixJ A = s.JtWJ.topLeftCorner(n, n);
+    VectorJ g = s.JtWr.head(n);
+    const double ridge = 1e-12 * A.diagonal().cwiseAbs().maxCoeff();
+    for (int i = 0; i < n; ++i) A(i, i) = A(i, i) * (1.0 + lambda) + ridge;
+    Eigen::LDLT<MatrixJ> ldlt(A);
+    if (ldlt.info() != Eigen::Success || !(ldlt.vectorD().minCoeff() > 0.0)) return false;
+    const VectorJ d = -ldlt.solve(g);
+    if (!d.allFinite()) return false;
+    delta->setZero();
+    delta->head(n) = d;
+    return true;
+  }
+
+  static Estimate apply(const Estimate& e, const Vector5d& d) {
+    Estimate out;
+    out.T = e.T * SE2::exp(d.head<3>());
+    out.a = e.a + d(3);
+    out.b = e.b + d(4);
+    return out;
+  }
+
+  static double mean_cost(const ReduceSums& s) { return s.valid > 0 ? s.cost / s.valid : HUGE_VAL; }
+
+  // Texture of a pyramid level on its own: mean squared gradient (a pass of the level against
+  // itself), for frames that have no keyframe to compare with.
+  double self_texture(const Pyramid& p, int level) {
+    const PyramidLevel& L = p.levels[static_cast<size_t>(level)];
+    WarpInputs in;
+    in.nparam = 3;
+    for (size_t i = 0; i < 3; ++i) in.G[i].setZero();
+    in.huber_k = 1e30;
+    ReduceSums s;
+    stats_pass.run(L.data, L.width, L.height, L.data, L.width, L.height, in, &s);
+    return s.valid > 0 ? s.gref / s.valid : 0.0;
+  }
+
+  struct LevelRange {
+    int coarsest = 0, finest = 0;
+  };
+
+  LevelRange level_range(const Pyramid& live) const {
+    LevelRange r;
+    int n = std::min({opt.levels, live.num_levels(), keyframe.num_levels(), kMaxLevels});
+    while (n > 1 && (live.levels[static_cast<size_t>(n - 1)].width < kMinLevelSide ||
+                     live.levels[static_cast<size_t>(n - 1)].height < kMinLevelSide))
+      --n;
+    r.coarsest = std::max(0, n - 1);
+    int finest = opt.finest_level;
+    if (finest < 0) {
+      finest = 0;
+      while (finest < r.coarsest && live.levels[static_cast<size_t>(finest + 1)].width >= opt.min_finest_width)
+        ++finest;
+    }
+    r.finest = std::clamp(finest, 0, r.coarsest);
+    return r;
+  }
+
+  // Coarse-to-fine alignment from `init`. Returns false with *reason when the frame cannot be
+  // tracked; fills result's per-level fields.
+  bool align(const Pyramid& live, const Estimate& init, Estimate* out, FrameResult* res,
+             const char** reason) {
+    const LevelRange range = level_range(live);
+    Estimate e = init;
+    res->iterations.fill(0);
+    res->level_ms.fill(0.0);
+    res->levels_used = 0;
+    int finest = range.finest;
+    for (int level = range.coarsest; level >= finest; --level) {
+      ++res->levels_used;
+      const auto level_start = std::chrono::steady_clock::now();
+      const PyramidLevel& R = keyframe.levels[static_cast<size_t>(level)];
+      const Eigen::Matrix3d Kl = level_camera_matrix(K, level);
+      evaluate(live, level, e, true, &cur);
+      int& passes = res->iterations[static_cast<size_t>(level)];
+      passes = 1;
+      const double level_pixels = static_cast<double>(R.width) * R.height;
+      if (!(cur.valid >= opt.min_valid_fraction * level_pixels)) {
+        *reason = kFewValid;
+        return false;
+      }
+      if (!(cur.glive >= opt.min_texture_ratio * cur.gref)) {
+        *reason = kNoLiveTexture;
+        return false;
+      }
+      // The level's robust scale from this pass's residuals. The threshold in use came from the
+      // previous frame; when the scale has moved by more than rescale_ratio (the robot starts
+      // moving after standing still, the exposure jumps, something covers the ground), the
+      // level restarts with the new threshold: one more pass, and the cost stays one function
+      // within the level.
+      const double measured =
+          std::clamp(kMadToSigma * cur.median_abs_residual(), opt.min_sigma, opt.max_sigma);
+      double& used = sigma[static_cast<size_t>(level)];
+      if (!(measured <= used * opt.rescale_ratio && measured >= used / opt.rescale_ratio)) {
+        used = measured;
+        evaluate(live, level, e, true, &cur);
+        ++passes;
+      }
+      if (level <= range.finest) {
+        finest_stats = cur;
+        finest_sigma = measured;
+      }
+
+      double lambda = 0.0;
+      int steps = 0;
+      const int max_steps = std::max(1, opt.max_iterations[static_cast<size_t>(level)]);
+      while (steps < max_steps) {
+        Vector5d d;
+        if (!solve(cur, lambda, &d)) {
+          if (lambda >= 1e8) break;
+          lambda = lambda == 0.0 ? opt.lambda_min : lambda * opt.lambda_up;
+          continue;
+        }
+        ++steps;
+        const Estimate cand = apply(e, d);
+        const double step_px = max_pixel_displacement(Kl, ext, e.T, cand.T, R.width, R.height);
+        if (!(step_px < 1e6)) {
+          lambda = lambda == 0.0 ? opt.lambda_min : lambda * opt.lambda_up;
+          continue;
+        }
+        // A step below the convergence threshold, or a small last one, is applied without
+        // the pass that would check it.
+        if (step_px < opt.convergence_px || (steps == max_steps && step_px < 0.5)) {
+          e = cand;
+          break;
+        }
+        evaluate(live, level, cand, false, &next);
+        ++passes;
+        if (next.valid >= opt.min_valid_fraction * level_pixels &&
+            mean_cost(next) <= mean_cost(cur)) {
+          e = cand;
+          std::swap(cur, next);
+          lambda = lambda / opt.lambda_down < opt.lambda_min ? 0.0 : lambda / opt.lambda_down;
+        } else {
+          lambda = lambda == 0.0 ? opt.lambda_min : lambda * opt.lambda_up;
+        }
+      }
+      used = measured;
+      res->level_ms[static_cast<size_t>(level)] =
+          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - level_start).count();
+      if (!finite(e.T) || !std::isfinite(e.a) || !std::isfinite(e.b)) {
+        *reason = kDiverged;
+        return false;
+      }
+      // A frame about to become the keyframe goes on to full resolution.
+      if (level == finest && finest > 0 && opt.refine_keyframes && cur.ref > 0 &&
+          cur.valid / cur.ref < opt.keyframe_overlap)
+        finest = 0;
+    }
+    *out = e;
+    return true;
+  }
+
+  // The position covariance too large, or much longer along one axis than the other (texture
+  // that constrains the motion in one direction only), or the heading too uncertain.
+  bool weakly_constrained(const Eigen::Matrix3d& cov) const {
+    const Eigen::Vector2d ev =
+        Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(cov.topLeftCorner<2, 2>()).eigenvalues();
+    return !(std::sqrt(ev(1)) <= opt.max_position_std) || !(ev(1) <= opt.max_std_ratio * opt.max_std_ratio * ev(0)) ||
+           !(std::sqrt(cov(2, 2)) <= opt.max_heading_std);
+  }
+
+  // Fills covariance, cost, inliers, overlap and the status from the finest level's sums.
+  void finish(FrameResult* res, const Estimate& e) {
+    const ReduceSums& s = cur;
+    res->final_cost = mean_cost(s);
+    res->inlier_fraction = s.valid > 0 ? s.inlier / s.valid : 0.0;
+    res->overlap = s.ref > 0 ? s.valid / s.ref : 0.0;
+    res->log_gain = e.a;
+    res->bias = e.b;
+    const int n = opt.estimate_brightness ? 5 : 3;
+    const double dof = std::max(1.0, s.valid - n);
+    // Floored at min_sigma: noise-free synthetic images would otherwise claim zero variance.
+    const double s2 = std::max(s.wrr / dof, opt.min_sigma * opt.min_sigma);
+    res->sigma = finest_sigma;
+    MatrixJ A = s.JtWJ.topLeftCorner(n, n);
+    Eigen::LDLT<MatrixJ> ldlt(A);
+    MatrixJ I = MatrixJ::Identity(n, n);
+    const MatrixJ inv = ldlt.solve(I);
+    res->covariance = s2 * inv.topLeftCorner(3, 3);
+    if (!res->covariance.allFinite()) res->covariance = lost_covariance();
+
+    const ReduceSums& st = finest_stats;
+    const double var_ref = st.valid > 0 ? st.iref2 / st.valid - std::pow(st.iref / st.valid, 2) : 0.0;
+    const double ratio = st.valid > 0 && var_ref > 0 ? (st.rr / st.valid) / var_ref : HUGE_VAL;
+    if (!(ratio <= opt.lost_residual_ratio)) {
+      res->status = Status::Lost;
+      res->reason = kMismatch;
+    } else if (!(std::abs(e.a) <= opt.max_log_gain)) {
+      res->status = Status::Lost;
+      res->reason = kBrightness;
+    } else if (ratio > opt.degraded_residual_ratio) {
+      res->status = Status::Degraded;
+      res->reason = "large residuals";
+    } else if (res->inlier_fraction < opt.min_inlier_fraction) {
+      res->status = Status::Degraded;
+      res->reason = "few inliers";
+    } else if (weakly_constrained(res->covariance)) {
+      res->status = Status::Degraded;
+      res->reason = kWeak;
+    } else {
+      res->status = Status::Ok;
+      res->reason = "";
+    }
+  }
+
+  // The live frame becomes the keyframe: a pyramid of ours (`slots`) by swapping, one of the
+  // caller's by copying on the device.
+  void make_keyframe(const Pyramid& live) {
+    if (&live == &slots[live_slot]) {
+      keyframe = live;
+      keyframe_is_slot = true;
+      live_slot ^= 1;
+    } else {
+      if (keyframe_is_slot || keyframe.levels.size() != live.levels.size()) keyframe.levels.clear();
+      keyframe_is_slot = false;
+      for (size_t l = 0; l < live.levels.size(); ++l) {
+        const PyramidLevel& src = live.levels[l];
+        if (keyframe.levels.size() <= l) keyframe.levels.push_back(PyramidLevel());
+        PyramidLevel& dst = keyframe.levels[l];
+        const size_t bytes = static_cast<size_t>(src.width) * src.height * 16;
+        if (dst.width != src.width || dst.height != src.height || !dst.data()) {
+          dst.width = src.width;
+          dst.height = src.height;
+          dst.data = cl::Buffer(rt.context(), CL_MEM_READ_WRITE, bytes);
+        }
+        rt.queue().enqueueCopyBuffer(src.data, dst.data, 0, 0, bytes);
+      }
+    }
+    has_keyframe = true;
+    prev = Estimate();
+  }
+
+  FrameResult track_gray(const uint8_t* gray, int width, int height, size_t stride, double t) {
+    if (!gray) throw_invalid_argument("Tracker::track: the image is null");
+    if (width > 0 && stride < static_cast<size_t>(width))
+      throw_invalid_argument("Tracker::track: stride " + std::to_string(stride) + " < width " +
+                             std::to_string(width));
+    if (width != camera.width || height != camera.height) return track(Pyramid(), t);
+    const auto t0 = std::chrono::steady_clock::now();
+    if (!pipeline) pipeline = std::make_unique<ImagePipeline>(rt, camera, opt.levels);
+    pipeline->process(gray, width, height, stride, slots[live_slot]);
+    // Waiting here costs one synchronisation (the first pass would wait anyway) and splits
+    // the frame's time between the pipeline and the tracker.
+    rt.queue().finish();
+    const auto t1 = std::chrono::steady_clock::now();
+    FrameResult r = track(slots[live_slot], t);
+    r.pipeline_ms = std::chrono::duration<double, std::milli>(t1 - t0).count();
+    r.ms += r.pipeline_ms;
+    return r;
+  }
+
+  bool right_size(const Pyramid& live) const {
+    if (live.num_levels() < 1) return false;
+    for (int l = 0; l < live.num_levels(); ++l) {
+      const PyramidLevel& p = live.levels[static_cast<size_t>(l)];
+      if (p.width != level_size(camera.width, l) || p.height != level_size(camera.height, l) || !p.data())
+        return false;
+    }
+    return true;
+  }
+
+  FrameResult track(const Pyramid& live, double t) {
+    const auto t0 = std::chrono::steady_clock::now();
+    FrameResult res;
+    res.covariance = lost_covariance();
+
+    // Time: the interval, gaps, and the constant-velocity prediction. A timestamp that is not
+    // finite or not after the last one is not used (the usual interval is assumed).
+    double dt = 0.0;
+    const char* time_problem = nullptr;
+    if (has_t) {
+      dt = std::isfinite(t) ? t - last_t : HUGE_VAL;
+      if (!(dt > 0.0) || !std::isfinite(dt)) {
+        time_problem = kBadTime;
+        dt = nominal_dt;
+      } else if (nominal_dt > 0.0 && dt > opt.max_gap_factor * nominal_dt) {
+        time_problem = kTimeGap;
+      } else {
+        nominal_dt = nominal_dt > 0.0 ? 0.9 * nominal_dt + 0.1 * dt : dt;
+      }
+    }
+    if (std::isfinite(t) && (!has_t || t > last_t)) {
+      last_t = t;
+      has_t = true;
+    }
+    since_good += dt;
+    const bool predict = dt > 0.0 && since_good <= opt.max_gap_seconds;
+    const SE2 predicted = predict ? SE2::exp(velocity * dt) : SE2();
+
+    auto done = [&](FrameResult& r) -> FrameResult {
+      r.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+      return r;
+    };
+    auto lost = [&](const char* why, bool can_be_keyframe) -> FrameResult {
+      res.status = Status::Lost;
+      res.reason = why;
+      res.motion = predicted;
+      res.covariance = lost_covariance();
+      pose = pose * predicted;
+      if (can_be_keyframe) {
+        make_keyframe(live);
+        res.keyframe = true;
+      } else {
+        prev.T = prev.T * predicted;
+      }
+      if (since_good > opt.max_gap_seconds) velocity.setZero();
+      return done(res);
+    };
+
+    if (!right_size(live)) return lost(kWrongSize, false);
+
+    if (!has_keyframe) {
+      // The frame's own texture decides whether it can be the keyframe.
+      int coarse = std::min(opt.levels, live.num_levels()) - 1;
+      while (coarse > 0 && (live.levels[static_cast<size_t>(coarse)].width < kMinLevelSide ||
+                            live.levels[static_cast<size_t>(coarse)].height < kMinLevelSide))
+        --coarse;
+      const double texture = self_texture(live, coarse);
+      if (!(texture >= kMinSelfTexture)) {
+        res.status = Status::Lost;
+        res.reason = kNoTexture;
+        return done(res);
+      }
+      make_keyframe(live);
+      res.status = Status::First;
+      res.keyframe = true;
+      since_good = 0.0;
+      return done(res);
+    }
+
+    // Align with the keyframe from the prediction; if that fails on the residual, once more
+    // from the previous frame's pose (the prediction may be what failed, e.g. after a gap).
+    Estimate init = prev;
+    init.T = prev.T * predicted;
+    Estimate est;
+    const char* reason = "";
+    bool ok = align(live, init, &est, &res, &reason);
+    if (ok) finish(&res, est);
+    if ((!ok || res.status == Status::Lost) && reason != kNoLiveTexture &&
+        !(predicted.x == 0 && predicted.y == 0 && predicted.theta == 0)) {
+      FrameResult retry = res;
+      const char* reason2 = "";
+      Estimate est2;
+      if (align(live, prev, &est2, &retry, &reason2)) {
+        finish(&retry, est2);
+        if (retry.status != Status::Lost) {
+          for (size_t l = 0; l < res.iterations.size(); ++l) {
+            retry.iterations[l] += res.iterations[l];
+            retry.level_ms[l] += res.level_ms[l];
+          }
+          res = retry;
+          est = est2;
+          ok = true;
+        }
+      }
+    }
+    if (!ok) return lost(reason, reason != kNoLiveTexture);
+    if (res.status == Status::Lost) return lost(res.reason, true);
+    if (time_problem && res.status == Status::Ok) {
+      res.status = Status::Degraded;
+      res.reason = time_problem;
+    }
+
+    // Frame-to-frame motion from the keyframe-relative estimates.
+    res.motion = prev.T.inverse() * est.T;
+    pose = pose * res.motion;
+    if (dt > 0.0) velocity = res.motion.log() / dt;
+    since_good = 0.0;
+    if (res.overlap < opt.keyframe_overlap) {
+      make_keyframe(live);
+      res.keyframe = true;
+    } else {
+      prev = est;
+    }
+    return done(res);
+  }
+};
+
+Tracker::Tracker(ocl::Runtime& runtime, const CameraModel& camera, const Extrinsics& extrinsics,
+                 const TrackerOptions& options)
+    : impl_(std::make_unique<Impl>(runtime, camera, extrinsics, options)) {}
+
+Tracker::~Tracker() = default;
+
+FrameResult Tracker::track(const Pyramid& live, double timestamp) { return impl_->track(live, timestamp); }
+FrameResult Tracker::track(const uint8_t* gray, int width, int height, size_t stride, double timestamp) {
+  return impl_->track_gray(gray, width, height, stride, timestamp);
+}
+void Tracker::reset() { impl_->reset(); }
+const SE2& Tracker::pose() const { return impl_->pose; }
+const TrackerOptions& Tracker::options() const { return impl_->opt; }
+
+}  // namespace planarvo::track

@@ -1,0 +1,162 @@
+// The dense planar tracker (paper section 4): aligns every live frame's pyramid with a reference
+// keyframe by ESM Gauss-Newton steps over the robot's planar motion and an affine brightness
+// change, coarse to fine, and reports the frame-to-frame motion in the robot frame. Design
+// and measurements: src/track/README.md.
+#pragma once
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+
+#include <Eigen/Core>
+
+#include "core/extrinsics.h"
+#include "core/se2.h"
+#include "image/camera.h"
+#include "image/pyramid.h"
+#include "track/warp_reduce.h"
+
+namespace planarvo::ocl {
+class Runtime;
+}
+
+namespace planarvo::track {
+
+inline constexpr int kMaxLevels = 8;
+
+struct TrackerOptions {
+  // Pyramid levels used, coarsest first: levels - 1 down to finest_level. Levels smaller than
+  // 8x8 pixels are skipped.
+  int levels = 4;
+  // The finest level tracked: 0 is full resolution; 1 stops at half resolution, a third of
+  // the time for 5-8 instead of 2-3 micrometres RMS per frame at 640x480 on the simulator
+  // (README.md). -1 (the default): the coarsest level at least min_finest_width pixels wide
+  // (level 1 at 640x480, level 0 at 320x240).
+  int finest_level = -1;
+  int min_finest_width = 320;
+  // With finest_level > 0: a frame that is to become the keyframe is refined down to level 0,
+  // so that the chain of keyframes (what the pose drifts by) has full-resolution accuracy.
+  bool refine_keyframes = false;
+  // Gauss-Newton steps per level, index = level (each step costs one fused pass at that level
+  // except the last, which is applied without checking when it is below convergence_px).
+  std::array<int, kMaxLevels> max_iterations = {2, 6, 10, 12, 12, 12, 12, 12};
+  // Convergence: a step that moves no pixel of the level (its corners and centre) by more than
+  // this many pixels of that level ends the level.
+  double convergence_px = 0.05;
+  // Huber threshold k = huber_factor * sigma, sigma = 1.4826 * median |r| per level (clamped
+  // to [min_sigma, max_sigma]), measured at the level's first pass. That pass is weighted
+  // with the previous frame's sigma (initial_sigma at first); when the new one differs by
+  // more than a factor rescale_ratio the level restarts with it (one more pass), so that the
+  // cost is one function within a level.
+  double huber_factor = 2.0;
+  double initial_sigma = 8.0, min_sigma = 0.5, max_sigma = 40.0;  // grey levels
+  double rescale_ratio = 1.25;
+  // Estimate the affine brightness change (r = e^a I_l + b - I_r) jointly with the motion.
+  bool estimate_brightness = true;
+  // Levenberg damping: H + lambda diag(H); lambda starts at 0 (Gauss-Newton) and grows by
+  // lambda_up (from lambda_min) when a step increases the cost, shrinks by lambda_down after
+  // an accepted step.
+  double lambda_min = 1e-4, lambda_up = 10.0, lambda_down = 10.0;
+  // Keyframes: the live frame becomes the keyframe when the fraction of valid keyframe pixels
+  // that land inside the live image, on valid pixels, falls below keyframe_overlap.
+  double keyframe_overlap = 0.7;
+  // Bad input. A frame interval longer than max_gap_factor times the usual interval is a gap
+  // (status at best Degraded); longer than max_gap_seconds, the constant-velocity prediction is
+  // not used (zero motion is). Live texture below min_texture_ratio of the keyframe's (mean
+  // squared gradient over the overlap) is Lost. Too few valid pixels (min_valid_fraction of
+  // the level's pixels) is Lost. The residual's mean square relative to the keyframe's
+  // intensity variance over the overlap (about 1 for unrelated images after the brightness
+  // fit; 0.02-0.1 on the simulator at 640x480, up to 0.26 at 320x240 where pixel noise
+  // dominates): above lost_residual_ratio Lost, above degraded_residual_ratio Degraded.
+  // Inlier fraction below min_inlier_fraction: Degraded (with k = 2 sigma of this frame's own
+  // residuals, Gaussian residuals give 0.95; a heavy tail of unexplained pixels, fewer).
+  // |a| > max_log_gain: Lost. Degraded when the covariance's position standard deviation
+  // (larger axis) exceeds max_position_std, its axes differ by more than max_std_ratio (texture
+  // that constrains the motion in one direction only, e.g. stripes: 21; the shared textures:
+  // 1.9-3.5), or the heading's exceeds max_heading_std (typical: 2-10 um, 1e-5 rad).
+  double max_gap_factor = 2.5;
+  double max_gap_seconds = 0.5;
+  double min_texture_ratio = 0.1;
+  double min_valid_fraction = 0.05;
+  double lost_residual_ratio = 0.75;
+  double degraded_residual_ratio = 0.5;
+  double min_inlier_fraction = 0.6;
+  double max_log_gain = 0.7;
+  double max_position_std = 1e-4;  // metres
+  double max_std_ratio = 10.0;
+  double max_heading_std = 1e-3;   // radians
+  // The fused pass's work-group shape etc. (stats and debug_output are set by the tracker).
+  WarpReduceOptions kernel = default_kernel_options();
+
+  static WarpReduceOptions default_kernel_options();
+};
+
+struct FrameResult {
+  enum class Status {
+    First,     // the first frame (or the first after reset): it becomes the keyframe, no motion
+    Ok,
+    Degraded,  // tracked, but something is doubtful (reason says what)
+    Lost,      // not tracked: motion is the constant-velocity prediction (or zero)
+  };
+  Status status = Status::First;
+  const char* reason = "";  // why Degraded or Lost ("" when Ok)
+  // Frame-to-frame motion: this frame's robot pose in the previous frame's robot frame
+  // (T_{k-1}^-1 T_k, conventions.md), metres and radians.
+  SE2 motion;
+  // Covariance of the right perturbation xi of the motion (motion = m̂ exp(xi)) from this frame's
+  // alignment: sigma^2 (J^T W J)^-1 of the finest level, brightness marginalised, sigma^2 the
+  // weighted residual variance (at least min_sigma^2); (x, y) in metres, theta in radians.
+  // Pixels are treated as independent, so it is optimistic as an absolute (README.md).
+  // Large (1 m^2, 1 rad^2 on the diagonal) when Lost or First.
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Identity();
+  std::array<int, kMaxLevels> iterations{};  // fused passes per level
+  std::array<double, kMaxLevels> level_ms{};  // wall time per level (passes and solves), ms
+  int levels_used = 0;
+  double final_cost = 0;       // mean Huber cost per valid pixel at the finest level
+  double inlier_fraction = 0;  // |r| <= k among the valid pixels at the finest level
+  double overlap = 0;          // valid keyframe pixels landing on valid live pixels
+  double sigma = 0;            // robust residual scale at the finest level, grey levels
+  double log_gain = 0, bias = 0;  // brightness relative to the keyframe
+  bool keyframe = false;       // this frame became the keyframe
+  double ms = 0;               // wall time of track(), milliseconds
+  double pipeline_ms = 0;      // of which the image pipeline (camera-frame API only)
+};
+
+const char* status_name(FrameResult::Status s);
+
+class Tracker {
+ public:
+  // The camera's undistorted pinhole model (K, width, height) and the extrinsics. Builds the
+  // kernels; allocates the keyframe pyramid on the first frame.
+  Tracker(ocl::Runtime& runtime, const CameraModel& camera, const Extrinsics& extrinsics,
+          const TrackerOptions& options = {});
+  ~Tracker();
+  Tracker(const Tracker&) = delete;
+  Tracker& operator=(const Tracker&) = delete;
+
+  // Tracks one camera frame: 8-bit grey, width x height (the camera's size), rows `stride`
+  // bytes apart, timestamp in seconds. The image pipeline (image/pipeline.h: upload,
+  // undistortion, pyramid, gradients; created on the first frame) fills one of two device
+  // pyramids that the tracker swaps with the keyframe's, so nothing is copied. A frame of
+  // another size is Lost (not an exception); a null image or stride < width is
+  // InvalidArgument.
+  FrameResult track(const uint8_t* gray, int width, int height, size_t stride, double timestamp);
+
+  // Tracks one frame's device pyramid made elsewhere (pyramid.h: level 0 of the camera's
+  // size; options.levels levels, or as many as it has). The pyramid is only read; when the
+  // frame becomes the keyframe its levels are copied on the device. A pyramid of another
+  // size is Lost.
+  FrameResult track(const Pyramid& live, double timestamp);
+
+  // Forgets the keyframe, the pose, the velocity and the residual scales.
+  void reset();
+  // The accumulated robot pose relative to the first frame (product of the motions).
+  const SE2& pose() const;
+  const TrackerOptions& options() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace planarvo::track

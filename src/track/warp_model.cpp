@@ -1,0 +1,71 @@
+#include "track/warp_model.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <Eigen/Geometry>
+#include <Eigen/LU>
+
+namespace planarvo::track {
+
+namespace {
+
+// top3(T) P: the 3x3 map from a ground point's camera coordinates to the moved point, for a
+// 4x4 camera motion T (conventions.md: R - t n^T / z).
+Eigen::Matrix3d plane_map(const Eigen::Matrix4d& T, const Eigen::Vector3d& n, double z) {
+  return T.topLeftCorner<3, 3>() - T.topRightCorner<3, 1>() * n.transpose() / z;
+}
+
+}  // namespace
+
+MotionHomography motion_homography(const Eigen::Matrix3d& K, const Extrinsics& e,
+                                   const SE2& motion) {
+  const Eigen::Matrix4d T_vc = e.T_vc();
+  Eigen::Matrix4d T_cv = Eigen::Matrix4d::Identity();
+  T_cv.topLeftCorner<3, 3>() = T_vc.topLeftCorner<3, 3>().transpose();
+  T_cv.topRightCorner<3, 1>() = -T_cv.topLeftCorner<3, 3>() * T_vc.topRightCorner<3, 1>();
+  const Eigen::Matrix4d right = motion.inverse().matrix3d() * T_vc;  // T̂^-1 T_vc
+  const Eigen::Vector3d n = e.plane_normal_camera();
+  const Eigen::Matrix3d Kinv = K.inverse();
+
+  const Eigen::Matrix3d Hu = K * plane_map(T_cv * right, n, e.z) * Kinv;
+  const double s = Hu(2, 2);
+  MotionHomography out;
+  out.H = Hu / s;
+  const Eigen::Matrix3d Hinv = out.H.inverse();
+  for (int i = 0; i < 3; ++i) {
+    // d/dx_i exp(-x) at 0 = -gen_i; gen: translation along x, along y, rotation about z.
+    Eigen::Matrix4d gen = Eigen::Matrix4d::Zero();
+    if (i == 0) gen(0, 3) = 1.0;
+    if (i == 1) gen(1, 3) = 1.0;
+    if (i == 2) {
+      gen(0, 1) = -1.0;
+      gen(1, 0) = 1.0;
+    }
+    // plane_map is linear in T, so its derivative is plane_map of the derivative (the
+    // translation part of a 4x4 derivative enters the same way).
+    const Eigen::Matrix4d dT = T_cv * (-gen) * right;
+    const Eigen::Matrix3d dHu = K * plane_map(dT, n, e.z) * Kinv;
+    out.dH[static_cast<size_t>(i)] = dHu / s - Hu * dHu(2, 2) / (s * s);
+    out.G[static_cast<size_t>(i)] = Hinv * out.dH[static_cast<size_t>(i)];
+  }
+  return out;
+}
+
+double max_pixel_displacement(const Eigen::Matrix3d& K, const Extrinsics& e, const SE2& a,
+                              const SE2& b, int width, int height) {
+  const Eigen::Matrix3d Ha = ground_homography(K, e, a.matrix3d());
+  const Eigen::Matrix3d Hb = ground_homography(K, e, b.matrix3d());
+  const double w = width - 1.0, h = height - 1.0;
+  const double pts[5][2] = {{0, 0}, {w, 0}, {0, h}, {w, h}, {0.5 * w, 0.5 * h}};
+  double worst = 0.0;
+  for (const auto& p : pts) {
+    const Eigen::Vector3d q(p[0], p[1], 1.0);
+    const Eigen::Vector3d qa = Ha * q, qb = Hb * q;
+    const double d = (qa.hnormalized() - qb.hnormalized()).norm();
+    worst = std::max(worst, std::isfinite(d) ? d : 1e30);
+  }
+  return worst;
+}
+
+}  // namespace planarvo::track

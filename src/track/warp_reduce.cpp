@@ -1,0 +1,235 @@
+#include "track/warp_reduce.h"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include "core/error.h"
+#include "ocl/runtime.h"
+
+namespace planarvo::track {
+
+double ReduceLayout::hist_threshold(int j) { return 0.25 * std::pow(2.0, 0.5 * j); }
+
+void ReduceSums::assign(const ReduceLayout& L, const double* row) {
+  const int n = L.nj();
+  JtWJ.resize(n, n);
+  JtWr.resize(n);
+  for (int i = 0; i < n; ++i) {
+    for (int j = i; j < n; ++j) JtWJ(i, j) = JtWJ(j, i) = row[L.jtj(i, j)];
+    JtWr(i) = row[L.jtr(i)];
+  }
+  cost = row[L.cost()];
+  wrr = row[L.wrr()];
+  valid = row[L.valid()];
+  inlier = row[L.inlier()];
+  ref = row[L.ref()];
+  has_stats = L.stats;
+  rr = iref = iref2 = glive = gref = hist_valid = 0.0;
+  hist_bins = L.stats ? L.hist_bins : 0;
+  hist.fill(0.0);
+  if (!L.stats) return;
+  rr = row[L.rr()];
+  iref = row[L.iref()];
+  iref2 = row[L.iref2()];
+  glive = row[L.glive()];
+  gref = row[L.gref()];
+  hist_valid = row[L.hvalid()];
+  for (int j = 0; j < L.hist_bins; ++j) hist[static_cast<size_t>(j)] = row[L.hist(j)];
+}
+
+double ReduceSums::median_abs_residual() const {
+  if (hist_bins <= 0 || !(hist_valid > 0)) return std::nan("");
+  const double half = 0.5 * hist_valid;
+  if (hist[0] >= half) return 0.5 * ReduceLayout::hist_threshold(0);
+  for (int j = 1; j < hist_bins; ++j) {
+    const double c1 = hist[static_cast<size_t>(j)];
+    if (c1 >= half) {
+      const double c0 = hist[static_cast<size_t>(j - 1)];
+      const double f = c1 > c0 ? (half - c0) / (c1 - c0) : 0.0;
+      const double t0 = ReduceLayout::hist_threshold(j - 1);
+      const double t1 = ReduceLayout::hist_threshold(j);
+      return t0 * std::pow(t1 / t0, f);
+    }
+  }
+  return ReduceLayout::hist_threshold(hist_bins - 1);
+}
+
+ReduceSums warp_reduce_reference(const LevelView& ref, const LevelView& live,
+                                 const WarpInputs& in, const ReduceLayout& L, int wg_x,
+                                 int pixels_per_item) {
+  const int span = wg_x * pixels_per_item;
+  if (in.nparam != L.nparam) throw_invalid_argument("warp_reduce_reference: nparam mismatch");
+  const int nj = L.nj();
+  std::vector<double> row(static_cast<size_t>(L.count()), 0.0);
+  float h[9];
+  for (int i = 0; i < 9; ++i) h[i] = static_cast<float>(in.H(i / 3, i % 3));
+  const float gain_f = static_cast<float>(in.gain);
+  const double gain = gain_f, bias = static_cast<float>(in.bias);
+  const double k = static_cast<float>(in.huber_k);
+  std::array<double, kMaxJacobian> J{};
+  std::array<double, kMaxHistBins> thr{};
+  for (int j = 0; j < L.hist_bins; ++j) thr[static_cast<size_t>(j)] = static_cast<float>(ReduceLayout::hist_threshold(j));
+  auto at = [](const LevelView& l, int x, int y) { return l.data + 4 * (static_cast<size_t>(y) * l.stride + x); };
+
+  for (int y = 0; y < ref.height; ++y) {
+    for (int x = 0; x < ref.width; ++x) {
+      const float* R = at(ref, x, y);
+      if (R[3] == 0.0f) continue;
+      row[static_cast<size_t>(L.ref())] += 1.0;
+      const float fu = static_cast<float>(x), fv = static_cast<float>(y);
+      // The warp in float, in the kernel's order.
+      const float qx = h[0] * fu + h[1] * fv + h[2];
+      const float qy = h[3] * fu + h[4] * fv + h[5];
+      const float qz = h[6] * fu + h[7] * fv + h[8];
+      if (!(qz > 1e-12f)) continue;
+      const float iz = 1.0f / qz;
+      const float wu = std::clamp(qx * iz, -1e6f, 1e6f), wv = std::clamp(qy * iz, -1e6f, 1e6f);
+      const float bu = std::floor(wu), bv = std::floor(wv);
+      const int iu = static_cast<int>(bu), iv = static_cast<int>(bv);
+      if (iu < 0 || iv < 0 || iu >= live.width - 1 || iv >= live.height - 1) continue;
+      const float* s00 = at(live, iu, iv);
+      const float* s01 = at(live, iu + 1, iv);
+      const float* s10 = at(live, iu, iv + 1);
+      const float* s11 = at(live, iu + 1, iv + 1);
+      if (s00[3] == 0.0f || s01[3] == 0.0f || s10[3] == 0.0f || s11[3] == 0.0f) continue;
+      const double ax = wu - bu, ay = wv - bv;
+      double Ls[3];
+      for (int c = 0; c < 3; ++c)
+        Ls[c] = (1 - ax) * (1 - ay) * s00[c] + ax * (1 - ay) * s01[c] + (1 - ax) * ay * s10[c] +
+                ax * ay * s11[c];
+      const double r = gain * Ls[0] + bias - R[0];
+      const double dz = 1.0 / qz;
+      const double d00 = dz * (h[0] - wu * h[6]), d01 = dz * (h[1] - wu * h[7]);
+      const double d10 = dz * (h[3] - wv * h[6]), d11 = dz * (h[4] - wv * h[7]);
+      const double gu = 0.5 * (R[1] + gain * (Ls[1] * d00 + Ls[2] * d10));
+      const double gv = 0.5 * (R[2] + gain * (Ls[1] * d01 + Ls[2] * d11));
+      const double u = x, v = y;
+      for (int i = 0; i < L.nparam; ++i) {
+        const Eigen::Matrix3d& G = in.G[static_cast<size_t>(i)];
+        const double mx = G(0, 0) * u + G(0, 1) * v + G(0, 2);
+        const double my = G(1, 0) * u + G(1, 1) * v + G(1, 2);
+        const double mz = G(2, 0) * u + G(2, 1) * v + G(2, 2);
+        J[static_cast<size_t>(i)] = gu * (mx - u * mz) + gv * (my - v * mz);
+      }
+      J[static_cast<size_t>(L.nparam)] = gain * Ls[0];
+      J[static_cast<size_t>(L.nparam + 1)] = 1.0;
+      const double ar = std::abs(r);
+      const bool inlier = ar <= k;
+      const double w = inlier ? 1.0 : k / ar;
+      const double rho = inlier ? 0.5 * r * r : k * (ar - 0.5 * k);
+      for (int i = 0; i < nj; ++i) {
+        for (int j = i; j < nj; ++j)
+          row[static_cast<size_t>(L.jtj(i, j))] += w * J[static_cast<size_t>(i)] * J[static_cast<size_t>(j)];
+        row[static_cast<size_t>(L.jtr(i))] += w * J[static_cast<size_t>(i)] * r;
+      }
+      row[static_cast<size_t>(L.cost())] += rho;
+      row[static_cast<size_t>(L.wrr())] += w * r * r;
+      row[static_cast<size_t>(L.valid())] += 1.0;
+      row[static_cast<size_t>(L.inlier())] += inlier ? 1.0 : 0.0;
+      if (!L.stats) continue;
+      row[static_cast<size_t>(L.rr())] += r * r;
+      const double ic = R[0] - 128.0;
+      row[static_cast<size_t>(L.iref())] += ic;
+      row[static_cast<size_t>(L.iref2())] += ic * ic;
+      row[static_cast<size_t>(L.glive())] += Ls[1] * Ls[1] + Ls[2] * Ls[2];
+      row[static_cast<size_t>(L.gref())] += static_cast<double>(R[1]) * R[1] + static_cast<double>(R[2]) * R[2];
+      if (x % span >= wg_x) continue;
+      row[static_cast<size_t>(L.hvalid())] += 1.0;
+      for (int j = 0; j < L.hist_bins; ++j)
+        row[static_cast<size_t>(L.hist(j))] += ar < thr[static_cast<size_t>(j)] ? 1.0 : 0.0;
+    }
+  }
+  ReduceSums out;
+  out.assign(L, row.data());
+  return out;
+}
+
+std::string WarpReduce::build_options(int nparam, const WarpReduceOptions& o) {
+  std::ostringstream s;
+  s << "-D NPARAM=" << nparam << " -D WG_X=" << o.wg_x << " -D WG_Y=" << o.wg_y
+    << " -D PIX=" << o.pixels_per_item;
+  if (o.stats) s << " -D STATS=1 -D HIST_BINS=" << o.hist_bins;
+  if (o.debug_output) s << " -D DEBUG_OUTPUT";
+  if (o.fast_math) s << " -cl-fast-relaxed-math";
+  return s.str();
+}
+
+WarpReduce::WarpReduce(ocl::Runtime& runtime, int nparam, const WarpReduceOptions& options)
+    : runtime_(runtime), options_(options) {
+  if (nparam < 1 || nparam > kMaxParams)
+    throw_invalid_argument("WarpReduce: nparam must be 1.." + std::to_string(kMaxParams));
+  const int wg = options.wg_x * options.wg_y;
+  if (options.wg_x < 1 || options.wg_y < 1 || (wg & (wg - 1)) != 0)
+    throw_invalid_argument("WarpReduce: the work-group size wg_x * wg_y must be a power of two");
+  if (options.pixels_per_item < 1 || options.pixels_per_item > 64)
+    throw_invalid_argument("WarpReduce: pixels_per_item must be 1..64");
+  if (options.hist_bins < 0 || options.hist_bins > kMaxHistBins)
+    throw_invalid_argument("WarpReduce: hist_bins must be 0.." + std::to_string(kMaxHistBins));
+  layout_.nparam = nparam;
+  layout_.stats = options.stats;
+  layout_.hist_bins = options.stats ? options.hist_bins : 0;
+  build_options_ = build_options(nparam, options);
+  ocl::Runtime::register_build_options("warp_reduce", build_options_);
+  kernel_ = cl::Kernel(runtime.program("warp_reduce", build_options_), "warp_reduce");
+  params_host_.assign(static_cast<size_t>(9 * (nparam + 1)), 0.0f);
+  params_ = cl::Buffer(runtime.context(), CL_MEM_READ_ONLY, params_host_.size() * sizeof(float));
+  row_.assign(static_cast<size_t>(layout_.count()), 0.0);
+}
+
+void WarpReduce::run(const cl::Buffer& ref, int ref_w, int ref_h, const cl::Buffer& live,
+                     int live_w, int live_h, const WarpInputs& in, ReduceSums* out,
+                     cl::Buffer* debug) {
+  if (in.nparam != layout_.nparam) throw_invalid_argument("WarpReduce::run: nparam mismatch");
+  if (ref_w < 1 || ref_h < 1 || live_w < 2 || live_h < 2)
+    throw_invalid_argument("WarpReduce::run: levels must be at least 1x1 (reference) and 2x2 (live)");
+  if (options_.debug_output != (debug != nullptr))
+    throw_invalid_argument("WarpReduce::run: a debug buffer goes with debug_output, and only then");
+  for (int i = 0; i < 9; ++i) params_host_[static_cast<size_t>(i)] = static_cast<float>(in.H(i / 3, i % 3));
+  for (int p = 0; p < in.nparam; ++p)
+    for (int i = 0; i < 9; ++i)
+      params_host_[static_cast<size_t>(9 + 9 * p + i)] =
+          static_cast<float>(in.G[static_cast<size_t>(p)](i / 3, i % 3));
+
+  const size_t wx = static_cast<size_t>(options_.wg_x), wy = static_cast<size_t>(options_.wg_y);
+  const size_t span = wx * static_cast<size_t>(options_.pixels_per_item);
+  const size_t groups_x = (static_cast<size_t>(ref_w) + span - 1) / span;
+  const size_t groups_y = (static_cast<size_t>(ref_h) + wy - 1) / wy;
+  const size_t groups = groups_x * groups_y;
+  const size_t n = groups * static_cast<size_t>(layout_.count());
+  if (n > partials_capacity_) {
+    partials_ = cl::Buffer(runtime_.context(), CL_MEM_WRITE_ONLY | CL_MEM_ALLOC_HOST_PTR, n * sizeof(float));
+    partials_capacity_ = n;
+    partials_host_.resize(n);
+  }
+
+  cl::CommandQueue& q = runtime_.queue();
+  q.enqueueWriteBuffer(params_, CL_FALSE, 0, params_host_.size() * sizeof(float), params_host_.data());
+  int a = 0;
+  kernel_.setArg(a++, ref);
+  kernel_.setArg(a++, ref_w);  // stride
+  kernel_.setArg(a++, ref_w);
+  kernel_.setArg(a++, ref_h);
+  kernel_.setArg(a++, live);
+  kernel_.setArg(a++, live_w);  // stride
+  kernel_.setArg(a++, live_w);
+  kernel_.setArg(a++, live_h);
+  kernel_.setArg(a++, params_);
+  kernel_.setArg(a++, static_cast<float>(in.gain));
+  kernel_.setArg(a++, static_cast<float>(in.bias));
+  kernel_.setArg(a++, static_cast<float>(in.huber_k));
+  kernel_.setArg(a++, partials_);
+  if (debug) kernel_.setArg(a++, *debug);
+  q.enqueueNDRangeKernel(kernel_, cl::NullRange, cl::NDRange(groups_x * wx, groups_y * wy),
+                         cl::NDRange(wx, wy));
+  q.enqueueReadBuffer(partials_, CL_TRUE, 0, n * sizeof(float), partials_host_.data());
+
+  const size_t c = static_cast<size_t>(layout_.count());
+  std::fill(row_.begin(), row_.end(), 0.0);
+  const float* p = partials_host_.data();
+  for (size_t g = 0; g < groups; ++g, p += c)
+    for (size_t o = 0; o < c; ++o) row_[o] += static_cast<double>(p[o]);
+  out->assign(layout_, row_.data());
+}
+
+}  // namespace planarvo::track

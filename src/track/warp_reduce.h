@@ -1,0 +1,147 @@
+// The tracker's fused warp-residual-Jacobian-reduction pass (kernels/warp_reduce.cl): the
+// layout of its per-work-group partial sums, its plain C++ reference, and the host side that
+// runs it and sums the partials in double. What one pass computes is documented at the top of
+// the kernel; the residual is r = gain * I_l(w(p)) + bias - I_r(p) with gain = e^a.
+#pragma once
+#include <array>
+#include <string>
+#include <vector>
+
+#include <CL/opencl.hpp>
+#include <Eigen/Core>
+
+namespace planarvo::ocl {
+class Runtime;
+}
+
+namespace planarvo::track {
+
+// The most parameters of the homography a pass can take (NPARAM), and of histogram bins.
+inline constexpr int kMaxParams = 8;
+inline constexpr int kMaxJacobian = kMaxParams + 2;  // plus brightness (a, b)
+inline constexpr int kMaxHistBins = 24;
+
+// Where each sum sits in a row of partials (mirrors the OUT_* macros of warp_reduce.cl). The
+// statistics from rr() on exist only in the STATS variant.
+struct ReduceLayout {
+  int nparam = 3;
+  bool stats = false;
+  int hist_bins = 16;  // with stats only
+
+  int nj() const { return nparam + 2; }
+  int nh() const { return nj() * (nj() + 1) / 2; }
+  // Upper triangle of J^T W J, row by row; i <= j.
+  int jtj(int i, int j) const { return i * nj() - i * (i - 1) / 2 + (j - i); }
+  int jtr(int i) const { return nh() + i; }
+  int cost() const { return nh() + nj(); }
+  int wrr() const { return cost() + 1; }
+  int valid() const { return cost() + 2; }
+  int inlier() const { return cost() + 3; }
+  int ref() const { return cost() + 4; }
+  int rr() const { return cost() + 5; }
+  int iref() const { return cost() + 6; }
+  int iref2() const { return cost() + 7; }
+  int glive() const { return cost() + 8; }
+  int gref() const { return cost() + 9; }
+  int hvalid() const { return cost() + 10; }  // valid pixels in the histogram's subsample
+  int hist(int j) const { return cost() + 11 + j; }
+  int count() const { return stats ? hist(0) + hist_bins : cost() + 5; }
+  // Histogram bin j counts |r| < hist_threshold(j) = 0.25 * 2^(j / 2) grey levels.
+  static double hist_threshold(int j);
+};
+
+using MatrixJ = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxJacobian, kMaxJacobian>;
+using VectorJ = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxJacobian, 1>;
+
+// One pass's sums over the reference level, in double.
+struct ReduceSums {
+  MatrixJ JtWJ;      // nj x nj, symmetric (both triangles filled)
+  VectorJ JtWr;      // nj
+  double cost = 0;   // sum of Huber costs rho(r)
+  double wrr = 0;    // sum of weight * r^2
+  double valid = 0;  // pixels with a valid reference and a valid live sample
+  double inlier = 0; // of those, |r| <= k
+  double ref = 0;    // pixels with a valid reference
+  // The STATS variant's (zero otherwise):
+  bool has_stats = false;
+  double rr = 0;                // sum of r^2
+  double iref = 0, iref2 = 0;   // sums of (I_r - 128) and its square over the valid pixels
+  double glive = 0, gref = 0;   // sums of |grad I_l(w(p))|^2 and |grad I_r(p)|^2 over them
+  int hist_bins = 0;
+  // Over a subsample of the valid pixels (each work-item's first pixel), hist_valid of them:
+  double hist_valid = 0;
+  std::array<double, kMaxHistBins> hist{};  // counts of |r| < ReduceLayout::hist_threshold(j)
+
+  // Fills the fields from the summed row (layout.count() values).
+  void assign(const ReduceLayout& layout, const double* row);
+  // Median of |r| over the histogram's subsample from the cumulative histogram, interpolated linearly
+  // in log |r| between the bins' thresholds; the last threshold when more than half of the
+  // residuals lie beyond it, and the first (halved) when more than half lie below it.
+  double median_abs_residual() const;
+};
+
+// What one pass needs besides the images.
+struct WarpInputs {
+  Eigen::Matrix3d H = Eigen::Matrix3d::Identity();  // reference -> live pixels
+  int nparam = 3;
+  std::array<Eigen::Matrix3d, kMaxParams> G{};  // reference-side generators (warp_model.h)
+  double gain = 1.0, bias = 0.0;                // e^a and b
+  double huber_k = 1e30;                        // Huber threshold, grey levels (> 0)
+};
+
+// A host float4 level (pyramid.h's layout), stride in float4 elements.
+struct LevelView {
+  const float* data = nullptr;
+  int width = 0, height = 0, stride = 0;
+};
+
+// The plain C++ reference of the kernel: the same per-pixel formulas, the warp in float in the
+// kernel's order (so validity decisions match), everything after it in double, accumulated in
+// double. Returns the sums for the layout's nparam, stats and hist_bins; the histogram's
+// subsample is the pixels whose column c satisfies (c mod (wg_x * pix)) < wg_x, as the
+// kernel's work distribution makes it.
+
+ReduceSums warp_reduce_reference(const LevelView& ref, const LevelView& live,
+                                 const WarpInputs& in, const ReduceLayout& layout, int wg_x = 16,
+                                 int pixels_per_item = 8);
+
+struct WarpReduceOptions {
+  int wg_x = 16, wg_y = 1;   // work-group shape (WG_X x WG_Y must be a power of two)
+  int pixels_per_item = 8;   // PIX: pixels per work-item along a row, WG_X apart
+  bool stats = false;        // the STATS variant: residual, intensity and gradient statistics
+  int hist_bins = 16;        // and a histogram of |r| for the robust scale (with stats only)
+  bool fast_math = false;    // -cl-fast-relaxed-math (no faster on PoCL: src/track/README.md)
+  bool debug_output = false; // per-pixel (r, weight, valid, rho) into a debug buffer
+};
+
+// The pass on the device. Builds its program once; run() allocates nothing once the partials
+// buffer has grown to the largest level it has seen.
+class WarpReduce {
+ public:
+  WarpReduce(ocl::Runtime& runtime, int nparam, const WarpReduceOptions& options = {});
+
+  // Enqueues the pass for a reference level and a live level (float4 buffers of pyramid.h,
+  // stride == width), reads the partials back (the one blocking call) and sums them in double
+  // into *out. With debug_output, `debug` (ref_w * ref_h float4) receives the per-pixel values.
+  void run(const cl::Buffer& ref, int ref_w, int ref_h, const cl::Buffer& live, int live_w,
+           int live_h, const WarpInputs& in, ReduceSums* out, cl::Buffer* debug = nullptr);
+
+  const ReduceLayout& layout() const { return layout_; }
+  const std::string& build_options() const { return build_options_; }
+  static std::string build_options(int nparam, const WarpReduceOptions& options);
+
+ private:
+  ocl::Runtime& runtime_;
+  WarpReduceOptions options_;
+  ReduceLayout layout_;
+  std::string build_options_;
+  cl::Kernel kernel_;
+  cl::Buffer params_;
+  cl::Buffer partials_;
+  size_t partials_capacity_ = 0;  // floats
+  std::vector<float> params_host_;
+  std::vector<float> partials_host_;
+  std::vector<double> row_;
+};
+
+}  // namespace planarvo::track

@@ -1,0 +1,388 @@
+// Benchmark and evaluation of the tracker. Prints tables, asserts nothing.
+//   bench_track kernel   [width height]   the fused pass per work-group shape / pixels per
+//                                          work-item / fast math, median ms per pass
+//   bench_track kernel w h wx wy pix hist fast [rounds]   one configuration
+//   bench_track speed [w h] [seconds] [rounds]   ms per frame through the camera-frame API
+//   bench_track accuracy [key=value...]     simulated sequences tracked against ground truth
+//       (seconds, w, h, seed, motion=mixed|straight|circle|spin, levels, finest, refine_kf, conv,
+//        huber, overlap, maxit=l0,l1,.., textures=a.png,b.png or textures=all; see main())
+#include <algorithm>
+#include <cmath>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <string>
+#include <vector>
+
+#include <sys/resource.h>
+
+#include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
+#include <opencv2/imgcodecs.hpp>
+
+#include "core/se2.h"
+#include "image/undistort.h"
+#include "io/simulator.h"
+#include "ocl/runtime.h"
+#include "track/evaluation.h"
+#include "track/tracker.h"
+#include "track/warp_model.h"
+#include "track/warp_reduce.h"
+#include "../unit/track_test_pyramid.h"
+
+using namespace planarvo;
+
+namespace {
+
+double now_ms() {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+// Process CPU time (all threads: PoCL's workers too), ms: less sensitive than wall time to
+// other processes competing for the two cores.
+double cpu_ms() {
+  rusage u{};
+  getrusage(RUSAGE_SELF, &u);
+  return 1e3 * (u.ru_utime.tv_sec + u.ru_stime.tv_sec) + 1e-3 * (u.ru_utime.tv_usec + u.ru_stime.tv_usec);
+}
+
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  return v.empty() ? 0.0 : v[v.size() / 2];
+}
+
+constexpr int kMaxLevelsBench = track::kMaxLevels;
+
+std::string texture_path(const std::string& name) {
+  return std::string(PLANARVO_SHARED_DIR) + "/data/textures/" + name;
+}
+
+struct KernelConfig { int wx, wy, pix, hist; bool fast; };
+
+int bench_kernel(int width, int height, const std::vector<KernelConfig>& only, int reps) {
+  ocl::Runtime rt;
+  std::printf("device: %s / %s\n", rt.device_info().platform_name.c_str(), rt.device_info().device_name.c_str());
+  sim::Options so;
+  so.texture = texture_path("asphalt_01.png");
+  so.camera = sim::default_camera(width, height);
+  so.camera.k1 = so.camera.k2 = 0.0;
+  sim::Renderer renderer(rt, cv::imread(so.texture, cv::IMREAD_GRAYSCALE), so);
+  const SE2 motion(0.01, 0.002, 0.02);
+  const Pyramid ref = test::test_upload(rt, test::test_pyramid(renderer.render_float(SE2()), nullptr, 1));
+  const Pyramid live = test::test_upload(rt, test::test_pyramid(renderer.render_float(motion), nullptr, 1));
+  const track::MotionHomography mh = track::motion_homography(so.camera.K(), so.extrinsics, motion);
+  track::WarpInputs in;
+  in.H = mh.H;
+  for (int i = 0; i < 3; ++i) in.G[static_cast<size_t>(i)] = mh.G[static_cast<size_t>(i)];
+  in.huber_k = 5.0;
+
+  using Row = KernelConfig;
+  std::vector<Row> rows = only;
+  if (rows.empty()) {
+  for (int fast = 1; fast >= 0; --fast)
+    for (const auto& s : std::vector<std::array<int, 2>>{{16, 1}, {32, 1}, {64, 1}, {128, 1}, {16, 4}, {32, 2}})
+      for (int pix : {1, 2, 4, 8}) rows.push_back({s[0], s[1], pix, 16, fast != 0});
+  rows.push_back({64, 1, 4, 0, true});
+  rows.push_back({64, 1, 8, 0, true});
+  }
+  std::printf("%dx%d, one fused pass (enqueue, kernel, read-back of the partials, host sum)\n", width, height);
+  std::printf("%6s %4s %4s %5s %5s %9s %9s %9s\n", "wg_x", "wg_y", "pix", "hist", "fast", "median_ms", "min_ms", "cpu_ms");
+  // Rounds over all configurations, so that load from other processes spreads over all of them.
+  std::vector<std::vector<double>> times(rows.size());
+  std::vector<double> valid(rows.size()), cpu(rows.size(), 0.0);
+  for (int round = 0; round < reps; ++round)
+  for (size_t ri = 0; ri < rows.size(); ++ri) {
+    const Row& r = rows[ri];
+    track::WarpReduceOptions o;
+    o.wg_x = r.wx; o.wg_y = r.wy; o.pixels_per_item = r.pix; o.stats = r.hist > 0; o.hist_bins = r.hist; o.fast_math = r.fast;
+    track::WarpReduce wr(rt, 3, o);
+    track::ReduceSums s;
+    wr.run(ref.levels[0].data, width, height, live.levels[0].data, width, height, in, &s);
+    const double c0 = cpu_ms();
+    for (int i = 0; i < 5; ++i) {
+      const double t0 = now_ms();
+      wr.run(ref.levels[0].data, width, height, live.levels[0].data, width, height, in, &s);
+      times[ri].push_back(now_ms() - t0);
+    }
+    cpu[ri] += (cpu_ms() - c0) / 5.0 / reps;
+    valid[ri] = s.valid;
+  }
+  for (size_t ri = 0; ri < rows.size(); ++ri) {
+    const Row& r = rows[ri];
+    std::printf("%6d %4d %4d %5d %5d %9.3f %9.3f %9.3f  (valid %.0f)\n", r.wx, r.wy, r.pix, r.hist, r.fast ? 1 : 0,
+                median(times[ri]), *std::min_element(times[ri].begin(), times[ri].end()), cpu[ri], valid[ri]);
+  }
+  // Launch overhead: the same pass on a tiny level.
+  {
+    track::WarpReduce wr(rt, 3);
+    track::ReduceSums s;
+    std::vector<double> t;
+    for (int i = 0; i < 50; ++i) {
+      const double t0 = now_ms();
+      wr.run(ref.levels[0].data, 16, 2, live.levels[0].data, width, height, in, &s);
+      t.push_back(now_ms() - t0);
+    }
+    std::printf("launch + read-back overhead (16x2 reference): median %.3f ms\n", median(t));
+  }
+  return 0;
+}
+
+// The simulator's frames of a sequence: 8-bit camera images, times and true poses.
+struct Sequence {
+  sim::Options options;
+  sim::Trajectory trajectory;
+  std::vector<cv::Mat> frames;  // rendered on demand when not kept
+};
+
+sim::Options sequence_options(const std::string& texture, double seconds, int width, int height, uint64_t seed) {
+  sim::Options so;
+  so.texture = texture_path(texture);
+  so.camera = sim::default_camera(width, height);
+  so.seconds = seconds;
+  so.seed = seed;
+  return so;
+}
+
+struct SequenceReport {
+  int frames = 0, ok = 0, degraded = 0, lost = 0, keyframes = 0;
+  track::MotionAccuracy acc;
+  double ms_frame = 0, ms_pipeline = 0, cpu_frame = 0;
+  double passes[kMaxLevelsBench] = {};
+  double level_ms[kMaxLevelsBench] = {};
+  double std_pos_median = 0, std_pos_max = 0, std_head_median = 0, nees = 0, aniso_max = 0;
+};
+
+// Renders and tracks a sequence frame by frame through the camera-frame API.
+SequenceReport run_sequence(ocl::Runtime& rt, const sim::Options& so, const track::TrackerOptions& topt,
+                            bool verbose) {
+  const sim::Trajectory traj = sim::generate_trajectory(so);
+  const std::vector<sim::Exposure> exposure = sim::exposure_series(so, traj.t);
+  sim::Renderer renderer(rt, cv::imread(so.texture, cv::IMREAD_GRAYSCALE), so);
+  track::Tracker tracker(rt, so.camera, so.extrinsics, topt);
+  SequenceReport rep;
+  std::vector<SE2> est, truth;
+  std::vector<double> dts, std_pos, std_head;
+  double nees = 0;
+  int nees_n = 0;
+  for (size_t k = 0; k < traj.t.size(); ++k) {
+    const cv::Mat img = sim::apply_camera(renderer.render_float(traj.pose[k]), exposure[k], so.pixel_noise,
+                                          sim::derive_seed(so.seed, 1000 + k));
+    const double c0 = cpu_ms();
+    const track::FrameResult r = tracker.track(img.data, img.cols, img.rows, img.step, traj.t[k]);
+    rep.cpu_frame += cpu_ms() - c0;
+    rep.ms_frame += r.ms;
+    rep.ms_pipeline += r.pipeline_ms;
+    ++rep.frames;
+    rep.keyframes += r.keyframe;
+    for (int l = 0; l < kMaxLevelsBench; ++l) {
+      rep.passes[l] += r.iterations[static_cast<size_t>(l)];
+      rep.level_ms[l] += r.level_ms[static_cast<size_t>(l)];
+    }
+    rep.ok += r.status == track::FrameResult::Status::Ok;
+    rep.degraded += r.status == track::FrameResult::Status::Degraded;
+    rep.lost += r.status == track::FrameResult::Status::Lost;
+    if (k == 0) continue;
+    const SE2 t = traj.pose[k - 1].inverse() * traj.pose[k];
+    est.push_back(r.motion);
+    truth.push_back(t);
+    dts.push_back(traj.t[k] - traj.t[k - 1]);
+    const double e = std::hypot(r.motion.x - t.x, r.motion.y - t.y);
+    if (r.status == track::FrameResult::Status::Ok) {
+      std_pos.push_back(std::sqrt(std::max(r.covariance(0, 0), r.covariance(1, 1))));
+      std_head.push_back(std::sqrt(r.covariance(2, 2)));
+      const Eigen::Vector2d ev = Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(r.covariance.topLeftCorner<2, 2>()).eigenvalues();
+      rep.aniso_max = std::max(rep.aniso_max, std::sqrt(ev(1) / ev(0)));
+      // Normalised error of the frames tracked directly against the keyframe's own frame
+      // (the previous frame was the keyframe), where the covariance is that of the motion.
+      const Eigen::Vector3d xi = (r.motion.inverse() * t).log();
+      nees += xi.dot(r.covariance.ldlt().solve(xi));
+      ++nees_n;
+    }
+    if (verbose && (e > 1e-3 || r.status != track::FrameResult::Status::Ok))
+      std::printf("  frame %zu: %s %s err %.3f mm, truth (%.4f %.4f %.4f) est (%.4f %.4f %.4f) overlap %.2f\n", k,
+                  track::status_name(r.status), r.reason, e * 1e3, t.x, t.y, t.theta, r.motion.x, r.motion.y,
+                  r.motion.theta, r.overlap);
+  }
+  rep.acc = track::evaluate_motions(est, truth, dts);
+  rep.std_pos_median = median(std_pos);
+  rep.std_pos_max = std_pos.empty() ? 0 : *std::max_element(std_pos.begin(), std_pos.end());
+  rep.std_head_median = median(std_head);
+  rep.nees = nees_n ? nees / nees_n : 0;
+  return rep;
+}
+
+int bench_accuracy(const std::vector<std::string>& textures, double seconds, int width, int height,
+                   uint64_t seed, sim::MotionProfile motion, const track::TrackerOptions& topt, bool verbose) {
+  ocl::Runtime rt;
+  std::printf("device: %s\n", rt.device_info().device_name.c_str());
+  std::printf("%dx%d, %.0f s at 30 Hz per texture (seed %llu), mixed motion up to 0.8 m/s and 1.5 rad/s, noise 1 grey "
+              "level, gain/offset drift 5%%, configuration 1, lens distortion; tracker levels %d, finest %d "
+              "(-1: auto)\n", width, height, seconds, static_cast<unsigned long long>(seed), topt.levels,
+              topt.finest_level);
+  std::printf("%-22s %6s %4s %4s %4s %4s %8s %8s %7s %7s %8s %5s %7s %7s %7s %7s  %s\n", "texture", "frames", "ok",
+              "deg", "lost", "kf", "slope_v", "slope_w", "rms_mm", "max_mm", "rms_deg", "gross", "drift%", "ms/fr",
+              "ms_pipe", "cpu/fr", "passes per frame, coarse to fine");
+  for (const std::string& tex : textures) {
+    sim::Options so = sequence_options(tex, seconds, width, height, seed);
+    so.motion = motion;
+    const SequenceReport r = run_sequence(rt, so, topt, verbose);
+    const double n = r.frames;
+    std::printf("%-22s %6d %4d %4d %4d %4d %8.5f %8.5f %7.4f %7.4f %8.5f %5d %7.3f %7.2f %7.2f %7.2f ", tex.c_str(),
+                r.frames, r.ok, r.degraded, r.lost, r.keyframes, r.acc.slope_linear, r.acc.slope_angular,
+                r.acc.rms_translation * 1e3, r.acc.max_translation * 1e3, r.acc.rms_rotation * 180 / M_PI,
+                r.acc.gross_errors, r.acc.endpoint_drift * 100, r.ms_frame / n, r.ms_pipeline / n, r.cpu_frame / n);
+    for (int l = topt.levels - 1; l >= 0; --l) std::printf(" %.2f", r.passes[l] / n);
+    std::printf("\n");
+    if (verbose)
+      std::printf("  covariance: position std median %.2g m (max %.2g), heading std median %.2g rad; "
+                  "mean NEES %.1f (3 if calibrated); largest std ratio of the position axes %.1f\n", r.std_pos_median,
+                  r.std_pos_max, r.std_head_median, r.nees, r.aniso_max);
+    std::fflush(stdout);
+  }
+  return 0;
+}
+
+// Speed: frames rendered once into memory, then tracked repeatedly with each configuration,
+// the configurations interleaved so that load from other processes spreads over all of them.
+int bench_speed(int width, int height, double seconds, int rounds) {
+  ocl::Runtime rt;
+  std::printf("device: %s\n", rt.device_info().device_name.c_str());
+  const sim::Options so = sequence_options("asphalt_01.png", seconds, width, height, 1);
+  const sim::Trajectory traj = sim::generate_trajectory(so);
+  const std::vector<sim::Exposure> exposure = sim::exposure_series(so, traj.t);
+  std::vector<cv::Mat> frames;
+  {
+    sim::Renderer renderer(rt, cv::imread(so.texture, cv::IMREAD_GRAYSCALE), so);
+    for (size_t k = 0; k < traj.t.size(); ++k)
+      frames.push_back(sim::apply_camera(renderer.render_float(traj.pose[k]), exposure[k], so.pixel_noise,
+                                         sim::derive_seed(so.seed, 1000 + k)));
+  }
+  struct Config {
+    const char* name;
+    track::TrackerOptions opt;
+  };
+  std::vector<Config> configs;
+  {
+    track::TrackerOptions o;
+    configs.push_back({"default (finest auto)", o});
+    o.finest_level = 0;
+    configs.push_back({"finest level 0", o});
+    o.finest_level = -1;
+    o.refine_keyframes = true;
+    configs.push_back({"auto + refine keyframes", o});
+    o.refine_keyframes = false;
+    o.levels = 3;
+    configs.push_back({"3 levels", o});
+  }
+  struct Stats {
+    std::vector<double> frame, pipe, track;
+    double cpu = 0, passes = 0;
+    int n = 0;
+  };
+  std::vector<Stats> stats(configs.size());
+  for (int round = 0; round < rounds; ++round)
+    for (size_t c = 0; c < configs.size(); ++c) {
+      track::Tracker tracker(rt, so.camera, so.extrinsics, configs[c].opt);
+      for (size_t k = 0; k < frames.size(); ++k) {
+        const double c0 = cpu_ms();
+        const track::FrameResult r = tracker.track(frames[k].data, frames[k].cols, frames[k].rows, frames[k].step, traj.t[k]);
+        if (k == 0) continue;  // the first frame builds the pipeline
+        stats[c].cpu += cpu_ms() - c0;
+        stats[c].frame.push_back(r.ms);
+        stats[c].pipe.push_back(r.pipeline_ms);
+        stats[c].track.push_back(r.ms - r.pipeline_ms);
+        for (int p : r.iterations) stats[c].passes += p;
+        ++stats[c].n;
+      }
+    }
+  std::printf("%dx%d, %zu frames of asphalt_01 (mixed motion) x %d rounds, camera-frame API (upload, undistortion, "
+              "pyramid, tracking)\n", width, height, frames.size(), rounds);
+  std::printf("%-26s %9s %9s %9s %9s %9s %8s %7s\n", "configuration", "med_frame", "mean_frame", "med_pipe",
+              "med_track", "cpu/frame", "passes", "fps");
+  for (size_t c = 0; c < configs.size(); ++c) {
+    const Stats& s = stats[c];
+    double mean = 0;
+    for (double v : s.frame) mean += v;
+    mean /= std::max<size_t>(1, s.frame.size());
+    std::printf("%-26s %9.2f %9.2f %9.2f %9.2f %9.2f %8.2f %7.0f\n", configs[c].name, median(s.frame), mean,
+                median(s.pipe), median(s.track), s.cpu / s.n, s.passes / s.n, 1000.0 / mean);
+  }
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const std::string mode = argc > 1 ? argv[1] : "kernel";
+  if (mode == "kernel") {
+    const int w = argc > 3 ? std::atoi(argv[2]) : 640, h = argc > 3 ? std::atoi(argv[3]) : 480;
+    std::vector<KernelConfig> only;
+    if (argc > 8)
+      only.push_back({std::atoi(argv[4]), std::atoi(argv[5]), std::atoi(argv[6]), std::atoi(argv[7]), std::atoi(argv[8]) != 0});
+    return bench_kernel(w, h, only, argc > 9 ? std::atoi(argv[9]) : 6);
+  }
+  if (mode == "speed") {
+    // bench_track speed [w h] [seconds] [rounds]
+    const int w = argc > 3 ? std::atoi(argv[2]) : 640, h = argc > 3 ? std::atoi(argv[3]) : 480;
+    return bench_speed(w, h, argc > 4 ? std::atof(argv[4]) : 5.0, argc > 5 ? std::atoi(argv[5]) : 3);
+  }
+  if (mode == "accuracy") {
+    // bench_track accuracy [key=value ...]: seconds=10 w=640 h=480 levels=4 finest=0
+    //   refine_kf=0 maxit=a,b,c,d (per level from 0) textures=a.png,b.png seed=1
+    double seconds = 10.0;
+    int w = 640, h = 480;
+    uint64_t seed = 1;
+    sim::MotionProfile motion = sim::MotionProfile::Mixed;
+    track::TrackerOptions topt;
+    std::vector<std::string> tex = {"asphalt_01.png", "anti_skid_tiles.png", "brick_floor.png",
+                                    "aerial_ground_rock.png"};
+    for (int i = 2; i < argc; ++i) {
+      const std::string a = argv[i];
+      const size_t eq = a.find('=');
+      const std::string k = a.substr(0, eq), v = eq == std::string::npos ? "" : a.substr(eq + 1);
+      auto list = [&](const std::string& x) {
+        std::vector<std::string> out;
+        size_t p = 0;
+        while (p <= x.size()) {
+          const size_t c = x.find(',', p);
+          out.push_back(x.substr(p, c == std::string::npos ? std::string::npos : c - p));
+          if (c == std::string::npos) break;
+          p = c + 1;
+        }
+        return out;
+      };
+      if (k == "seconds") seconds = std::atof(v.c_str());
+      else if (k == "w") w = std::atoi(v.c_str());
+      else if (k == "h") h = std::atoi(v.c_str());
+      else if (k == "seed") seed = std::strtoull(v.c_str(), nullptr, 10);
+      else if (k == "motion")
+        motion = v == "straight" ? sim::MotionProfile::Straight
+                 : v == "circle" ? sim::MotionProfile::Circle
+                 : v == "spin"   ? sim::MotionProfile::Spin
+                                 : sim::MotionProfile::Mixed;
+      else if (k == "levels") topt.levels = std::atoi(v.c_str());
+      else if (k == "finest") topt.finest_level = std::atoi(v.c_str());
+      else if (k == "refine_kf") topt.refine_keyframes = std::atoi(v.c_str()) != 0;
+      else if (k == "conv") topt.convergence_px = std::atof(v.c_str());
+      else if (k == "huber") topt.huber_factor = std::atof(v.c_str());
+      else if (k == "overlap") topt.keyframe_overlap = std::atof(v.c_str());
+      else if (k == "maxit") {
+        const auto it = list(v);
+        for (size_t l = 0; l < it.size() && l < topt.max_iterations.size(); ++l) topt.max_iterations[l] = std::atoi(it[l].c_str());
+      } else if (k == "textures") tex = list(v);
+      else {
+        std::fprintf(stderr, "unknown option %s\n", a.c_str());
+        return 2;
+      }
+    }
+    if (tex.size() == 1 && tex[0] == "all")
+      tex = {"aerial_asphalt_01.png", "aerial_ground_rock.png", "anti_skid_tiles.png", "anti_slip_concrete.png",
+             "asphalt_01.png", "asphalt_02.png", "black_painted_planks.png", "blue_floor_tiles_01.png",
+             "brick_floor.png", "brown_mud_rocks_01.png", "brushed_concrete.png", "skimage_brick.png",
+             "skimage_grass.png", "skimage_gravel.png"};
+    return bench_accuracy(tex, seconds, w, h, seed, motion, topt, std::getenv("BENCH_VERBOSE") != nullptr);
+  }
+  std::fprintf(stderr, "usage: bench_track kernel [w h [wx wy pix hist fast [rounds]]] | speed [w h [seconds [rounds]]]"
+                       " | accuracy [key=value...]\n");
+  return 2;
+}

@@ -1,0 +1,236 @@
+// The tracker on bad input: black, saturated and textureless frames, a frame of another size,
+// gaps and bad timestamps. Each gives Lost or Degraded with a reason, a finite motion and pose,
+// and tracking recovers on the next good frame; the pose stays close to the truth where the
+// good frames allow it.
+#include <cmath>
+#include <cstdio>
+
+#include <gtest/gtest.h>
+#include <opencv2/imgcodecs.hpp>
+
+#include "common/test_util.h"
+#include "core/error.h"
+#include "io/simulator.h"
+#include "ocl/runtime.h"
+#include "track/tracker.h"
+#include "unit/track_test_pyramid.h"
+
+namespace planarvo::track {
+namespace {
+
+using Status = FrameResult::Status;
+
+class TrackBadInput : public ::testing::Test {
+ protected:
+  TrackBadInput() {
+    options_.texture = test::texture("asphalt_01.png").string();
+    options_.camera = sim::default_camera(320, 240);
+    options_.camera.k1 = options_.camera.k2 = 0.0;
+    renderer_ = std::make_unique<sim::Renderer>(rt_, cv::imread(options_.texture, cv::IMREAD_GRAYSCALE), options_);
+    tracker_ = std::make_unique<Tracker>(rt_, options_.camera, options_.extrinsics);
+  }
+
+  // Constant velocity 0.3 m/s and 0.6 rad/s: frame k at time k / 30 s.
+  static SE2 truth(double t) { return SE2::exp(Eigen::Vector3d(0.3 * t, 0.0, 0.6 * t)); }
+
+  Pyramid good(double t, uint64_t seed = 7) {
+    const cv::Mat u8 = sim::apply_camera(renderer_->render_float(truth(t)), {}, 1.0, seed + static_cast<uint64_t>(t * 1000));
+    return test::test_upload(rt_, test::test_pyramid(u8, nullptr, 4));
+  }
+  Pyramid flat(double value, double noise, int w = 320, int h = 240) {
+    cv::Mat f(h, w, CV_32FC1, cv::Scalar(value));
+    const cv::Mat u8 = sim::apply_camera(f, {}, noise, 3);
+    return test::test_upload(rt_, test::test_pyramid(u8, nullptr, 4));
+  }
+
+  FrameResult track(const Pyramid& p, double t) {
+    const FrameResult r = tracker_->track(p, t);
+    EXPECT_TRUE(std::isfinite(r.motion.x) && std::isfinite(r.motion.y) && std::isfinite(r.motion.theta));
+    EXPECT_TRUE(r.covariance.allFinite());
+    EXPECT_TRUE(std::isfinite(tracker_->pose().x) && std::isfinite(tracker_->pose().theta));
+    if (r.status == Status::Lost || r.status == Status::Degraded) {
+      EXPECT_STRNE(r.reason, "");
+    }
+    return r;
+  }
+  // Distance between the tracker's pose and the truth at t (the first frame at t0).
+  double pose_error_mm(double t0, double t) const {
+    const SE2 rel = truth(t0).inverse() * truth(t);
+    return 1e3 * std::hypot(tracker_->pose().x - rel.x, tracker_->pose().y - rel.y);
+  }
+
+  ocl::Runtime rt_;
+  sim::Options options_;
+  std::unique_ptr<sim::Renderer> renderer_;
+  std::unique_ptr<Tracker> tracker_;
+};
+
+constexpr double dt = 1.0 / 30;
+
+#define EXPECT_STATUS(result, expected)                                              \
+  do {                                                                               \
+    const FrameResult r_ = (result);                                                 \
+    EXPECT_STREQ(status_name(r_.status), status_name(Status::expected)) << r_.reason; \
+  } while (0)
+
+TEST_F(TrackBadInput, BlackAndSaturatedFramesAreLostThenTrackingResumes) {
+  EXPECT_STATUS(track(good(0), 0), First);
+  for (int k = 1; k <= 3; ++k) EXPECT_STATUS(track(good(k * dt), k * dt), Ok);
+  // Black: lost, the motion is the constant-velocity prediction, the keyframe is kept.
+  const FrameResult black = track(flat(0, 0), 4 * dt);
+  EXPECT_STATUS(black, Lost);
+  EXPECT_FALSE(black.keyframe);
+  const SE2 step = truth(3 * dt).inverse() * truth(4 * dt);
+  EXPECT_NEAR(black.motion.x, step.x, 1e-4);
+  EXPECT_NEAR(black.motion.theta, step.theta, 1e-3);
+  // The next good frame is tracked against the keyframe: the pose is right again.
+  EXPECT_STATUS(track(good(5 * dt), 5 * dt), Ok);
+  EXPECT_LT(pose_error_mm(0, 5 * dt), 0.05);
+  // Saturated: the same.
+  const FrameResult white = track(flat(255, 0), 6 * dt);
+  EXPECT_STATUS(white, Lost);
+  for (int k = 7; k <= 9; ++k) EXPECT_STATUS(track(good(k * dt), k * dt), Ok);
+  EXPECT_LT(pose_error_mm(0, 9 * dt), 0.05);
+}
+
+TEST_F(TrackBadInput, TexturelessFrameIsLost) {
+  track(good(0), 0);
+  track(good(dt), dt);
+  const FrameResult r = track(flat(110, 1.0), 2 * dt);
+  EXPECT_STATUS(r, Lost);
+  EXPECT_STATUS(track(good(3 * dt), 3 * dt), Ok);
+  EXPECT_LT(pose_error_mm(0, 3 * dt), 0.05);
+}
+
+TEST_F(TrackBadInput, BadFirstFramesDoNotBecomeTheKeyframe) {
+  EXPECT_STATUS(track(flat(0, 0), 0), Lost);
+  EXPECT_STATUS(track(flat(128, 1.0), dt), Lost);
+  EXPECT_STATUS(track(good(2 * dt), 2 * dt), First);
+  EXPECT_STATUS(track(good(3 * dt), 3 * dt), Ok);
+}
+
+TEST_F(TrackBadInput, FrameOfAnotherSizeIsLost) {
+  track(good(0), 0);
+  track(good(dt), dt);
+  const FrameResult r = track(flat(100, 5.0, 160, 120), 2 * dt);
+  EXPECT_STATUS(r, Lost);
+  EXPECT_FALSE(r.keyframe);
+  EXPECT_STATUS(track(good(3 * dt), 3 * dt), Ok);
+  EXPECT_LT(pose_error_mm(0, 3 * dt), 0.05);
+}
+
+TEST_F(TrackBadInput, ShortGapIsDegradedButTracked) {
+  track(good(0), 0);
+  track(good(dt), dt);
+  track(good(2 * dt), 2 * dt);
+  // Five frames missing: 50 mm and 0.1 rad in one interval, predicted from the velocity.
+  const FrameResult r = track(good(8 * dt), 8 * dt);
+  EXPECT_STATUS(r, Degraded);
+  const SE2 step = truth(2 * dt).inverse() * truth(8 * dt);
+  EXPECT_LT(1e3 * std::hypot(r.motion.x - step.x, r.motion.y - step.y), 0.05);
+  EXPECT_STATUS(track(good(9 * dt), 9 * dt), Ok);
+  EXPECT_LT(pose_error_mm(0, 9 * dt), 0.05);
+}
+
+TEST_F(TrackBadInput, LongGapIsLostThenTheFrameIsTheNewKeyframe) {
+  track(good(0), 0);
+  track(good(dt), dt);
+  // Three seconds later the robot is a metre away: nothing overlaps. Lost, zero motion (no
+  // prediction over so long), and the textured frame becomes the keyframe.
+  const FrameResult r = track(good(3.0), 3.0);
+  EXPECT_STATUS(r, Lost);
+  EXPECT_TRUE(r.keyframe);
+  EXPECT_EQ(r.motion.x, 0.0);
+  EXPECT_EQ(r.motion.theta, 0.0);
+  const FrameResult next = track(good(3.0 + dt), 3.0 + dt);
+  EXPECT_STATUS(next, Ok);
+  const SE2 step = truth(3.0).inverse() * truth(3.0 + dt);
+  EXPECT_LT(1e3 * std::hypot(next.motion.x - step.x, next.motion.y - step.y), 0.02);
+}
+
+TEST_F(TrackBadInput, BadTimestampsAreDegradedNotNaN) {
+  track(good(0), 0);
+  track(good(dt), dt);
+  // Not finite, repeated, backwards: the frame is tracked with the usual interval assumed.
+  for (const double t : {std::nan(""), dt, 0.5 * dt}) {
+    const FrameResult r = track(good(2 * dt), t);
+    EXPECT_STATUS(r, Degraded);
+    EXPECT_STREQ(r.reason, "timestamp not increasing");
+  }
+  EXPECT_STATUS(track(good(3 * dt), 3 * dt), Ok);
+  EXPECT_LT(pose_error_mm(0, 3 * dt), 0.05);
+}
+
+TEST_F(TrackBadInput, CameraFrameApi) {
+  // The same through track(gray, ...): the image pipeline makes the pyramids. A frame of
+  // another size is Lost, not an exception; a null image or a short stride is a caller error.
+  auto frame = [&](double t) {
+    return sim::apply_camera(renderer_->render_float(truth(t)), {}, 1.0, 11 + static_cast<uint64_t>(t * 1000));
+  };
+  Tracker tr(rt_, options_.camera, options_.extrinsics);
+  cv::Mat f = frame(0);
+  EXPECT_STATUS(tr.track(f.data, f.cols, f.rows, f.step, 0.0), First);
+  f = frame(dt);
+  const FrameResult r1 = tr.track(f.data, f.cols, f.rows, f.step, dt);
+  EXPECT_STATUS(r1, Ok);
+  EXPECT_GT(r1.pipeline_ms, 0.0);
+  EXPECT_GE(r1.ms, r1.pipeline_ms);
+  cv::Mat small(120, 160, CV_8UC1, cv::Scalar(90));
+  cv::randu(small, 0, 255);
+  EXPECT_STATUS(tr.track(small.data, small.cols, small.rows, small.step, 2 * dt), Lost);
+  // A frame inside a larger buffer (stride > width).
+  f = frame(3 * dt);
+  cv::Mat padded(f.rows, f.cols + 13, CV_8UC1, cv::Scalar(0));
+  f.copyTo(padded(cv::Rect(0, 0, f.cols, f.rows)));
+  const FrameResult r3 = tr.track(padded.data, f.cols, f.rows, padded.step, 3 * dt);
+  EXPECT_STATUS(r3, Ok);
+  const SE2 rel = truth(0).inverse() * truth(3 * dt);
+  EXPECT_LT(1e3 * std::hypot(tr.pose().x - rel.x, tr.pose().y - rel.y), 0.05);
+  EXPECT_THROW(tr.track(nullptr, f.cols, f.rows, f.step, 4 * dt), Error);
+  EXPECT_THROW(tr.track(f.data, f.cols, f.rows, f.cols - 1, 4 * dt), Error);
+}
+
+TEST(TrackWeakTexture, StripesLeaveTheMotionAlongThemUnconstrained) {
+  // Straight stripes on the ground: motion along them changes nothing in the image. The frame
+  // is Degraded ("motion poorly constrained"), the covariance says which direction is free,
+  // and nothing is NaN.
+  ocl::Runtime rt;
+  test::ScratchDir dir;
+  cv::Mat tex(512, 512, CV_8UC1);
+  for (int y = 0; y < tex.rows; ++y)
+    for (int x = 0; x < tex.cols; ++x)
+      tex.at<uint8_t>(y, x) = static_cast<uint8_t>(128 + 60 * std::sin(2 * M_PI * x / 32.0));
+  sim::Options so;
+  so.camera = sim::default_camera(320, 240);
+  so.camera.k1 = so.camera.k2 = 0.0;
+  sim::Renderer renderer(rt, tex, so);
+  Tracker tr(rt, so.camera, so.extrinsics);
+  // Stripes run along the world y axis (texture v); the robot faces +y and drives along them.
+  const SE2 a(0.0, 0.0, M_PI / 2), m(0.01, 0.0, 0.0);
+  auto frame = [&](const SE2& p) {
+    return test::test_upload(rt, test::test_pyramid(renderer.render_float(p), nullptr, 4));
+  };
+  tr.track(frame(a), 0.0);
+  const FrameResult r = tr.track(frame(a * m), dt);
+  std::printf("status %s (%s), motion %.5f %.5f %.5f, std x %.3g m, y %.3g m, theta %.3g rad\n",
+              status_name(r.status), r.reason, r.motion.x, r.motion.y, r.motion.theta,
+              std::sqrt(r.covariance(0, 0)), std::sqrt(r.covariance(1, 1)), std::sqrt(r.covariance(2, 2)));
+  EXPECT_STATUS(r, Degraded);
+  EXPECT_STREQ(r.reason, "motion poorly constrained");
+  // Forward (x, along the stripes) is free, sideways and the heading are not.
+  EXPECT_GT(r.covariance(0, 0), 100 * r.covariance(1, 1));
+  EXPECT_LT(std::abs(r.motion.y - m.y), 1e-4);
+  EXPECT_LT(std::abs(r.motion.theta - m.theta), 1e-3);
+}
+
+TEST_F(TrackBadInput, ResetStartsOver) {
+  track(good(0), 0);
+  track(good(dt), dt);
+  tracker_->reset();
+  EXPECT_EQ(tracker_->pose().x, 0.0);
+  EXPECT_STATUS(track(good(2 * dt), 2 * dt), First);
+  EXPECT_STATUS(track(good(3 * dt), 3 * dt), Ok);
+}
+
+}  // namespace
+}  // namespace planarvo::track

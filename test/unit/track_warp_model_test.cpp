@@ -1,0 +1,111 @@
+// The tracker's motion model (track/warp_model.h) against independent computations: the
+// analytic derivatives of the homography against central differences of ground_homography,
+// the reference-side generators against the composition of planar motions, and the homography
+// of a motion against projecting ground points with the camera.
+#include <cmath>
+#include <random>
+
+#include <Eigen/Dense>
+#include <gtest/gtest.h>
+
+#include "core/extrinsics.h"
+#include "core/se2.h"
+#include "io/simulator.h"
+#include "track/warp_model.h"
+
+namespace planarvo::track {
+namespace {
+
+constexpr double kDeg = M_PI / 180.0;
+
+Extrinsics config1() { return {0.2441, -0.0185, 0.1787, 12.4 * kDeg, 17.6 * kDeg, -9.2 * kDeg}; }
+
+Eigen::Matrix3d camera_matrix(double f, double cx, double cy) {
+  Eigen::Matrix3d K;
+  K << f, 0, cx, 0, f * 1.01, cy, 0, 0, 1;
+  return K;
+}
+
+TEST(TrackWarpModel, HomographyIsGroundHomography) {
+  const Eigen::Matrix3d K = camera_matrix(380, 321.3, 238.7);
+  const SE2 m(0.021, -0.004, 0.03);
+  const MotionHomography mh = motion_homography(K, config1(), m);
+  EXPECT_LT((mh.H - ground_homography(K, config1(), m.matrix3d())).norm(), 1e-12);
+  EXPECT_DOUBLE_EQ(mh.H(2, 2), 1.0);
+}
+
+TEST(TrackWarpModel, DerivativesMatchCentralDifferences) {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(-1, 1);
+  for (int trial = 0; trial < 50; ++trial) {
+    Extrinsics e{0.3 * u(rng), 0.1 * u(rng), 0.15 + 0.3 * (u(rng) + 1), 25 * kDeg * u(rng),
+                 25 * kDeg * u(rng), M_PI * u(rng)};
+    const Eigen::Matrix3d K = camera_matrix(200 + 300 * (u(rng) + 1), 320 + 10 * u(rng), 240 + 10 * u(rng));
+    const SE2 m(0.05 * u(rng), 0.05 * u(rng), 0.3 * u(rng));
+    const MotionHomography mh = motion_homography(K, e, m);
+    for (int i = 0; i < 3; ++i) {
+      const double h = 1e-6;
+      Eigen::Vector3d dx = Eigen::Vector3d::Zero();
+      dx(i) = h;
+      const Eigen::Matrix3d Hp = ground_homography(K, e, (m * SE2::exp(dx)).matrix3d());
+      const Eigen::Matrix3d Hm = ground_homography(K, e, (m * SE2::exp(-dx)).matrix3d());
+      const Eigen::Matrix3d numeric = (Hp - Hm) / (2 * h);
+      const Eigen::Matrix3d& analytic = mh.dH[static_cast<size_t>(i)];
+      EXPECT_LT((numeric - analytic).norm(), 1e-6 * (1.0 + analytic.norm()))
+          << "parameter " << i << "\nnumeric\n" << numeric << "\nanalytic\n" << analytic;
+      EXPECT_LT((mh.H * mh.G[static_cast<size_t>(i)] - analytic).norm(), 1e-9 * (1.0 + analytic.norm()));
+    }
+  }
+}
+
+TEST(TrackWarpModel, IncrementActsOnTheReferenceSideInExponentialCoordinates) {
+  // H(T exp(x)) = H(T) * H(exp(Ad_T x)): the increment is a planar motion of the reference
+  // frame, so the reference-side generators are the derivatives of H(exp(Ad_T x)).
+  const Eigen::Matrix3d K = camera_matrix(400, 320, 240);
+  const Extrinsics e = config1();
+  const SE2 T(0.03, 0.01, 0.2);
+  const Eigen::Vector3d x(0.004, -0.002, 0.01);
+  Eigen::Matrix3d Ad;  // SE(2) adjoint: Ad_T (vx, vy, w) = (R v + w (y, -x), w)
+  Ad << std::cos(T.theta), -std::sin(T.theta), T.y, std::sin(T.theta), std::cos(T.theta), -T.x, 0, 0, 1;
+  Eigen::Matrix3d lhs = ground_homography(K, e, (T * SE2::exp(x)).matrix3d());
+  Eigen::Matrix3d rhs = ground_homography(K, e, T.matrix3d()) *
+                        ground_homography(K, e, SE2::exp(Ad * x).matrix3d());
+  lhs /= lhs(2, 2);
+  rhs /= rhs(2, 2);
+  EXPECT_LT((lhs - rhs).norm(), 1e-10);
+}
+
+TEST(TrackWarpModel, HomographyMovesProjectedGroundPoints) {
+  // A ground point seen by the reference camera at pixel p is seen by the live camera at H p,
+  // with the live robot pose T in the reference robot frame.
+  CameraModel cam = sim::default_camera(640, 480);
+  cam.k1 = cam.k2 = 0;
+  const Extrinsics e = config1();
+  const SE2 T(0.025, -0.006, 0.04);
+  const MotionHomography mh = motion_homography(cam.K(), e, T);
+  const Eigen::Matrix4d T_vc = e.T_vc();
+  for (double gx : {0.3, 0.4, 0.5})
+    for (double gy : {-0.1, 0.0, 0.08}) {
+      const Eigen::Vector4d X_ref_robot(gx, gy, 0, 1);
+      const Eigen::Vector4d Xc_ref = T_vc.inverse() * X_ref_robot;
+      const Eigen::Vector4d Xc_live = T_vc.inverse() * T.matrix3d().inverse() * X_ref_robot;
+      const Eigen::Vector2d p_ref = cam.project(Xc_ref.head<3>());
+      const Eigen::Vector2d p_live = cam.project(Xc_live.head<3>());
+      const Eigen::Vector3d q = mh.H * p_ref.homogeneous();
+      EXPECT_LT((q.hnormalized() - p_live).norm(), 1e-9);
+    }
+}
+
+TEST(TrackWarpModel, PixelDisplacementOfASmallStep) {
+  const Eigen::Matrix3d K = camera_matrix(400, 320, 240);
+  const Extrinsics e = config1();
+  const SE2 a(0.02, 0.0, 0.0);
+  EXPECT_EQ(max_pixel_displacement(K, e, a, a, 640, 480), 0.0);
+  // 1 mm forward at ~0.2 m depth and f = 400 is about 2 pixels.
+  const double d = max_pixel_displacement(K, e, a, a * SE2(0.001, 0, 0), 640, 480);
+  EXPECT_GT(d, 1.0);
+  EXPECT_LT(d, 5.0);
+}
+
+}  // namespace
+}  // namespace planarvo::track
