@@ -8,6 +8,8 @@
 // Input motions are planar relative motions of the sensor in its own frame, translation in its
 // own units: metres for a metric sensor (a laser scan matcher; fix the scale at 1), units of the
 // camera height for the tracker run with x = y = 0, z = 1, yaw = 0 (the height is then the scale).
+// Intervals must turn less than half a turn (|θ| < π): beyond, driving forwards moves the robot
+// backwards over the interval, and angles wrapped to (-π, π] cannot show it.
 #pragma once
 #include <array>
 #include <optional>
