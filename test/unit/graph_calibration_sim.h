@@ -37,6 +37,8 @@ struct CalibrationSim {
   double odometry_sigma_t = 0.0, odometry_sigma_theta = 0.0;
   bool odometry = true, labels = true;
   double outlier_fraction = 0.0, outlier_size = 0.1;  // gross sensor errors, metres
+  // Forward speed while "turning in place" (still labelled 0), m/s: labels from a threshold.
+  double in_place_speed = 0.0;
   unsigned seed = 1;
 };
 
@@ -64,6 +66,7 @@ inline SimulatedMotions simulate_motions(const std::array<double, 4>& z, const C
         const double sign = (k / 6) % 2 ? 1.0 : -1.0;
         if (kind == 0) {
           w = sign * std::max(0.3 * o.omega_max, std::abs(turn));
+          v = o.in_place_speed;
         } else if (kind == 5) {
           v = sign * speed;
         } else {
@@ -75,7 +78,10 @@ inline SimulatedMotions simulate_motions(const std::array<double, 4>& z, const C
       case Drive::StraightOnly: v = (k % 2 ? 1.0 : -1.0) * speed; break;
       case Drive::OneCircle: v = 0.5 * (o.speed_min + o.speed_max), w = 0.5 * o.omega_max; break;
       case Drive::ForwardOnly: v = speed, w = turn; break;
-      case Drive::TurnInPlace: w = (k % 2 ? 1.0 : -1.0) * std::max(0.3 * o.omega_max, std::abs(turn)); break;
+      case Drive::TurnInPlace:
+        w = (k % 2 ? 1.0 : -1.0) * std::max(0.3 * o.omega_max, std::abs(turn));
+        v = o.in_place_speed;
+        break;
     }
     const SE2 robot = SE2::exp(Eigen::Vector3d(v, 0.0, w) * o.dt);
     const SE2 metric = T.inverse() * robot * T;
@@ -98,7 +104,7 @@ inline SimulatedMotions simulate_motions(const std::array<double, 4>& z, const C
                                                 o.odometry_sigma_theta * o.odometry_sigma_theta)
                                     .asDiagonal();
     }
-    if (o.labels) s.direction = v > 0.0 ? 1 : (v < 0.0 ? -1 : 0);
+    if (o.labels) s.direction = std::abs(v) <= o.in_place_speed ? 0 : (v > 0.0 ? 1 : -1);
     out.samples.push_back(s);
     out.robot.push_back(robot);
   }
