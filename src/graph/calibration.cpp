@@ -659,8 +659,9 @@ CalibrationResult calibrate_nonholonomic(Context& ctx) {
     }
     reasons.push_back(
         r.direction_counts[0] + r.direction_counts[2] == 0
-            ? "no direction labels (+1/-1) or odometry: (x, yaw) and (-x, yaw + 180°) fit the "
-              "nonholonomic constraint equally; give direction labels or odometry"
+            ? "no forward or backward direction labels (+1/-1, given or from odometry): (x, yaw) "
+              "and (-x, yaw + 180°) fit the nonholonomic constraint equally; give direction "
+              "labels or odometry"
             : "the direction labels do not decide between (x, yaw) and (-x, yaw + 180°) (too few "
               "decisive labels, or contradicting ones); check the labels");
   }
@@ -773,8 +774,10 @@ CalibrationResult calibrate_nonholonomic(Context& ctx) {
         if (r.direction_counts[0] == 0) why += "; there is no backward motion";
         if (r.direction_counts[2] == 0) why += "; there is no forward motion";
       } else {
-        why = "the labels 0 (turning in place) constrain y too weakly: σ(y) = " +
-              num(1000.0 * sigma_y) + " mm" +
+        why = (std::isfinite(sigma_y)
+                   ? "the labels 0 (turning in place) constrain y too weakly: σ(y) = " +
+                         num(1000.0 * sigma_y) + " mm"
+                   : std::string("the labels 0 do not constrain y (no rotation while labelled 0)")) +
               "; turn in place more, and turn while standing rather than stand still";
       }
       reasons.push_back("y: " + why);

@@ -165,7 +165,7 @@ TEST(GraphCalibrationNonholonomic, WithoutLabelsTheBranchIsAmbiguous) {
   EXPECT_TRUE(r.ambiguous);
   EXPECT_FALSE(r.ok());
   EXPECT_FALSE(r.estimated[1]);
-  EXPECT_NE(r.unobservable_reason.find("no direction labels"), std::string::npos) << r.unobservable_reason;
+  EXPECT_NE(r.unobservable_reason.find("no forward or backward direction labels"), std::string::npos) << r.unobservable_reason;
   // One of the two branches, exactly.
   const bool flipped = std::abs(dyaw(r, kTruth[3])) > M_PI / 2;
   EXPECT_NEAR(r.value[0], flipped ? -kTruth[0] : kTruth[0], 1e-9);
