@@ -201,12 +201,12 @@ struct Context {
   }
 };
 
-// The robust variance factor of normalised squared residuals with `dof` degrees of freedom, and
-// the samples beyond the gate; returns how many were newly gated.
+// Gates the samples whose normalised squared residual (chi2, with median chi2_median for its
+// degrees of freedom) is beyond gate_sigma² times the robust variance factor where that exceeds
+// 1; returns how many were newly gated.
 int gate(Context& ctx, const std::vector<double>& chi2, const std::vector<int>& sample_of,
-         double chi2_median, double* variance_factor) {
+         double chi2_median) {
   const double k = median(chi2) / chi2_median;
-  if (variance_factor) *variance_factor = k;
   const double threshold = sq(ctx.options.gate_sigma) * std::max(k, 1.0);
   int gated = 0;
   for (size_t j = 0; j < chi2.size(); ++j)
@@ -219,8 +219,6 @@ int gate(Context& ctx, const std::vector<double>& chi2, const std::vector<int>& 
 
 struct Observability {
   std::array<bool, 4> null_space{};
-  bool analysed = false;
-  std::string describe;
 };
 
 // Marginal covariance (scaled by f) and null space of z's free parameters in the final graph.
@@ -238,8 +236,6 @@ Observability covariance_of_z(const FactorGraph& g, VariableId z, double f, Cali
   Eigen::MatrixXd S;
   try {
     const ObservabilityReport rep = analyse_observability(g, {z});
-    obs.analysed = true;
-    obs.describe = rep.describe();
     S = rep.information;
     for (const std::string& n : rep.unobservable) {
       const int k = index_of(n);
@@ -428,7 +424,7 @@ CalibrationResult calibrate_odometry(Context& ctx) {
   if (o.gate_sigma > 0.0) {
     for (int round = 0; round < 5; ++round) {
       sample_chi2(chi2, sample_of);
-      const int gated = gate(ctx, chi2, sample_of, kChi2Median3, nullptr);
+      const int gated = gate(ctx, chi2, sample_of, kChi2Median3);
       if (round > 0 && gated == 0) break;
       solve_pass(nullptr);
       kernel_on = false;
@@ -633,7 +629,7 @@ CalibrationResult calibrate_nonholonomic(Context& ctx) {
   if (o.gate_sigma > 0.0) {
     for (int round = 0; round < 5; ++round) {
       sample_chi2(chi2, sample_of);
-      const int gated = gate(ctx, chi2, sample_of, kChi2Median1, nullptr);
+      const int gated = gate(ctx, chi2, sample_of, kChi2Median1);
       if (round > 0 && gated == 0) break;
       solve_pass(nullptr);
       kernel_on = false;
