@@ -267,6 +267,23 @@ PLANARVO_API planarvo_status planarvo_dataset_frame(planarvo_dataset* dataset, i
 PLANARVO_API planarvo_status planarvo_write_tum(const char* path, const double* timestamps,
                                                 const planarvo_se2* poses, size_t count);
 
+/* Per-frame statistics CSV (timestamp, vx, vy, omega, iterations, final_cost, inlier_fraction,
+ * ms, status): the header on open, then one row per call, flushed, so that a crash loses no row. */
+typedef struct planarvo_stats_writer planarvo_stats_writer;
+typedef struct planarvo_frame_stats {
+  double timestamp;
+  double vx, vy, omega;  /* robot-frame velocity over the interval ending at this frame */
+  int32_t iterations;    /* alignment steps, all levels */
+  double final_cost, inlier_fraction;
+  double ms;             /* engine time for the frame */
+  const char* status;    /* "first", "ok", "degraded", "lost", ... */
+} planarvo_frame_stats;
+PLANARVO_API planarvo_status planarvo_stats_writer_open(const char* path, planarvo_stats_writer** writer);
+PLANARVO_API planarvo_status planarvo_stats_writer_add(planarvo_stats_writer* writer,
+                                                       const planarvo_frame_stats* row);
+/* Closes the file (reporting a failed final write) and releases the writer; NULL is allowed. */
+PLANARVO_API planarvo_status planarvo_stats_writer_close(planarvo_stats_writer* writer);
+
 /* ------------------------------------------------------------------------------------------ */
 /* Simulator                                                                                   */
 
@@ -313,6 +330,188 @@ PLANARVO_API planarvo_status planarvo_sim_default_camera(int32_t width, int32_t 
 PLANARVO_API planarvo_status planarvo_simulate(planarvo_context* context,
                                                const planarvo_sim_options* options,
                                                const char* out_directory);
+
+/* ------------------------------------------------------------------------------------------ */
+/* Dense planar visual odometry                                                                */
+
+/* Tracks each frame against a keyframe by dense alignment through the ground-plane homography
+ * (the paper's section 4), coarse to fine, estimating the robot's planar motion and an affine
+ * brightness change. Owns its device buffers; uses the context it was created with, which must
+ * outlive it. Thread safety: one thread at a time (its context too). */
+typedef struct planarvo_tracker planarvo_tracker;
+
+typedef struct planarvo_tracker_options {
+  size_t struct_size;
+  int32_t levels;             /* pyramid levels; default 4 */
+  int32_t finest_level;       /* finest level tracked, 0 = full resolution; default -1: the
+                                 coarsest level at least 320 pixels wide (1 at 640x480) */
+  int32_t max_iterations;     /* cap on alignment steps per level; 0 = the per-level defaults */
+  double keyframe_overlap;    /* a new keyframe when the overlap falls below this; default 0.7 */
+  int32_t estimate_brightness;/* non-zero: estimate gain and offset per frame; default 1 */
+} planarvo_tracker_options;
+
+typedef enum planarvo_track_status {
+  PLANARVO_TRACK_FIRST = 0,    /* the first frame: it becomes the keyframe, no motion */
+  PLANARVO_TRACK_OK = 1,
+  PLANARVO_TRACK_DEGRADED = 2, /* tracked, but doubtful: reason says why */
+  PLANARVO_TRACK_LOST = 3      /* not tracked: motion is a prediction (constant velocity or 0) */
+} planarvo_track_status;
+
+typedef struct planarvo_track_result {
+  size_t struct_size;
+  planarvo_track_status status;
+  const char* reason;         /* why DEGRADED or LOST, "" otherwise; a static string */
+  planarvo_se2 motion;        /* this frame's robot pose in the previous frame's robot frame */
+  double covariance[9];       /* of motion (x, y, theta), row-major; large when LOST */
+  planarvo_se2 pose;          /* the robot's pose relative to the first frame */
+  int32_t iterations[8];      /* alignment steps per pyramid level (index = level) */
+  int32_t levels_used;
+  double final_cost;          /* mean robust cost per pixel at the finest level */
+  double inlier_fraction;     /* residuals within the robust threshold */
+  double overlap;             /* keyframe pixels seen in this frame */
+  int32_t keyframe;           /* non-zero when this frame became the keyframe */
+  double ms;                  /* engine time: upload, undistortion, pyramid and tracking */
+} planarvo_track_result;
+
+PLANARVO_API void planarvo_tracker_options_init(planarvo_tracker_options* options);
+/* camera: the distorted camera the frames come from; extrinsics: the camera on the robot.
+ * options may be NULL. */
+PLANARVO_API planarvo_status planarvo_tracker_create(planarvo_context* context,
+                                                     const planarvo_camera* camera,
+                                                     const planarvo_extrinsics* extrinsics,
+                                                     const planarvo_tracker_options* options,
+                                                     planarvo_tracker** tracker);
+PLANARVO_API void planarvo_tracker_destroy(planarvo_tracker* tracker);
+/* Tracks one frame (any planarvo_pixel_format; colour is converted to grey). A frame that cannot
+ * be tracked (wrong size, black, saturated, textureless, after a gap) is not an error: the call
+ * returns PLANARVO_OK with status LOST or DEGRADED, and tracking recovers on the next good frame.
+ * Timestamps are in seconds and must increase. */
+PLANARVO_API planarvo_status planarvo_tracker_track(planarvo_tracker* tracker,
+                                                    const planarvo_image* image, double timestamp,
+                                                    planarvo_track_result* result);
+/* Forgets the keyframe and the pose: the next frame is FIRST again. */
+PLANARVO_API planarvo_status planarvo_tracker_reset(planarvo_tracker* tracker);
+
+/* Accuracy of estimated frame-to-frame motions against true ones (see planarvo track). */
+typedef struct planarvo_motion_accuracy {
+  size_t struct_size;
+  int32_t intervals;        /* compared */
+  double distance;          /* metres travelled */
+  double slope_linear;      /* fitted slope of estimated vs true forward speed */
+  double slope_angular;     /* ... and angular speed */
+  double rms_translation;   /* per interval, metres */
+  double max_translation;
+  double rms_rotation;      /* radians */
+  int32_t gross_errors;     /* intervals with a translation error over the threshold */
+  double endpoint_error;    /* metres */
+  double endpoint_drift;    /* endpoint_error / distance */
+  double endpoint_heading;  /* radians */
+} planarvo_motion_accuracy;
+
+/* estimated[i], truth[i]: motion over interval i; dt[i] its duration; valid: NULL or per-interval
+ * flags (0: left out of the per-interval figures). */
+PLANARVO_API planarvo_status planarvo_evaluate_motions(const planarvo_se2* estimated,
+                                                       const planarvo_se2* truth, const double* dt,
+                                                       const int32_t* valid, size_t count,
+                                                       double gross_threshold,
+                                                       planarvo_motion_accuracy* accuracy);
+
+/* ------------------------------------------------------------------------------------------ */
+/* Graph optimisation and calibration (no OpenCL device is used)                               */
+
+/* Receives text lines (an iteration table, notes) from long calls that take one. */
+typedef void (*planarvo_log_fn)(void* user_data, const char* line);
+
+typedef struct planarvo_solver_summary {
+  size_t struct_size;
+  int32_t converged;        /* non-zero: stopped on a tolerance, not a cap or a failure */
+  char termination[256];    /* why it stopped, with the numbers */
+  int32_t iterations;       /* Levenberg-Marquardt iterations */
+  int32_t factorizations;   /* numeric Cholesky factorisations (CHOLMOD) */
+  double initial_chi2, final_chi2; /* sum of e' Omega e over the factors (robustified where a
+                                      robust loss is used) */
+  double seconds;
+} planarvo_solver_summary;
+
+typedef enum planarvo_posegraph_init {
+  PLANARVO_POSEGRAPH_INIT_NONE = 0,          /* start from the file's poses */
+  PLANARVO_POSEGRAPH_INIT_ROTATION_FIRST = 1 /* orientations first (LAGO), then positions */
+} planarvo_posegraph_init;
+
+typedef struct planarvo_posegraph_options {
+  size_t struct_size;
+  int32_t max_iterations;           /* default 100 */
+  planarvo_posegraph_init init;     /* default PLANARVO_POSEGRAPH_INIT_NONE */
+  planarvo_log_fn log;              /* the iteration table; NULL for none */
+  void* log_user_data;
+} planarvo_posegraph_options;
+
+PLANARVO_API void planarvo_posegraph_options_init(planarvo_posegraph_options* options);
+/* Optimises a g2o-format 2-D pose graph (VERTEX_SE2, EDGE_SE2, FIX; g2o's error convention; the
+ * first vertex held fixed) read from in_path, and writes it to out_path (NULL: not written).
+ * PLANARVO_ERROR_FAILED when the solver did not converge (summary says why; out_path is still
+ * written). */
+PLANARVO_API planarvo_status planarvo_posegraph_optimize(const char* in_path, const char* out_path,
+                                                         const planarvo_posegraph_options* options,
+                                                         planarvo_solver_summary* summary);
+
+/* One interval of planar motion: the sensor's own motion (its frame at the interval's start;
+ * translation in metres for a metric sensor, in units of the camera height for the tracker run
+ * at height 1), optionally the robot's motion from wheel odometry and a direction label. */
+typedef struct planarvo_motion_pair {
+  double interval;          /* seconds */
+  planarvo_se2 sensor;
+  int32_t has_odometry;
+  planarvo_se2 odometry;
+  int32_t has_direction;
+  int32_t direction;        /* +1 forwards, -1 backwards, 0 no linear motion */
+} planarvo_motion_pair;
+
+/* Reads a motion-pair CSV (columns interval_s, [odo_dx, odo_dy, odo_dtheta,] sensor_dx, sensor_dy,
+ * sensor_dtheta[, direction]; without a direction column the odometry's forward motion gives it).
+ * Call with pairs = NULL for the count, then with capacity >= count. */
+PLANARVO_API planarvo_status planarvo_motion_pairs_load(const char* path, planarvo_motion_pair* pairs,
+                                                        size_t capacity, size_t* count);
+
+typedef enum planarvo_calibration_method {
+  PLANARVO_CALIBRATE_ODOMETRY = 0,    /* x, y, scale (height), yaw against wheel odometry */
+  PLANARVO_CALIBRATE_NONHOLONOMIC = 1 /* x, yaw from the nonholonomic constraint; y from labels */
+} planarvo_calibration_method;
+
+typedef struct planarvo_calibration_options {
+  size_t struct_size;
+  planarvo_calibration_method method;  /* default ODOMETRY */
+  int32_t fix_scale;        /* hold the scale at fixed_scale (metric sensor: 1; a measured camera
+                               height); the nonholonomic method always needs it held */
+  double fixed_scale;       /* default 1 */
+  int32_t has_initial;      /* use initial (x, y, scale, yaw) instead of the built-in initialisation */
+  double initial[4];
+  int32_t velocity_form;    /* nonholonomic: the paper's velocity form instead of the exact arc */
+  int32_t max_iterations;   /* default 100 */
+  planarvo_log_fn log;      /* the solver's iteration table; NULL for none */
+  void* log_user_data;
+} planarvo_calibration_options;
+
+typedef struct planarvo_calibration_result {
+  size_t struct_size;
+  double value[4];          /* x (m), y (m), scale (camera height m, or the fixed scale), yaw (rad) */
+  double covariance[16];    /* row-major, order x y scale yaw; zero rows when not estimated */
+  int32_t estimated[4];     /* the method estimated this parameter */
+  int32_t observable[4];    /* ... and the data determine it */
+  int32_t ambiguous;        /* nonholonomic without labels: (-x, yaw + pi) fits as well */
+  int32_t outliers;         /* samples rejected as gross errors */
+  int32_t ok;               /* converged, every estimated parameter observable, not ambiguous */
+  char unobservable_reason[512];
+  planarvo_solver_summary summary;
+} planarvo_calibration_result;
+
+PLANARVO_API void planarvo_calibration_options_init(planarvo_calibration_options* options);
+/* Calibrates from count motion pairs. Returns PLANARVO_ERROR_FAILED (with the reason as the
+ * message) when the result is not ok: unobservable, ambiguous or not converged; the result is
+ * filled in either case. */
+PLANARVO_API planarvo_status planarvo_calibrate(const planarvo_motion_pair* pairs, size_t count,
+                                                const planarvo_calibration_options* options,
+                                                planarvo_calibration_result* result);
 
 #ifdef __cplusplus
 }

@@ -1,5 +1,6 @@
 // C API: camera and extrinsics YAML, TUM trajectories.
 #include <cmath>
+#include <memory>
 #include <sstream>
 #include <string>
 
@@ -7,6 +8,7 @@
 #include "capi/status.h"
 #include "core/error.h"
 #include "io/formats.h"
+#include "io/stats.h"
 
 using planarvo::capi::guard;
 using planarvo::capi::require;
@@ -89,6 +91,45 @@ PLANARVO_API planarvo_status planarvo_write_tum(const char* path, const double* 
     std::vector<planarvo::io::StampedPose> v(count);
     for (size_t i = 0; i < count; ++i) v[i] = {timestamps[i], planarvo::capi::to_cpp(poses[i])};
     planarvo::io::write_tum(path, v);
+  });
+}
+
+struct planarvo_stats_writer {
+  std::unique_ptr<planarvo::io::StatsWriter> writer;
+};
+
+PLANARVO_API planarvo_status planarvo_stats_writer_open(const char* path, planarvo_stats_writer** writer) {
+  return guard([&] {
+    require(writer != nullptr, "planarvo_stats_writer_open: writer is NULL");
+    *writer = nullptr;
+    require_path(path, "planarvo_stats_writer_open");
+    auto w = std::make_unique<planarvo_stats_writer>();
+    w->writer = std::make_unique<planarvo::io::StatsWriter>(path);
+    *writer = w.release();
+  });
+}
+
+PLANARVO_API planarvo_status planarvo_stats_writer_add(planarvo_stats_writer* writer, const planarvo_frame_stats* row) {
+  return guard([&] {
+    require(writer != nullptr && row != nullptr, "planarvo_stats_writer_add: NULL argument");
+    planarvo::io::FrameStats r;
+    r.timestamp = row->timestamp;
+    r.vx = row->vx;
+    r.vy = row->vy;
+    r.omega = row->omega;
+    r.iterations = row->iterations;
+    r.final_cost = row->final_cost;
+    r.inlier_fraction = row->inlier_fraction;
+    r.ms = row->ms;
+    r.status = row->status ? row->status : "";
+    writer->writer->add(r);
+  });
+}
+
+PLANARVO_API planarvo_status planarvo_stats_writer_close(planarvo_stats_writer* writer) {
+  std::unique_ptr<planarvo_stats_writer> owned(writer);
+  return guard([&] {
+    if (owned) owned->writer->close();
   });
 }
 

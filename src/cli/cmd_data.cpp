@@ -102,23 +102,6 @@ void apply_simulate_args(const Args& a, planarvo_sim_options* o, std::string* te
   }
 }
 
-struct DatasetDeleter {
-  void operator()(planarvo_dataset* d) const { planarvo_dataset_destroy(d); }
-};
-using DatasetPtr = std::unique_ptr<planarvo_dataset, DatasetDeleter>;
-
-DatasetPtr open_dataset(const std::string& dir, const std::string& video, bool verify, Progress* progress) {
-  planarvo_dataset_options o;
-  planarvo_dataset_options_init(&o);
-  if (!video.empty()) o.video = video.c_str();
-  o.verify_images = verify ? 1 : 0;
-  o.progress = &Progress::callback;
-  o.progress_user_data = progress;
-  planarvo_dataset* d = nullptr;
-  check(planarvo_dataset_open(dir.c_str(), &o, &d));
-  return DatasetPtr(d);
-}
-
 // What a trajectory and its wheel odometry look like against ground truth.
 struct DriveSummary {
   double distance = 0, peak_speed = 0, peak_turn = 0;
@@ -312,12 +295,28 @@ int cmd_demo(int argc, char** argv) {
   std::printf("3. the drive (ground truth): %.2f m, peak %.2f m/s, %.2f rad/s; intervals: %d forward, %d backward,"
               " %d without linear motion\n",
               s.distance, s.peak_speed, s.peak_turn, s.forward, s.backward, s.still);
-  std::printf("\n   accuracy against ground truth       end-point error   heading error   per-frame RMS\n");
+  t0 = std::chrono::steady_clock::now();
+  planarvo_tracker_options to;
+  planarvo_tracker_options_init(&to);
+  const TrackRun run = track_dataset(ctx.get(), ds.get(), info.extrinsics_gt, to, {}, &progress);
+  progress.finish();
+  std::printf("4. tracked every frame with the true extrinsics in %.1f s: %lld ok, %lld degraded, %lld lost;"
+              " engine %.2f ms per frame (%.0f fps)\n",
+              seconds_since(t0), static_cast<long long>(run.ok), static_cast<long long>(run.degraded),
+              static_cast<long long>(run.lost), run.engine_ms / static_cast<double>(std::max<int64_t>(run.frames, 1)),
+              1000.0 * static_cast<double>(run.frames) / run.engine_ms);
+  std::printf("\n   accuracy against ground truth       end-point error     heading error   per-frame RMS\n");
   if (s.has_odometry)
-    std::printf("   wheel odometry (simulated, %.0f%%)   %8.1f mm (%4.2f%%) %9.3f deg %11.3f mm\n",
+    std::printf("   wheel odometry (simulated, %2.0f%%)   %8.2f mm (%5.3f%%) %9.3f deg %11.4f mm\n",
                 o.odometry_noise * 100, s.odo_end_error * 1e3, 100 * s.odo_end_error / std::max(s.distance, 1e-9),
                 s.odo_heading_error / kDeg, s.odo_rms_step * 1e3);
-  std::printf("   visual odometry                     not built yet: the dense tracker comes next (issue 4)\n");
+  if (run.has_accuracy) {
+    const planarvo_motion_accuracy& a = run.accuracy;
+    std::printf("   visual odometry (planarvo)          %8.2f mm (%5.3f%%) %9.3f deg %11.4f mm\n",
+                a.endpoint_error * 1e3, 100 * a.endpoint_drift, a.endpoint_heading / kDeg, a.rms_translation * 1e3);
+    std::printf("   visual odometry velocity slopes: linear %.4f, angular %.4f; gross errors (> 1 mm): %d\n",
+                a.slope_linear, a.slope_angular, a.gross_errors);
+  }
   std::printf("\nLook at the frames in %s/images; `planarvo info %s` describes the data set.\n", out.c_str(),
               out.c_str());
   return kExitOk;

@@ -53,6 +53,18 @@ std::string device_name(const planarvo_context* context) {
   return std::string(info.device_name) + " (" + info.platform_name + ")";
 }
 
+DatasetPtr open_dataset(const std::string& dir, const std::string& video, bool verify, Progress* progress) {
+  planarvo_dataset_options o;
+  planarvo_dataset_options_init(&o);
+  if (!video.empty()) o.video = video.c_str();
+  o.verify_images = verify ? 1 : 0;
+  o.progress = &Progress::callback;
+  o.progress_user_data = progress;
+  planarvo_dataset* d = nullptr;
+  check(planarvo_dataset_open(dir.c_str(), &o, &d));
+  return DatasetPtr(d);
+}
+
 bool stderr_is_terminal() { return isatty(STDERR_FILENO) == 1; }
 
 Progress::Progress(bool enabled) : enabled_(enabled && stderr_is_terminal()) {}

@@ -49,6 +49,27 @@ class Progress {
 };
 bool stderr_is_terminal();
 
+struct DatasetDeleter {
+  void operator()(planarvo_dataset* d) const { planarvo_dataset_destroy(d); }
+};
+using DatasetPtr = std::unique_ptr<planarvo_dataset, DatasetDeleter>;
+DatasetPtr open_dataset(const std::string& dir, const std::string& video, bool verify, Progress* progress);
+
+// Tracks every frame of a data set (cmd_track.cpp), for `track` and `demo`.
+struct TrackRun {
+  int64_t frames = 0, ok = 0, degraded = 0, lost = 0, keyframes = 0;
+  double engine_ms = 0;          // sum of the per-frame engine times
+  std::vector<double> ms;        // per frame
+  bool has_accuracy = false;
+  planarvo_motion_accuracy accuracy{};
+};
+struct TrackOutputs {
+  std::string trajectory, stats;  // "" for none
+};
+TrackRun track_dataset(planarvo_context* ctx, planarvo_dataset* ds, const planarvo_extrinsics& extrinsics,
+                       const planarvo_tracker_options& options, const TrackOutputs& outputs, Progress* progress);
+void print_track_run(const TrackRun& run);
+
 // Each command: returns the exit code; throws UsageError or ApiError.
 struct Command {
   const char* name;
@@ -62,5 +83,8 @@ int cmd_kernels(int argc, char** argv);
 int cmd_simulate(int argc, char** argv);
 int cmd_info(int argc, char** argv);
 int cmd_demo(int argc, char** argv);
+int cmd_track(int argc, char** argv);
+int cmd_posegraph(int argc, char** argv);
+int cmd_calibrate(int argc, char** argv);
 
 }  // namespace planarvo::cli

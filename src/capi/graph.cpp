@@ -1,0 +1,218 @@
+// C API: pose graphs, motion pairs and the graph calibrations (src/graph, src/io/motions.h).
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "capi/convert.h"
+#include "capi/handles.h"
+#include "capi/status.h"
+#include "core/error.h"
+#include "graph/calibration.h"
+#include "graph/g2o.h"
+#include "graph/initialisation.h"
+#include "graph/solver.h"
+#include "io/motions.h"
+
+using planarvo::capi::guard;
+using planarvo::capi::require;
+
+namespace {
+
+void copy_string(char* dst, size_t capacity, const std::string& src) {
+  const size_t n = std::min(capacity - 1, src.size());
+  std::memcpy(dst, src.data(), n);
+  dst[n] = '\0';
+}
+
+void send_lines(planarvo_log_fn log, void* user, const std::string& text) {
+  if (!log) return;
+  std::istringstream in(text);
+  std::string line;
+  while (std::getline(in, line)) log(user, line.c_str());
+}
+
+void fill_summary(const planarvo::graph::SolverSummary& s, double initial_chi2, double final_chi2,
+                  planarvo_solver_summary* out) {
+  const size_t size = out->struct_size;
+  planarvo_solver_summary o;
+  std::memset(&o, 0, sizeof o);
+  o.struct_size = size;
+  o.converged = s.converged() ? 1 : 0;
+  copy_string(o.termination, sizeof o.termination, s.message.empty() ? to_string(s.termination) : s.message);
+  o.iterations = s.num_iterations;
+  o.factorizations = s.num_factorizations;
+  o.initial_chi2 = initial_chi2;
+  o.final_chi2 = final_chi2;
+  o.seconds = s.total_time_s;
+  std::memcpy(out, &o, std::min(size, sizeof o));
+}
+
+constexpr size_t kSummaryEnd = offsetof(planarvo_solver_summary, seconds) + sizeof(double);
+
+}  // namespace
+
+extern "C" {
+
+PLANARVO_API void planarvo_posegraph_options_init(planarvo_posegraph_options* o) {
+  if (!o) return;
+  std::memset(o, 0, sizeof *o);
+  o->struct_size = sizeof *o;
+  o->max_iterations = planarvo::graph::SolverOptions().max_iterations;
+  o->init = PLANARVO_POSEGRAPH_INIT_NONE;
+}
+
+PLANARVO_API planarvo_status planarvo_posegraph_optimize(const char* in_path, const char* out_path,
+                                                         const planarvo_posegraph_options* options,
+                                                         planarvo_solver_summary* summary) {
+  bool converged = true;
+  std::string why;
+  const planarvo_status st = guard([&] {
+    require(in_path != nullptr && *in_path, "planarvo_posegraph_optimize: in_path is NULL or empty");
+    require(summary != nullptr, "planarvo_posegraph_optimize: summary is NULL");
+    planarvo::capi::require_struct_size(summary->struct_size, kSummaryEnd, "planarvo_solver_summary");
+    planarvo_posegraph_options o;
+    planarvo_posegraph_options_init(&o);
+    if (options) {
+      planarvo::capi::require_struct_size(options->struct_size,
+                                          offsetof(planarvo_posegraph_options, log_user_data) + sizeof(void*),
+                                          "planarvo_posegraph_options");
+      o = *options;
+    }
+    require(o.max_iterations > 0, "planarvo_posegraph_options.max_iterations must be positive");
+    require(o.init == PLANARVO_POSEGRAPH_INIT_NONE || o.init == PLANARVO_POSEGRAPH_INIT_ROTATION_FIRST,
+            "planarvo_posegraph_options.init is not a planarvo_posegraph_init");
+    planarvo::graph::G2oFile file = planarvo::graph::read_g2o(in_path);
+    if (file.vertices.empty()) planarvo::throw_invalid_input(std::string(in_path) + ": no VERTEX_SE2 lines");
+    planarvo::graph::FactorGraph graph = planarvo::graph::make_pose_graph(file);
+    const double chi2_0 = graph.chi2();
+    if (o.init == PLANARVO_POSEGRAPH_INIT_ROTATION_FIRST) planarvo::graph::initialise_rotation_first(graph);
+    planarvo::graph::SolverOptions so;
+    so.max_iterations = o.max_iterations;
+    planarvo::graph::Solver solver(so);
+    const planarvo::graph::SolverSummary s = solver.solve(graph);
+    send_lines(o.log, o.log_user_data, s.full_report());
+    fill_summary(s, chi2_0, graph.chi2(), summary);
+    if (out_path && *out_path) {
+      planarvo::graph::update_poses(file, graph);
+      planarvo::graph::write_g2o(out_path, file);
+    }
+    converged = s.converged();
+    why = summary->termination;
+  });
+  if (st == PLANARVO_OK && !converged) return planarvo::capi::fail(PLANARVO_ERROR_FAILED, "did not converge: " + why);
+  return st;
+}
+
+PLANARVO_API planarvo_status planarvo_motion_pairs_load(const char* path, planarvo_motion_pair* pairs,
+                                                        size_t capacity, size_t* count) {
+  return guard([&] {
+    require(path != nullptr && *path, "planarvo_motion_pairs_load: path is NULL or empty");
+    require(count != nullptr, "planarvo_motion_pairs_load: count is NULL");
+    const planarvo::io::MotionPairs m = planarvo::io::read_motion_pairs(path);
+    *count = m.pairs.size();
+    if (!pairs) return;
+    if (capacity < m.pairs.size())
+      throw planarvo::capi::BufferTooSmall("planarvo_motion_pairs_load: " + std::to_string(m.pairs.size()) +
+                                           " pairs, capacity " + std::to_string(capacity));
+    for (size_t i = 0; i < m.pairs.size(); ++i) {
+      const planarvo::io::MotionPair& p = m.pairs[i];
+      planarvo_motion_pair& o = pairs[i];
+      std::memset(&o, 0, sizeof o);
+      o.interval = p.interval;
+      o.sensor = planarvo::capi::to_c(p.sensor);
+      o.has_odometry = p.odometry.has_value();
+      if (p.odometry) o.odometry = planarvo::capi::to_c(*p.odometry);
+      o.has_direction = p.direction.has_value();
+      if (p.direction) o.direction = *p.direction;
+    }
+  });
+}
+
+PLANARVO_API void planarvo_calibration_options_init(planarvo_calibration_options* o) {
+  if (!o) return;
+  std::memset(o, 0, sizeof *o);
+  const planarvo::graph::CalibrationOptions d;
+  o->struct_size = sizeof *o;
+  o->method = PLANARVO_CALIBRATE_ODOMETRY;
+  o->fix_scale = d.fix_scale ? 1 : 0;
+  o->fixed_scale = d.fixed_scale;
+  o->velocity_form = 0;
+  o->max_iterations = d.solver.max_iterations;
+}
+
+PLANARVO_API planarvo_status planarvo_calibrate(const planarvo_motion_pair* pairs, size_t count,
+                                                const planarvo_calibration_options* options,
+                                                planarvo_calibration_result* result) {
+  bool ok = true;
+  std::string reason;
+  const planarvo_status st = guard([&] {
+    require(result != nullptr, "planarvo_calibrate: result is NULL");
+    planarvo::capi::require_struct_size(result->struct_size, sizeof(planarvo_calibration_result),
+                                        "planarvo_calibration_result");
+    require(count > 0 && pairs != nullptr, "planarvo_calibrate: no motion pairs");
+    planarvo_calibration_options o;
+    planarvo_calibration_options_init(&o);
+    if (options) {
+      planarvo::capi::require_struct_size(options->struct_size,
+                                          offsetof(planarvo_calibration_options, log_user_data) + sizeof(void*),
+                                          "planarvo_calibration_options");
+      o = *options;
+    }
+    require(o.method == PLANARVO_CALIBRATE_ODOMETRY || o.method == PLANARVO_CALIBRATE_NONHOLONOMIC,
+            "planarvo_calibration_options.method is not a planarvo_calibration_method");
+    require(o.max_iterations > 0, "planarvo_calibration_options.max_iterations must be positive");
+    require(!o.fix_scale || (std::isfinite(o.fixed_scale) && o.fixed_scale > 0),
+            "planarvo_calibration_options.fixed_scale must be positive");
+    planarvo::graph::CalibrationOptions co;
+    co.method = o.method == PLANARVO_CALIBRATE_ODOMETRY ? planarvo::graph::CalibrationMethod::Odometry
+                                                        : planarvo::graph::CalibrationMethod::Nonholonomic;
+    co.fix_scale = o.fix_scale != 0;
+    co.fixed_scale = o.fixed_scale;
+    if (o.has_initial) co.initial = std::array<double, 4>{o.initial[0], o.initial[1], o.initial[2], o.initial[3]};
+    co.nonholonomic_form = o.velocity_form ? planarvo::graph::CalibrationOptions::NonholonomicForm::Velocity
+                                           : planarvo::graph::CalibrationOptions::NonholonomicForm::Arc;
+    co.solver.max_iterations = o.max_iterations;
+    std::vector<planarvo::graph::MotionSample> samples(count);
+    for (size_t i = 0; i < count; ++i) {
+      const planarvo_motion_pair& p = pairs[i];
+      planarvo::graph::MotionSample& s = samples[i];
+      s.interval = p.interval;
+      s.sensor = planarvo::capi::to_cpp(p.sensor);
+      if (p.has_odometry) s.odometry = planarvo::capi::to_cpp(p.odometry);
+      if (p.has_direction) {
+        require(p.direction >= -1 && p.direction <= 1, "planarvo_calibrate: a direction is not -1, 0 or +1");
+        s.direction = p.direction;
+      }
+    }
+    const planarvo::graph::CalibrationResult r = planarvo::graph::calibrate(samples, co);
+    send_lines(o.log, o.log_user_data, r.summary.full_report());
+    planarvo_calibration_result out;
+    std::memset(&out, 0, sizeof out);
+    out.struct_size = result->struct_size;
+    for (int i = 0; i < 4; ++i) {
+      out.value[i] = r.value[static_cast<size_t>(i)];
+      out.estimated[i] = r.estimated[static_cast<size_t>(i)];
+      out.observable[i] = r.observable[static_cast<size_t>(i)];
+      for (int j = 0; j < 4; ++j) out.covariance[i * 4 + j] = r.covariance(i, j);
+    }
+    out.ambiguous = r.ambiguous;
+    out.outliers = r.outliers;
+    out.ok = r.ok();
+    copy_string(out.unobservable_reason, sizeof out.unobservable_reason, r.unobservable_reason);
+    out.summary.struct_size = sizeof out.summary;
+    fill_summary(r.summary, 2.0 * r.summary.initial_cost, 2.0 * r.summary.final_cost, &out.summary);
+    *result = out;
+    ok = r.ok();
+    reason = r.ambiguous ? std::string("ambiguous: (x, yaw) and (-x, yaw + 180 deg) fit equally; give direction "
+                                       "labels or odometry")
+             : !r.unobservable_reason.empty() ? r.unobservable_reason
+                                              : "did not converge: " + std::string(out.summary.termination);
+  });
+  if (st == PLANARVO_OK && !ok) return planarvo::capi::fail(PLANARVO_ERROR_FAILED, reason);
+  return st;
+}
+
+}  // extern "C"

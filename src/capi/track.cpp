@@ -1,0 +1,195 @@
+// C API: visual odometry (src/track/tracker.h) and the accuracy of motions.
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <memory>
+#include <vector>
+
+#include <opencv2/imgproc.hpp>
+
+#include "capi/convert.h"
+#include "capi/handles.h"
+#include "capi/status.h"
+#include "core/error.h"
+#include "track/evaluation.h"
+#include "track/tracker.h"
+
+using planarvo::capi::guard;
+using planarvo::capi::require;
+
+struct planarvo_tracker {
+  std::unique_ptr<planarvo::track::Tracker> tracker;
+  cv::Mat grey;  // conversion buffer for colour and float frames
+};
+
+namespace {
+
+planarvo_track_status to_c(planarvo::track::FrameResult::Status s) {
+  using S = planarvo::track::FrameResult::Status;
+  switch (s) {
+    case S::First: return PLANARVO_TRACK_FIRST;
+    case S::Ok: return PLANARVO_TRACK_OK;
+    case S::Degraded: return PLANARVO_TRACK_DEGRADED;
+    case S::Lost: return PLANARVO_TRACK_LOST;
+  }
+  return PLANARVO_TRACK_LOST;
+}
+
+// The frame as 8-bit grey: a view of the caller's memory when it already is, else converted.
+const uint8_t* grey_view(const planarvo_image& im, cv::Mat& buffer, size_t* stride) {
+  const int type = im.format == PLANARVO_GRAY8 ? CV_8UC1
+                   : im.format == PLANARVO_GRAY32F ? CV_32FC1
+                                                   : CV_8UC3;
+  const cv::Mat src(im.height, im.width, type, const_cast<void*>(im.data), im.stride);
+  switch (im.format) {
+    case PLANARVO_GRAY8:
+      *stride = im.stride;
+      return static_cast<const uint8_t*>(im.data);
+    case PLANARVO_BGR8: cv::cvtColor(src, buffer, cv::COLOR_BGR2GRAY); break;
+    case PLANARVO_RGB8: cv::cvtColor(src, buffer, cv::COLOR_RGB2GRAY); break;
+    case PLANARVO_GRAY32F: src.convertTo(buffer, CV_8UC1); break;  // rounds and saturates
+  }
+  *stride = buffer.step[0];
+  return buffer.data;
+}
+
+}  // namespace
+
+extern "C" {
+
+PLANARVO_API void planarvo_tracker_options_init(planarvo_tracker_options* o) {
+  if (!o) return;
+  std::memset(o, 0, sizeof *o);
+  const planarvo::track::TrackerOptions d;
+  o->struct_size = sizeof *o;
+  o->levels = d.levels;
+  o->finest_level = d.finest_level;
+  o->max_iterations = 0;
+  o->keyframe_overlap = d.keyframe_overlap;
+  o->estimate_brightness = d.estimate_brightness ? 1 : 0;
+}
+
+PLANARVO_API planarvo_status planarvo_tracker_create(planarvo_context* context, const planarvo_camera* camera,
+                                                     const planarvo_extrinsics* extrinsics,
+                                                     const planarvo_tracker_options* options,
+                                                     planarvo_tracker** tracker) {
+  return guard([&] {
+    require(tracker != nullptr, "planarvo_tracker_create: tracker is NULL");
+    *tracker = nullptr;
+    require(context != nullptr && camera != nullptr && extrinsics != nullptr,
+            "planarvo_tracker_create: context, camera and extrinsics are required");
+    const planarvo::CameraModel cam = planarvo::capi::to_cpp(*camera);
+    try {
+      cam.validate("planarvo_tracker_create: camera");
+    } catch (const planarvo::Error& e) {
+      throw planarvo::Error(planarvo::ErrorCode::InvalidArgument, e.what());
+    }
+    require(extrinsics->z > 0, "planarvo_tracker_create: extrinsics.z (the camera height) must be positive");
+    planarvo::track::TrackerOptions o;
+    if (options) {
+      planarvo::capi::require_struct_size(options->struct_size,
+                                          offsetof(planarvo_tracker_options, estimate_brightness) + 4,
+                                          "planarvo_tracker_options");
+      require(options->levels >= 1 && options->levels <= planarvo::track::kMaxLevels,
+              "planarvo_tracker_options.levels must be 1..8");
+      require(options->finest_level >= -1 && options->finest_level < options->levels,
+              "planarvo_tracker_options.finest_level must be -1 (automatic) or 0..levels-1");
+      require(options->max_iterations >= 0, "planarvo_tracker_options.max_iterations must be >= 0");
+      require(options->keyframe_overlap > 0 && options->keyframe_overlap < 1,
+              "planarvo_tracker_options.keyframe_overlap must be in (0, 1)");
+      o.levels = options->levels;
+      o.finest_level = options->finest_level;
+      if (options->max_iterations > 0)
+        for (int& n : o.max_iterations) n = std::min(n, static_cast<int>(options->max_iterations));
+      o.keyframe_overlap = options->keyframe_overlap;
+      o.estimate_brightness = options->estimate_brightness != 0;
+    }
+    auto t = std::make_unique<planarvo_tracker>();
+    t->tracker = std::make_unique<planarvo::track::Tracker>(*context->runtime, cam,
+                                                            planarvo::capi::to_cpp(*extrinsics), o);
+    *tracker = t.release();
+  });
+}
+
+PLANARVO_API void planarvo_tracker_destroy(planarvo_tracker* tracker) { delete tracker; }
+
+PLANARVO_API planarvo_status planarvo_tracker_track(planarvo_tracker* tracker, const planarvo_image* image,
+                                                    double timestamp, planarvo_track_result* result) {
+  return guard([&] {
+    require(tracker != nullptr && image != nullptr && result != nullptr, "planarvo_tracker_track: NULL argument");
+    planarvo::capi::require_struct_size(result->struct_size, offsetof(planarvo_track_result, ms) + sizeof(double),
+                                        "planarvo_track_result");
+    require(image->data != nullptr && image->width > 0 && image->height > 0,
+            "planarvo_tracker_track: the image has no pixels");
+    require(image->format >= PLANARVO_GRAY8 && image->format <= PLANARVO_GRAY32F,
+            "planarvo_tracker_track: unknown pixel format");
+    const size_t bpp = image->format == PLANARVO_GRAY8 ? 1 : image->format == PLANARVO_GRAY32F ? 4 : 3;
+    require(image->stride >= bpp * static_cast<size_t>(image->width), "planarvo_tracker_track: stride < row size");
+    require(std::isfinite(timestamp), "planarvo_tracker_track: timestamp is NaN or inf");
+    size_t stride = 0;
+    const uint8_t* grey = grey_view(*image, tracker->grey, &stride);
+    const planarvo::track::FrameResult r =
+        tracker->tracker->track(grey, image->width, image->height, stride, timestamp);
+    planarvo_track_result out;
+    std::memset(&out, 0, sizeof out);
+    out.struct_size = result->struct_size;
+    out.status = to_c(r.status);
+    out.reason = r.reason;
+    out.motion = planarvo::capi::to_c(r.motion);
+    for (int i = 0; i < 9; ++i) out.covariance[i] = r.covariance(i / 3, i % 3);
+    out.pose = planarvo::capi::to_c(tracker->tracker->pose());
+    for (int i = 0; i < 8; ++i) out.iterations[i] = r.iterations[static_cast<size_t>(i)];
+    out.levels_used = r.levels_used;
+    out.final_cost = r.final_cost;
+    out.inlier_fraction = r.inlier_fraction;
+    out.overlap = r.overlap;
+    out.keyframe = r.keyframe ? 1 : 0;
+    out.ms = r.ms;
+    std::memcpy(result, &out, std::min(result->struct_size, sizeof out));
+  });
+}
+
+PLANARVO_API planarvo_status planarvo_tracker_reset(planarvo_tracker* tracker) {
+  return guard([&] {
+    require(tracker != nullptr, "planarvo_tracker_reset: tracker is NULL");
+    tracker->tracker->reset();
+  });
+}
+
+PLANARVO_API planarvo_status planarvo_evaluate_motions(const planarvo_se2* estimated, const planarvo_se2* truth,
+                                                       const double* dt, const int32_t* valid, size_t count,
+                                                       double gross_threshold, planarvo_motion_accuracy* accuracy) {
+  return guard([&] {
+    require(accuracy != nullptr, "planarvo_evaluate_motions: accuracy is NULL");
+    planarvo::capi::require_struct_size(accuracy->struct_size,
+                                        offsetof(planarvo_motion_accuracy, endpoint_heading) + sizeof(double),
+                                        "planarvo_motion_accuracy");
+    require(count == 0 || (estimated && truth && dt), "planarvo_evaluate_motions: NULL arrays");
+    std::vector<planarvo::SE2> e(count), t(count);
+    std::vector<double> d(dt, dt + count);
+    std::vector<bool> v;
+    for (size_t i = 0; i < count; ++i) {
+      e[i] = planarvo::capi::to_cpp(estimated[i]);
+      t[i] = planarvo::capi::to_cpp(truth[i]);
+      if (valid) v.push_back(valid[i] != 0);
+    }
+    const auto a = planarvo::track::evaluate_motions(e, t, d, gross_threshold, v);
+    planarvo_motion_accuracy out;
+    std::memset(&out, 0, sizeof out);
+    out.struct_size = accuracy->struct_size;
+    out.intervals = a.intervals;
+    out.distance = a.distance;
+    out.slope_linear = a.slope_linear;
+    out.slope_angular = a.slope_angular;
+    out.rms_translation = a.rms_translation;
+    out.max_translation = a.max_translation;
+    out.rms_rotation = a.rms_rotation;
+    out.gross_errors = a.gross_errors;
+    out.endpoint_error = a.endpoint_error;
+    out.endpoint_drift = a.endpoint_drift;
+    out.endpoint_heading = a.endpoint_heading;
+    std::memcpy(accuracy, &out, std::min(accuracy->struct_size, sizeof out));
+  });
+}
+
+}  // extern "C"

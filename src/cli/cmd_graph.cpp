@@ -1,0 +1,166 @@
+// `planarvo posegraph` and `planarvo calibrate`: graph optimisation, no OpenCL device.
+#include <cmath>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include "common.h"
+
+namespace planarvo::cli {
+namespace {
+
+constexpr double kDeg = M_PI / 180.0;
+
+void print_line(void*, const char* line) { std::printf("  %s\n", line); }
+
+}  // namespace
+
+int cmd_posegraph(int argc, char** argv) {
+  const std::vector<OptionSpec> specs = {
+      {"output", "FILE", "write the optimised graph (g2o) to FILE (also -o)", ""},
+      {"max-iterations", "N", "iteration cap", "100"},
+      {"init", "KIND", "none | rotation (orientations first, then positions)", "none"},
+      {"verbose", "", "print the iteration table", ""},
+      {"help", "", "show this help", ""}};
+  Args args(specs, argc, argv, 1);
+  if (args.has("help") || args.positionals().size() != 1) {
+    std::printf("usage: planarvo posegraph IN.g2o [-o OUT.g2o] [--init rotation] [--verbose]\n\n"
+                "Optimises a 2-D pose graph in g2o's format (VERTEX_SE2, EDGE_SE2; the first vertex held\n"
+                "fixed) with planarvo's sparse Levenberg-Marquardt solver on CHOLMOD.\n\n%s",
+                format_options(specs).c_str());
+    return args.has("help") ? kExitOk : kExitUsage;
+  }
+  planarvo_posegraph_options o;
+  planarvo_posegraph_options_init(&o);
+  o.max_iterations = static_cast<int32_t>(args.get_int("max-iterations", o.max_iterations));
+  const std::string init = args.get("init", "none");
+  if (init == "rotation") o.init = PLANARVO_POSEGRAPH_INIT_ROTATION_FIRST;
+  else if (init != "none") throw UsageError("--init must be none or rotation");
+  if (args.has("verbose")) o.log = &print_line;
+  planarvo_solver_summary s{};
+  s.struct_size = sizeof s;
+  const std::string out = args.get("output");
+  const planarvo_status st = planarvo_posegraph_optimize(args.positionals()[0].c_str(), out.empty() ? nullptr : out.c_str(), &o, &s);
+  if (st != PLANARVO_OK && st != PLANARVO_ERROR_FAILED) check(st);
+  std::printf("%s: chi2 %.6f -> %.6f in %d iterations (%d factorisations), %.3f s\n",
+              args.positionals()[0].c_str(), s.initial_chi2, s.final_chi2, s.iterations, s.factorizations, s.seconds);
+  std::printf("termination: %s\n", s.termination);
+  if (!out.empty()) std::printf("wrote %s\n", out.c_str());
+  if (st == PLANARVO_ERROR_FAILED) {
+    std::fprintf(stderr, "planarvo posegraph: %s\n", planarvo_last_error());
+    return kExitFailed;
+  }
+  return kExitOk;
+}
+
+int cmd_calibrate(int argc, char** argv) {
+  const std::vector<OptionSpec> specs = {
+      {"motions", "FILE.csv", "motion pairs (interval_s, [odo_dx, odo_dy, odo_dtheta,] sensor_dx, sensor_dy, "
+                              "sensor_dtheta[, direction])", ""},
+      {"method", "KIND", "odometry | nonholonomic", "odometry"},
+      {"fix-scale", "", "a metric sensor (e.g. a laser scan matcher): scale 1, z written as 0", ""},
+      {"height", "METRES", "the camera height is known: hold the scale at it", ""},
+      {"initial", "x,y,scale,yaw", "start here (metres, degrees) instead of the built-in initialisation", ""},
+      {"velocity-form", "", "nonholonomic: the paper's velocity form instead of the exact arc form", ""},
+      {"output", "FILE", "write the extrinsics YAML to FILE (also -o)", ""},
+      {"verbose", "", "print the solver's iteration table", ""},
+      {"help", "", "show this help", ""}};
+  Args args(specs, argc, argv, 1);
+  if (args.has("help") || !args.has("motions")) {
+    std::printf("usage: planarvo calibrate --motions FILE.csv [--method odometry|nonholonomic] [--fix-scale | "
+                "--height H] [-o extrinsics.yaml]\n\n"
+                "Calibrates the sensor's pose on the robot (x, y, yaw, and the camera height) from its planar\n"
+                "motions: against wheel odometry, or from the nonholonomic constraint with direction labels.\n"
+                "Exit code 1 when the data cannot determine the answer (it says why).\n\n%s",
+                format_options(specs).c_str());
+    return args.has("help") ? kExitOk : kExitUsage;
+  }
+  if (!args.positionals().empty()) throw UsageError("unexpected argument " + args.positionals()[0]);
+  planarvo_calibration_options o;
+  planarvo_calibration_options_init(&o);
+  const std::string method = args.get("method", "odometry");
+  if (method == "odometry") o.method = PLANARVO_CALIBRATE_ODOMETRY;
+  else if (method == "nonholonomic") o.method = PLANARVO_CALIBRATE_NONHOLONOMIC;
+  else throw UsageError("--method must be odometry or nonholonomic, not \"" + method + "\"");
+  if (args.has("fix-scale") && args.has("height")) throw UsageError("give --fix-scale or --height, not both");
+  const bool metric = args.has("fix-scale");
+  if (metric) {
+    o.fix_scale = 1;
+    o.fixed_scale = 1.0;
+  } else if (args.has("height")) {
+    o.fix_scale = 1;
+    o.fixed_scale = args.get_double("height", 0);
+    if (!(o.fixed_scale > 0)) throw UsageError("--height must be positive");
+  } else if (o.method == PLANARVO_CALIBRATE_NONHOLONOMIC) {
+    throw UsageError("the nonholonomic method cannot estimate the scale: give --fix-scale (a metric sensor) or "
+                     "--height H (the camera height)");
+  }
+  if (args.has("initial")) {
+    const auto v = args.get_doubles("initial", 4);
+    o.has_initial = 1;
+    o.initial[0] = v[0];
+    o.initial[1] = v[1];
+    o.initial[2] = v[2];
+    o.initial[3] = v[3] * kDeg;
+  }
+  o.velocity_form = args.has("velocity-form") ? 1 : 0;
+  if (args.has("verbose")) o.log = &print_line;
+
+  const std::string path = args.get("motions");
+  size_t n = 0;
+  check(planarvo_motion_pairs_load(path.c_str(), nullptr, 0, &n));
+  std::vector<planarvo_motion_pair> pairs(n);
+  check(planarvo_motion_pairs_load(path.c_str(), pairs.data(), n, &n));
+  planarvo_calibration_result r{};
+  r.struct_size = sizeof r;
+  const planarvo_status st = planarvo_calibrate(pairs.data(), n, &o, &r);
+  if (st != PLANARVO_OK && st != PLANARVO_ERROR_FAILED) check(st);
+
+  static const char* names[4] = {"x", "y", "scale", "yaw"};
+  std::printf("%s calibration from %zu motion pairs (%d rejected as gross errors)\n", method.c_str(), n, r.outliers);
+  for (int i = 0; i < 4; ++i) {
+    const double sd = std::sqrt(std::max(0.0, r.covariance[i * 5]));
+    const bool angle = i == 3;
+    const double k = angle ? 1 / kDeg : 1e3;
+    const char* unit = angle ? "deg" : "mm";
+    if (i == 2 && metric) continue;
+    if (!r.estimated[i]) {
+      std::printf("  %-5s %10.3f %-3s  (held)\n", names[i], r.value[i] * k, unit);
+      continue;
+    }
+    std::printf("  %-5s %10.3f %-3s  +- %.3f%s\n", names[i], r.value[i] * k, unit, sd * k,
+                r.observable[i] ? "" : "  UNOBSERVABLE");
+  }
+  std::printf("solver: %d iterations, %s\n", r.summary.iterations, r.summary.termination);
+  if (r.ambiguous) std::printf("ambiguous: (-x, -y, yaw + 180 deg) fits equally well\n");
+  if (r.unobservable_reason[0]) std::printf("%s\n", r.unobservable_reason);
+
+  const std::string out = args.get("output");
+  if (!out.empty() && !r.ok) std::printf("%s not written: the calibration is not determined\n", out.c_str());
+  if (!out.empty() && r.ok) {
+    // Extrinsics YAML: z is the camera height (0 for a metric sensor); roll and pitch are not
+    // estimated from motions (they come from images).
+    const planarvo_extrinsics e{r.value[0], r.value[1], metric ? 0.0 : r.value[2], 0, 0, r.value[3]};
+    double cov[36] = {};
+    const int map[4] = {0, 1, 2, 5};  // x y scale yaw -> x y z roll pitch yaw
+    for (int i = 0; i < 4; ++i)
+      for (int j = 0; j < 4; ++j)
+        if (!(metric && (i == 2 || j == 2))) cov[map[i] * 6 + map[j]] = r.covariance[i * 4 + j];
+    std::string estimated;
+    for (int i = 0; i < 4; ++i)
+      if (r.estimated[i] && !(i == 2 && metric)) estimated += std::string(estimated.empty() ? "" : ",") + (i == 2 ? "z" : names[i]);
+    const std::string notes = std::to_string(n) + " motion pairs from " + path;
+    check(planarvo_extrinsics_save(out.c_str(), &e, cov, estimated.c_str(),
+                                   method == "odometry" ? "graph calibration against wheel odometry"
+                                                        : "nonholonomic graph calibration",
+                                   notes.c_str()));
+    std::printf("wrote %s\n", out.c_str());
+  }
+  if (st == PLANARVO_ERROR_FAILED) {
+    std::fprintf(stderr, "planarvo calibrate: %s\n", planarvo_last_error());
+    return kExitFailed;
+  }
+  return kExitOk;
+}
+
+}  // namespace planarvo::cli

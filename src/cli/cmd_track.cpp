@@ -1,0 +1,187 @@
+// `planarvo track`: dense planar visual odometry over a data set.
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "common.h"
+
+namespace planarvo::cli {
+namespace {
+
+constexpr double kDeg = M_PI / 180.0;
+
+const char* status_label(planarvo_track_status s) {
+  switch (s) {
+    case PLANARVO_TRACK_FIRST: return "first";
+    case PLANARVO_TRACK_OK: return "ok";
+    case PLANARVO_TRACK_DEGRADED: return "degraded";
+    case PLANARVO_TRACK_LOST: return "lost";
+  }
+  return "?";
+}
+
+// The motion from pose a to pose b, in a's frame.
+planarvo_se2 relative(const planarvo_se2& a, const planarvo_se2& b) {
+  const double c = std::cos(a.theta), s = std::sin(a.theta), dx = b.x - a.x, dy = b.y - a.y;
+  return {c * dx + s * dy, -s * dx + c * dy, std::remainder(b.theta - a.theta, 2 * M_PI)};
+}
+
+struct StatsCloser {
+  void operator()(planarvo_stats_writer* w) const { planarvo_stats_writer_close(w); }
+};
+struct TrackerDeleter {
+  void operator()(planarvo_tracker* t) const { planarvo_tracker_destroy(t); }
+};
+
+}  // namespace
+
+TrackRun track_dataset(planarvo_context* ctx, planarvo_dataset* ds, const planarvo_extrinsics& extrinsics,
+                       const planarvo_tracker_options& options, const TrackOutputs& outputs, Progress* progress) {
+  planarvo_dataset_info info{};
+  info.struct_size = sizeof info;
+  check(planarvo_dataset_info_get(ds, &info));
+  planarvo_tracker* raw = nullptr;
+  check(planarvo_tracker_create(ctx, &info.camera, &extrinsics, &options, &raw));
+  std::unique_ptr<planarvo_tracker, TrackerDeleter> tracker(raw);
+  std::unique_ptr<planarvo_stats_writer, StatsCloser> stats;
+  if (!outputs.stats.empty()) {
+    planarvo_stats_writer* w = nullptr;
+    check(planarvo_stats_writer_open(outputs.stats.c_str(), &w));
+    stats.reset(w);
+  }
+  TrackRun run;
+  const auto n = static_cast<size_t>(info.frame_count);
+  std::vector<double> t(n);
+  std::vector<planarvo_se2> pose(n), motion(n), truth(n);
+  std::vector<int32_t> valid(n, 0);
+  bool all_truth = info.has_groundtruth != 0;
+  for (size_t i = 0; i < n; ++i) {
+    planarvo_frame_data fd{};
+    check(planarvo_dataset_frame_data(ds, static_cast<int64_t>(i), &fd));
+    planarvo_image img{};
+    check(planarvo_dataset_frame(ds, static_cast<int64_t>(i), &img));
+    planarvo_track_result r{};
+    r.struct_size = sizeof r;
+    check(planarvo_tracker_track(tracker.get(), &img, fd.timestamp, &r));
+    t[i] = fd.timestamp;
+    pose[i] = r.pose;
+    motion[i] = r.motion;
+    ++run.frames;
+    run.ms.push_back(r.ms);
+    run.engine_ms += r.ms;
+    run.keyframes += r.keyframe ? 1 : 0;
+    if (r.status == PLANARVO_TRACK_OK || r.status == PLANARVO_TRACK_FIRST) ++run.ok;
+    if (r.status == PLANARVO_TRACK_DEGRADED) ++run.degraded;
+    if (r.status == PLANARVO_TRACK_LOST) ++run.lost;
+    valid[i] = r.status == PLANARVO_TRACK_OK || r.status == PLANARVO_TRACK_DEGRADED;
+    if (fd.has_groundtruth) truth[i] = fd.groundtruth;
+    else all_truth = false;
+    if (stats) {
+      const double dt = i > 0 ? t[i] - t[i - 1] : 0;
+      planarvo_frame_stats row{};
+      row.timestamp = fd.timestamp;
+      row.vx = dt > 0 ? r.motion.x / dt : 0;
+      row.vy = dt > 0 ? r.motion.y / dt : 0;
+      row.omega = dt > 0 ? r.motion.theta / dt : 0;
+      for (int l = 0; l < 8; ++l) row.iterations += r.iterations[l];
+      row.final_cost = r.final_cost;
+      row.inlier_fraction = r.inlier_fraction;
+      row.ms = r.ms;
+      row.status = status_label(r.status);
+      check(planarvo_stats_writer_add(stats.get(), &row));
+    }
+    if (progress) Progress::callback(progress, static_cast<double>(i + 1) / static_cast<double>(n), "tracking");
+  }
+  if (stats) check(planarvo_stats_writer_close(stats.release()));
+  if (!outputs.trajectory.empty()) check(planarvo_write_tum(outputs.trajectory.c_str(), t.data(), pose.data(), n));
+  if (all_truth && n > 1) {
+    std::vector<planarvo_se2> est(n - 1), tru(n - 1);
+    std::vector<double> dt(n - 1);
+    for (size_t i = 1; i < n; ++i) {
+      est[i - 1] = motion[i];
+      tru[i - 1] = relative(truth[i - 1], truth[i]);
+      dt[i - 1] = t[i] - t[i - 1];
+    }
+    run.accuracy.struct_size = sizeof run.accuracy;
+    check(planarvo_evaluate_motions(est.data(), tru.data(), dt.data(), valid.data() + 1, n - 1, 1e-3,
+                                    &run.accuracy));
+    run.has_accuracy = true;
+  }
+  return run;
+}
+
+void print_track_run(const TrackRun& run) {
+  std::vector<double> ms = run.ms;
+  std::sort(ms.begin(), ms.end());
+  const double median = ms.empty() ? 0 : ms[ms.size() / 2];
+  std::printf("frames %lld: %lld ok, %lld degraded, %lld lost; %lld keyframes\n", static_cast<long long>(run.frames),
+              static_cast<long long>(run.ok), static_cast<long long>(run.degraded), static_cast<long long>(run.lost),
+              static_cast<long long>(run.keyframes));
+  std::printf("engine time per frame: mean %.2f ms (%.0f fps), median %.2f ms (upload, undistortion, pyramid, "
+              "tracking)\n",
+              run.engine_ms / std::max<int64_t>(run.frames, 1), 1000.0 * static_cast<double>(run.frames) / run.engine_ms,
+              median);
+  if (!run.has_accuracy) return;
+  const planarvo_motion_accuracy& a = run.accuracy;
+  std::printf("accuracy against ground truth over %d intervals, %.3f m travelled:\n", a.intervals, a.distance);
+  std::printf("  velocity slope (fit of estimated vs true)   linear %.4f   angular %.4f\n", a.slope_linear,
+              a.slope_angular);
+  std::printf("  per-frame translation error                 RMS %.4f mm   max %.4f mm   gross (> 1 mm) %d\n",
+              a.rms_translation * 1e3, a.max_translation * 1e3, a.gross_errors);
+  std::printf("  per-frame rotation error                    RMS %.4f deg\n", a.rms_rotation / kDeg);
+  std::printf("  end point                                   %.2f mm (%.3f%% of distance), heading %.3f deg\n",
+              a.endpoint_error * 1e3, 100 * a.endpoint_drift, a.endpoint_heading / kDeg);
+}
+
+int cmd_track(int argc, char** argv) {
+  std::vector<OptionSpec> specs = {
+      {"extrinsics", "FILE", "camera extrinsics YAML", "DATASET/extrinsics.yaml"},
+      {"output", "FILE", "write the trajectory (TUM) to FILE (also -o)", ""},
+      {"stats", "FILE", "write per-frame statistics (CSV) to FILE", ""},
+      {"levels", "N", "pyramid levels", "4"},
+      {"finest-level", "N", "finest pyramid level tracked (0 = full resolution)", "the coarsest at least 320 px wide"},
+      {"max-iterations", "N", "cap on alignment steps per level", "per-level defaults"},
+      {"video", "FILE", "a video file standing in for images/ and frames.txt", ""},
+      {"quiet", "", "no progress bar", ""},
+      {"help", "", "show this help", ""}};
+  for (auto& d : device_options()) specs.push_back(d);
+  Args args(specs, argc, argv, 1);
+  if (args.has("help") || args.positionals().size() != 1) {
+    std::printf("usage: planarvo track DATASET [--extrinsics FILE] [-o trajectory.txt] [--stats stats.csv]\n\n"
+                "Dense planar visual odometry over a data set: prints a summary, and the accuracy against\n"
+                "groundtruth.txt when the data set has one.\n\n%s",
+                format_options(specs).c_str());
+    return args.has("help") ? kExitOk : kExitUsage;
+  }
+  const std::string dir = args.positionals()[0];
+  std::string extr = args.get("extrinsics");
+  if (extr.empty()) {
+    extr = (std::filesystem::path(dir) / "extrinsics.yaml").string();
+    if (!std::filesystem::exists(extr))
+      throw UsageError("no --extrinsics given and " + extr + " does not exist (calibrate first, or pass the file)");
+  }
+  planarvo_extrinsics e{};
+  check(planarvo_extrinsics_load(extr.c_str(), &e));
+  planarvo_tracker_options o;
+  planarvo_tracker_options_init(&o);
+  o.levels = static_cast<int32_t>(args.get_int("levels", o.levels));
+  o.finest_level = static_cast<int32_t>(args.get_int("finest-level", o.finest_level));
+  o.max_iterations = static_cast<int32_t>(args.get_int("max-iterations", 0));
+  ContextPtr ctx = make_context(args);
+  Progress progress(!args.has("quiet"));
+  DatasetPtr ds = open_dataset(dir, args.get("video"), false, &progress);
+  const TrackRun run = track_dataset(ctx.get(), ds.get(), e, o, {args.get("output"), args.get("stats")}, &progress);
+  progress.finish();
+  std::printf("tracked %s on %s\n", dir.c_str(), device_name(ctx.get()).c_str());
+  print_track_run(run);
+  if (run.lost == run.frames - 1 && run.frames > 1) {
+    std::fprintf(stderr, "planarvo track: tracking was lost on every frame\n");
+    return kExitFailed;
+  }
+  return kExitOk;
+}
+
+}  // namespace planarvo::cli
