@@ -1,5 +1,6 @@
 // The C API's contract: statuses and messages instead of exceptions, NULL safety, struct_size
 // checks, thread-local error messages, buffer sizing.
+#include <cmath>
 #include <cstring>
 #include <string>
 #include <thread>
@@ -226,6 +227,88 @@ TEST(CApiData, ExtrinsicsAndTumRoundTrip) {
   const std::string tum = (dir / "traj.txt").string();
   ASSERT_EQ(planarvo_write_tum(tum.c_str(), t, p, 2), PLANARVO_OK) << planarvo_last_error();
   EXPECT_EQ(planarvo_write_tum("/nonexistent/dir/traj.txt", t, p, 2), PLANARVO_ERROR_IO);
+}
+
+}  // namespace
+
+namespace {
+
+TEST(CApiTracker, TracksFramesWithStatusesNotErrors) {
+  planarvo_context* c = make_context();
+  ScratchDir dir;
+  planarvo_sim_options o = tiny_sim(planarvo::test::texture("asphalt_01.png").string());
+  ASSERT_EQ(planarvo_sim_default_camera(320, 240, 80.0, &o.camera), PLANARVO_OK);
+  o.seconds = 0.3;
+  ASSERT_EQ(planarvo_simulate(c, &o, dir.path().c_str()), PLANARVO_OK) << planarvo_last_error();
+  planarvo_dataset* d = nullptr;
+  ASSERT_EQ(planarvo_dataset_open(dir.path().c_str(), nullptr, &d), PLANARVO_OK);
+
+  planarvo_tracker* t = nullptr;
+  EXPECT_EQ(planarvo_tracker_create(c, nullptr, &o.extrinsics, nullptr, &t), PLANARVO_ERROR_INVALID_ARGUMENT);
+  planarvo_extrinsics below = o.extrinsics;
+  below.z = -0.1;
+  EXPECT_EQ(planarvo_tracker_create(c, &o.camera, &below, nullptr, &t), PLANARVO_ERROR_INVALID_ARGUMENT);
+  ASSERT_EQ(planarvo_tracker_create(c, &o.camera, &o.extrinsics, nullptr, &t), PLANARVO_OK) << planarvo_last_error();
+
+  planarvo_track_result r{};
+  r.struct_size = sizeof r;
+  planarvo_image img{};
+  planarvo_frame_data f{};
+  for (int64_t i = 0; i < 9; ++i) {
+    ASSERT_EQ(planarvo_dataset_frame(d, i, &img), PLANARVO_OK);
+    ASSERT_EQ(planarvo_dataset_frame_data(d, i, &f), PLANARVO_OK);
+    ASSERT_EQ(planarvo_tracker_track(t, &img, f.timestamp, &r), PLANARVO_OK) << planarvo_last_error();
+    EXPECT_EQ(r.status, i == 0 ? PLANARVO_TRACK_FIRST : PLANARVO_TRACK_OK) << i << " " << r.reason;
+  }
+  // The accumulated pose against ground truth (relative to frame 0, which is the origin).
+  EXPECT_NEAR(r.pose.x, f.groundtruth.x, 1e-4);
+  EXPECT_NEAR(r.pose.y, f.groundtruth.y, 1e-4);
+  EXPECT_NEAR(r.pose.theta, f.groundtruth.theta, 1e-3);
+
+  // A frame of another size: LOST with a reason, not an error; the pose stays finite.
+  std::vector<uint8_t> small(100 * 80, 128);
+  planarvo_image wrong{small.data(), 100, 80, 100, PLANARVO_GRAY8};
+  ASSERT_EQ(planarvo_tracker_track(t, &wrong, f.timestamp + 0.033, &r), PLANARVO_OK);
+  EXPECT_EQ(r.status, PLANARVO_TRACK_LOST);
+  EXPECT_GT(std::strlen(r.reason), 0u);
+  EXPECT_TRUE(std::isfinite(r.pose.x) && std::isfinite(r.pose.theta));
+
+  // Caller errors are statuses.
+  planarvo_image empty{nullptr, 320, 240, 320, PLANARVO_GRAY8};
+  EXPECT_EQ(planarvo_tracker_track(t, &empty, 1.0, &r), PLANARVO_ERROR_INVALID_ARGUMENT);
+  planarvo_image short_stride = img;
+  short_stride.stride = 10;
+  EXPECT_EQ(planarvo_tracker_track(t, &short_stride, 1.0, &r), PLANARVO_ERROR_INVALID_ARGUMENT);
+
+  // Reset: the next frame is FIRST again; colour input is converted.
+  ASSERT_EQ(planarvo_tracker_reset(t), PLANARVO_OK);
+  ASSERT_EQ(planarvo_dataset_frame(d, 0, &img), PLANARVO_OK);
+  std::vector<uint8_t> bgr(static_cast<size_t>(img.width * img.height * 3));
+  for (int y = 0; y < img.height; ++y)
+    for (int x = 0; x < img.width; ++x)
+      for (int k = 0; k < 3; ++k)
+        bgr[static_cast<size_t>((y * img.width + x) * 3 + k)] =
+            static_cast<const uint8_t*>(img.data)[static_cast<size_t>(y) * img.stride + static_cast<size_t>(x)];
+  planarvo_image colour{bgr.data(), img.width, img.height, static_cast<size_t>(img.width * 3), PLANARVO_BGR8};
+  ASSERT_EQ(planarvo_tracker_track(t, &colour, 5.0, &r), PLANARVO_OK);
+  EXPECT_EQ(r.status, PLANARVO_TRACK_FIRST);
+  EXPECT_DOUBLE_EQ(r.pose.x, 0.0);
+
+  planarvo_tracker_destroy(t);
+  planarvo_dataset_destroy(d);
+  planarvo_context_destroy(c);
+}
+
+TEST(CApiTracker, EvaluateMotionsChecksItsArguments) {
+  planarvo_motion_accuracy a{};
+  const planarvo_se2 m[2] = {{0.01, 0, 0}, {0.01, 0, 0.01}};
+  const double dt[2] = {0.1, 0.1};
+  EXPECT_EQ(planarvo_evaluate_motions(m, m, dt, nullptr, 2, 1e-3, &a), PLANARVO_ERROR_INVALID_ARGUMENT);  // no struct_size
+  a.struct_size = sizeof a;
+  ASSERT_EQ(planarvo_evaluate_motions(m, m, dt, nullptr, 2, 1e-3, &a), PLANARVO_OK);
+  EXPECT_EQ(a.intervals, 2);
+  EXPECT_DOUBLE_EQ(a.rms_translation, 0.0);
+  EXPECT_NEAR(a.distance, 0.02, 1e-15);
 }
 
 }  // namespace
