@@ -3,6 +3,7 @@
 #include <memory>
 #include <string>
 
+#include "capi/convert.h"
 #include "capi/handles.h"
 #include "capi/status.h"
 #include "ocl/runtime.h"
@@ -12,24 +13,18 @@ using planarvo::capi::require;
 
 namespace {
 
-void copy_string(char* dst, size_t capacity, const std::string& src) {
-  const size_t n = std::min(capacity - 1, src.size());
-  std::memcpy(dst, src.data(), n);
-  dst[n] = '\0';
-}
-
 void fill_info(const planarvo::ocl::DeviceInfo& d, planarvo_device_info* out) {
   const size_t struct_size = out->struct_size;
   planarvo_device_info info;
   std::memset(&info, 0, sizeof info);
   info.struct_size = struct_size;
   info.index = d.global_index;
-  copy_string(info.platform_name, sizeof info.platform_name, d.platform_name);
-  copy_string(info.device_name, sizeof info.device_name, d.device_name);
-  copy_string(info.device_type, sizeof info.device_type, d.type);
-  copy_string(info.device_version, sizeof info.device_version, d.device_version);
-  copy_string(info.opencl_c_version, sizeof info.opencl_c_version, d.opencl_c_version);
-  copy_string(info.driver_version, sizeof info.driver_version, d.driver_version);
+  planarvo::capi::copy_string(info.platform_name, sizeof info.platform_name, d.platform_name);
+  planarvo::capi::copy_string(info.device_name, sizeof info.device_name, d.device_name);
+  planarvo::capi::copy_string(info.device_type, sizeof info.device_type, d.type);
+  planarvo::capi::copy_string(info.device_version, sizeof info.device_version, d.device_version);
+  planarvo::capi::copy_string(info.opencl_c_version, sizeof info.opencl_c_version, d.opencl_c_version);
+  planarvo::capi::copy_string(info.driver_version, sizeof info.driver_version, d.driver_version);
   info.image_support = d.image_support;
   info.fp64 = d.fp64;
   info.local_mem_size = d.local_mem_size;

@@ -1,11 +1,22 @@
 // Conversions between the C API's plain structs and the engine's C++ types.
 #pragma once
+#include <algorithm>
+#include <cstring>
+#include <string>
+
 #include "core/extrinsics.h"
 #include "core/se2.h"
 #include "image/camera.h"
 #include "planarvo/planarvo.h"
 
 namespace planarvo::capi {
+
+// Copies src into a fixed-size C string field, truncating and always terminating.
+inline void copy_string(char* dst, size_t capacity, const std::string& src) {
+  const size_t n = std::min(capacity - 1, src.size());
+  std::memcpy(dst, src.data(), n);
+  dst[n] = '\0';
+}
 
 inline CameraModel to_cpp(const planarvo_camera& c) {
   CameraModel m;

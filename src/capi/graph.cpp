@@ -21,12 +21,6 @@ using planarvo::capi::require;
 
 namespace {
 
-void copy_string(char* dst, size_t capacity, const std::string& src) {
-  const size_t n = std::min(capacity - 1, src.size());
-  std::memcpy(dst, src.data(), n);
-  dst[n] = '\0';
-}
-
 void send_lines(planarvo_log_fn log, void* user, const std::string& text) {
   if (!log) return;
   std::istringstream in(text);
@@ -41,7 +35,7 @@ void fill_summary(const planarvo::graph::SolverSummary& s, double initial_chi2, 
   std::memset(&o, 0, sizeof o);
   o.struct_size = size;
   o.converged = s.converged() ? 1 : 0;
-  copy_string(o.termination, sizeof o.termination, s.message.empty() ? to_string(s.termination) : s.message);
+  planarvo::capi::copy_string(o.termination, sizeof o.termination, s.message.empty() ? to_string(s.termination) : s.message);
   o.iterations = s.num_iterations;
   o.factorizations = s.num_factorizations;
   o.initial_chi2 = initial_chi2;
@@ -201,7 +195,7 @@ PLANARVO_API planarvo_status planarvo_calibrate(const planarvo_motion_pair* pair
     out.ambiguous = r.ambiguous;
     out.outliers = r.outliers;
     out.ok = r.ok();
-    copy_string(out.unobservable_reason, sizeof out.unobservable_reason, r.unobservable_reason);
+    planarvo::capi::copy_string(out.unobservable_reason, sizeof out.unobservable_reason, r.unobservable_reason);
     out.summary.struct_size = sizeof out.summary;
     fill_summary(r.summary, 2.0 * r.summary.initial_cost, 2.0 * r.summary.final_cost, &out.summary);
     *result = out;
