@@ -2,7 +2,7 @@
 // pyramid level, warp it into the live level through the homography H, sample the live level
 // bilinearly, form the photometric residual with an affine brightness model, its ESM Jacobian,
 // a Huber weight, and reduce J^T W J, J^T W r, the cost and counts into one row of partial sums
-// per work-group (local-memory tree reduction; the host sums the rows in double). The layout
+// per work-group (local-memory tree reduction; the host sums the rows in 64-bit precision). The layout
 // of a row is mirrored by src/track/warp_reduce.h (ReduceLayout); the plain C++ reference is
 // warp_reduce_reference() in src/track/warp_reduce.cpp.
 //
