@@ -16,8 +16,7 @@
 #define PYRAMID_WG_Y 4
 #endif
 
-// pipeline.h's kInvalidIntensity.
-#define PV_INVALID (-1048576.0f)
+// PV_INVALID and pv_store_head come from kernels/common.cl.
 
 // ---------------------------------------------------------------------------------------------
 // Downsampling: level l (sw x sh) -> level l + 1 (dw x dh = ceil(sw / 2) x ceil(sh / 2)).
@@ -46,17 +45,6 @@ inline float8 pv_row_sums(__global const float* r, const int c, const int xm) {
   const float8 e1 = (float8)(a.s2468, a.sACE, b.s0), o1 = (float8)(a.s3579, a.sBDF, b.s1);
   const float8 e2 = (float8)(a.s468A, a.sCE, b.s02), o2 = (float8)(a.s579B, a.sDF, b.s13);
   return (e0 + o2) + 5.0f * (o0 + e2) + 10.0f * (e1 + o1);
-}
-
-// Stores the first n (1..7) elements of v at d.
-inline void pv_store_head(const float8 v, __global float* d, const int n) {
-  d[0] = v.s0;
-  if (n > 1) d[1] = v.s1;
-  if (n > 2) d[2] = v.s2;
-  if (n > 3) d[3] = v.s3;
-  if (n > 4) d[4] = v.s4;
-  if (n > 5) d[5] = v.s5;
-  if (n > 6) d[6] = v.s6;
 }
 
 __kernel __attribute__((reqd_work_group_size(PYRAMID_WG_X, PYRAMID_WG_Y, 1)))

@@ -16,7 +16,7 @@
 //            reads whole vectors
 //   weights  per output pixel (ax, ay) interleaved, the bilinear weights of the right and
 //            lower neighbours; then 8 pixels of padding
-//   dst      width x height floats: the level-0 intensity image, UD_INVALID where no source
+//   dst      width x height floats: the level-0 intensity image, PV_INVALID where no source
 
 #ifndef UNDISTORT_WG_X
 #define UNDISTORT_WG_X 16
@@ -25,19 +25,7 @@
 #define UNDISTORT_WG_Y 4
 #endif
 
-// pipeline.h's kInvalidIntensity.
-#define UD_INVALID (-1048576.0f)
-
-// Stores the first n (1..7) elements of v at d.
-inline void ud_store_head(const float8 v, __global float* d, const int n) {
-  d[0] = v.s0;
-  if (n > 1) d[1] = v.s1;
-  if (n > 2) d[2] = v.s2;
-  if (n > 3) d[3] = v.s3;
-  if (n > 4) d[4] = v.s4;
-  if (n > 5) d[5] = v.s5;
-  if (n > 6) d[6] = v.s6;
-}
+// PV_INVALID and pv_store_head come from kernels/common.cl.
 
 __kernel __attribute__((reqd_work_group_size(UNDISTORT_WG_X, UNDISTORT_WG_Y, 1)))
 void undistort(__global const uchar* src, __global const int* index,
@@ -66,9 +54,9 @@ void undistort(__global const uchar* src, __global const int* index,
   // remap_bilinear's operations, in its order.
   const float8 top = (1.0f - ax) * p00 + ax * p01;
   const float8 bottom = (1.0f - ax) * p10 + ax * p11;
-  const float8 value = select((float8)(UD_INVALID), (1.0f - ay) * top + ay * bottom, valid);
+  const float8 value = select((float8)(PV_INVALID), (1.0f - ay) * top + ay * bottom, valid);
   if (x + 8 <= width)
     vstore8(value, 0, dst + p);
   else
-    ud_store_head(value, dst + p, width - x);
+    pv_store_head(value, dst + p, width - x);
 }
