@@ -128,12 +128,7 @@ DriveSummary summarise(planarvo_dataset* ds, int64_t n) {
       s.peak_turn = std::max(s.peak_turn, std::abs(dth) / dt);
       if (a.has_odometry && b.has_odometry) {
         // Relative motion in the frame of a, for both, compared.
-        auto rel = [](const planarvo_se2& p, const planarvo_se2& q) {
-          const double c = std::cos(p.theta), sn = std::sin(p.theta);
-          const double dx = q.x - p.x, dy = q.y - p.y;
-          return planarvo_se2{c * dx + sn * dy, -sn * dx + c * dy, std::remainder(q.theta - p.theta, 2 * M_PI)};
-        };
-        const planarvo_se2 g = rel(a.groundtruth, b.groundtruth), o = rel(a.odometry, b.odometry);
+        const planarvo_se2 g = relative(a.groundtruth, b.groundtruth), o = relative(a.odometry, b.odometry);
         sq += (g.x - o.x) * (g.x - o.x) + (g.y - o.y) * (g.y - o.y);
         ++steps;
       }
@@ -146,13 +141,8 @@ DriveSummary summarise(planarvo_dataset* ds, int64_t n) {
   }
   if (s.has_odometry && f.back().has_odometry && f.back().has_groundtruth) {
     // Both trajectories relative to their first pose.
-    auto rel0 = [](const planarvo_se2& p0, const planarvo_se2& p) {
-      const double c = std::cos(p0.theta), sn = std::sin(p0.theta);
-      const double dx = p.x - p0.x, dy = p.y - p0.y;
-      return planarvo_se2{c * dx + sn * dy, -sn * dx + c * dy, std::remainder(p.theta - p0.theta, 2 * M_PI)};
-    };
-    const planarvo_se2 g = rel0(f.front().groundtruth, f.back().groundtruth);
-    const planarvo_se2 o = rel0(f.front().odometry, f.back().odometry);
+    const planarvo_se2 g = relative(f.front().groundtruth, f.back().groundtruth);
+    const planarvo_se2 o = relative(f.front().odometry, f.back().odometry);
     s.odo_end_error = std::hypot(g.x - o.x, g.y - o.y);
     s.odo_heading_error = std::abs(std::remainder(g.theta - o.theta, 2 * M_PI));
     s.odo_rms_step = steps ? std::sqrt(sq / steps) : 0;

@@ -23,12 +23,6 @@ const char* status_label(planarvo_track_status s) {
   return "?";
 }
 
-// The motion from pose a to pose b, in a's frame.
-planarvo_se2 relative(const planarvo_se2& a, const planarvo_se2& b) {
-  const double c = std::cos(a.theta), s = std::sin(a.theta), dx = b.x - a.x, dy = b.y - a.y;
-  return {c * dx + s * dy, -s * dx + c * dy, std::remainder(b.theta - a.theta, 2 * M_PI)};
-}
-
 struct StatsCloser {
   void operator()(planarvo_stats_writer* w) const { planarvo_stats_writer_close(w); }
 };

@@ -1,5 +1,6 @@
 #include "common.h"
 
+#include <cmath>
 #include <cstdio>
 #include <unistd.h>
 
@@ -63,6 +64,11 @@ DatasetPtr open_dataset(const std::string& dir, const std::string& video, bool v
   planarvo_dataset* d = nullptr;
   check(planarvo_dataset_open(dir.c_str(), &o, &d));
   return DatasetPtr(d);
+}
+
+planarvo_se2 relative(const planarvo_se2& a, const planarvo_se2& b) {
+  const double c = std::cos(a.theta), s = std::sin(a.theta), dx = b.x - a.x, dy = b.y - a.y;
+  return {c * dx + s * dy, -s * dx + c * dy, std::remainder(b.theta - a.theta, 2 * M_PI)};
 }
 
 bool stderr_is_terminal() { return isatty(STDERR_FILENO) == 1; }

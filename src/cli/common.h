@@ -70,6 +70,9 @@ TrackRun track_dataset(planarvo_context* ctx, planarvo_dataset* ds, const planar
                        const planarvo_tracker_options& options, const TrackOutputs& outputs, Progress* progress);
 void print_track_run(const TrackRun& run);
 
+// The motion from pose a to pose b, in a's frame (a^-1 b).
+planarvo_se2 relative(const planarvo_se2& a, const planarvo_se2& b);
+
 // Each command: returns the exit code; throws UsageError or ApiError.
 struct Command {
   const char* name;
