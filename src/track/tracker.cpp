@@ -17,12 +17,8 @@ namespace planarvo::track {
 namespace {
 
 using Status = FrameResult::Status;
-using Vector5d = Eigen::Matrix<double, 5, 1>;
 
 constexpr int kMinLevelSide = 8;
-constexpr double kMadToSigma = 1.4826;
-
-bool finite(const SE2& m) { return std::isfinite(m.x) && std::isfinite(m.y) && std::isfinite(m.theta); }
 
 // The estimate: live pose in the keyframe's robot frame and brightness relative to it.
 struct Estimate {
@@ -33,10 +29,7 @@ struct Estimate {
 Eigen::Matrix3d lost_covariance() { return Eigen::Matrix3d::Identity(); }
 
 // Reasons (compared by address).
-constexpr const char* kNoLiveTexture = "no texture in the live frame";
 constexpr const char* kNoTexture = "no texture";
-constexpr const char* kFewValid = "too few valid pixels";
-constexpr const char* kDiverged = "diverged";
 constexpr const char* kMismatch = "images do not match";
 constexpr const char* kBrightness = "brightness changed too much";
 constexpr const char* kWrongSize = "frame size differs from the camera's";
@@ -79,8 +72,7 @@ struct Tracker::Impl {
   CameraModel camera;
   Extrinsics ext;
   TrackerOptions opt;
-  Eigen::Matrix3d K;
-  WarpReduce pass, stats_pass;
+  Aligner aligner;
 
   Pyramid keyframe;
   bool has_keyframe = false;
@@ -95,21 +87,13 @@ struct Tracker::Impl {
   Eigen::Vector3d velocity = Eigen::Vector3d::Zero();  // se(2) per second
   double last_t = 0.0, nominal_dt = 0.0, since_good = 0.0;
   bool has_t = false;
-  std::array<double, kMaxLevels> sigma{};
-  double finest_sigma = 0.0;
-  ReduceSums cur, next, finest_stats;
+  std::array<double, kMaxLevels> sigma{};  // the robust scale per level, from frame to frame
+  std::vector<AlignmentPair> pairs = std::vector<AlignmentPair>(1);
+  AlignmentReport report;
 
   Impl(ocl::Runtime& r, const CameraModel& c, const Extrinsics& e, const TrackerOptions& o)
-      : rt(r), camera(validated(c, e, o)), ext(e), opt(o), K(c.K()),
-        pass(r, 3, kernel_options(o, false)), stats_pass(r, 3, kernel_options(o, true)) {
+      : rt(r), camera(validated(c, e, o)), ext(e), opt(o), aligner(r, c.K(), o, false) {
     reset();
-  }
-
-  static WarpReduceOptions kernel_options(const TrackerOptions& o, bool stats) {
-    WarpReduceOptions k = o.kernel;
-    k.stats = stats;
-    k.debug_output = false;
-    return k;
   }
 
   void reset() {
@@ -123,174 +107,44 @@ struct Tracker::Impl {
     sigma.fill(opt.initial_sigma);
   }
 
-  double huber_k(int level) const { return opt.huber_factor * sigma[static_cast<size_t>(level)]; }
-
-  void evaluate(const Pyramid& live, int level, const Estimate& e, bool stats, ReduceSums* out) {
-    const PyramidLevel& R = keyframe.levels[static_cast<size_t>(level)];
-    const PyramidLevel& L = live.levels[static_cast<size_t>(level)];
-    const MotionHomography mh = motion_homography(level_camera_matrix(K, level), ext, e.T);
-    WarpInputs in;
-    in.H = mh.H;
-    in.nparam = 3;
-    for (size_t i = 0; i < 3; ++i) in.G[i] = mh.G[i];
-    in.gain = std::exp(e.a);
-    in.bias = e.b;
-    in.huber_k = huber_k(level);
-    (stats ? stats_pass : pass).run(R.data, R.width, R.height, L.data, L.width, L.height, in, out);
-  }
-
-  // The damped Gauss-Newton step for the motion (and brightness); false when singular.
-  bool solve(const ReduceSums& s, double lambda, Vector5d* delta) const {
-    const int n = opt.estimate_brightness ? 5 : 3;
-    MatrixJ A = s.JtWJ.topLeftCorner(n, n);
-    VectorJ g = s.JtWr.head(n);
-    const double ridge = 1e-12 * A.diagonal().cwiseAbs().maxCoeff();
-    for (int i = 0; i < n; ++i) A(i, i) = A(i, i) * (1.0 + lambda) + ridge;
-    Eigen::LDLT<MatrixJ> ldlt(A);
-    if (ldlt.info() != Eigen::Success || !(ldlt.vectorD().minCoeff() > 0.0)) return false;
-    const VectorJ d = -ldlt.solve(g);
-    if (!d.allFinite()) return false;
-    delta->setZero();
-    delta->head(n) = d;
-    return true;
-  }
-
-  static Estimate apply(const Estimate& e, const Vector5d& d) {
-    Estimate out;
-    out.T = e.T * SE2::exp(d.head<3>());
-    out.a = e.a + d(3);
-    out.b = e.b + d(4);
-    return out;
-  }
-
-  static double mean_cost(const ReduceSums& s) { return s.valid > 0 ? s.cost / s.valid : HUGE_VAL; }
-
-  // Texture of a pyramid level on its own: mean squared gradient (a pass of the level against
-  // itself), for frames that have no keyframe to compare with.
-  double self_texture(const Pyramid& p, int level) {
-    const PyramidLevel& L = p.levels[static_cast<size_t>(level)];
-    WarpInputs in;
-    in.nparam = 3;
-    for (size_t i = 0; i < 3; ++i) in.G[i].setZero();
-    in.huber_k = 1e30;
-    ReduceSums s;
-    stats_pass.run(L.data, L.width, L.height, L.data, L.width, L.height, in, &s);
-    return s.valid > 0 ? s.gref / s.valid : 0.0;
-  }
-
-  struct LevelRange {
-    int coarsest = 0, finest = 0;
-  };
-
-  LevelRange level_range(const Pyramid& live) const {
-    LevelRange r;
-    int n = std::min({opt.levels, live.num_levels(), keyframe.num_levels(), kMaxLevels});
-    while (n > 1 && (live.levels[static_cast<size_t>(n - 1)].width < kMinLevelSide ||
-                     live.levels[static_cast<size_t>(n - 1)].height < kMinLevelSide))
-      --n;
-    r.coarsest = std::max(0, n - 1);
-    int finest = opt.finest_level;
-    if (finest < 0) {
-      finest = 0;
-      while (finest < r.coarsest && live.levels[static_cast<size_t>(finest + 1)].width >= opt.min_finest_width)
-        ++finest;
-    }
-    r.finest = std::clamp(finest, 0, r.coarsest);
-    return r;
-  }
-
-  // Coarse-to-fine alignment from `init`. Returns false with *reason when the frame cannot be
-  // tracked; fills result's per-level fields.
+  // Coarse-to-fine alignment with the keyframe from `init` (the aligner, one pair). Returns false
+  // with *reason when the frame cannot be tracked; fills result's per-level fields.
   bool align(const Pyramid& live, const Estimate& init, Estimate* out, FrameResult* res,
              const char** reason) {
-    const LevelRange range = level_range(live);
-    Estimate e = init;
-    res->iterations.fill(0);
-    res->level_ms.fill(0.0);
-    res->levels_used = 0;
-    int finest = range.finest;
-    for (int level = range.coarsest; level >= finest; --level) {
-      ++res->levels_used;
-      const auto level_start = std::chrono::steady_clock::now();
-      const PyramidLevel& R = keyframe.levels[static_cast<size_t>(level)];
-      const Eigen::Matrix3d Kl = level_camera_matrix(K, level);
-      evaluate(live, level, e, true, &cur);
-      int& passes = res->iterations[static_cast<size_t>(level)];
-      passes = 1;
-      const double level_pixels = static_cast<double>(R.width) * R.height;
-      if (!(cur.valid >= opt.min_valid_fraction * level_pixels)) {
-        *reason = kFewValid;
-        return false;
+    AlignmentPair& pair = pairs[0];
+    pair.reference = &keyframe;
+    pair.live = &live;
+    pair.motion = init.T;
+    pair.log_gain = init.a;
+    pair.bias = init.b;
+    pair.sigma = sigma;
+    Extrinsics e = ext;
+    AlignmentLevels levels = aligner.levels(keyframe, live);
+    report = aligner.align(pairs, &e, levels);
+    res->iterations = report.passes;
+    res->level_ms = report.level_ms;
+    res->levels_used = report.levels_used;
+    // A frame about to become the keyframe goes on to full resolution.
+    const ReduceSums* s = report.ok ? &report.finest[0] : nullptr;
+    if (s && levels.finest > 0 && opt.refine_keyframes && s->ref > 0 && s->valid / s->ref < opt.keyframe_overlap) {
+      levels.coarsest = levels.finest = 0;
+      const std::array<int, kMaxLevels> passes = report.passes;
+      const std::array<double, kMaxLevels> ms = report.level_ms;
+      report = aligner.align(pairs, &e, levels);
+      for (size_t l = 0; l < passes.size(); ++l) {
+        res->iterations[l] = passes[l] + report.passes[l];
+        res->level_ms[l] = ms[l] + report.level_ms[l];
       }
-      if (!(cur.glive >= opt.min_texture_ratio * cur.gref)) {
-        *reason = kNoLiveTexture;
-        return false;
-      }
-      // The level's robust scale from this pass's residuals. The threshold in use came from the
-      // previous frame; when the scale has moved by more than rescale_ratio (the robot starts
-      // moving after standing still, the exposure jumps, something covers the ground), the
-      // level restarts with the new threshold: one more pass, and the cost stays one function
-      // within the level.
-      const double measured =
-          std::clamp(kMadToSigma * cur.median_abs_residual(), opt.min_sigma, opt.max_sigma);
-      double& used = sigma[static_cast<size_t>(level)];
-      if (!(measured <= used * opt.rescale_ratio && measured >= used / opt.rescale_ratio)) {
-        used = measured;
-        evaluate(live, level, e, true, &cur);
-        ++passes;
-      }
-      if (level <= range.finest) {
-        finest_stats = cur;
-        finest_sigma = measured;
-      }
-
-      double lambda = 0.0;
-      int steps = 0;
-      const int max_steps = std::max(1, opt.max_iterations[static_cast<size_t>(level)]);
-      while (steps < max_steps) {
-        Vector5d d;
-        if (!solve(cur, lambda, &d)) {
-          if (lambda >= 1e8) break;
-          lambda = lambda == 0.0 ? opt.lambda_min : lambda * opt.lambda_up;
-          continue;
-        }
-        ++steps;
-        const Estimate cand = apply(e, d);
-        const double step_px = max_pixel_displacement(Kl, ext, e.T, cand.T, R.width, R.height);
-        if (!(step_px < 1e6)) {
-          lambda = lambda == 0.0 ? opt.lambda_min : lambda * opt.lambda_up;
-          continue;
-        }
-        // A step below the convergence threshold, or a small last one, is applied without
-        // the pass that would check it.
-        if (step_px < opt.convergence_px || (steps == max_steps && step_px < 0.5)) {
-          e = cand;
-          break;
-        }
-        evaluate(live, level, cand, false, &next);
-        ++passes;
-        if (next.valid >= opt.min_valid_fraction * level_pixels &&
-            mean_cost(next) <= mean_cost(cur)) {
-          e = cand;
-          std::swap(cur, next);
-          lambda = lambda / opt.lambda_down < opt.lambda_min ? 0.0 : lambda / opt.lambda_down;
-        } else {
-          lambda = lambda == 0.0 ? opt.lambda_min : lambda * opt.lambda_up;
-        }
-      }
-      used = measured;
-      res->level_ms[static_cast<size_t>(level)] =
-          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - level_start).count();
-      if (!finite(e.T) || !std::isfinite(e.a) || !std::isfinite(e.b)) {
-        *reason = kDiverged;
-        return false;
-      }
-      // A frame about to become the keyframe goes on to full resolution.
-      if (level == finest && finest > 0 && opt.refine_keyframes && cur.ref > 0 &&
-          cur.valid / cur.ref < opt.keyframe_overlap)
-        finest = 0;
+      res->levels_used += report.levels_used;
     }
-    *out = e;
+    sigma = pair.sigma;
+    if (!report.ok) {
+      *reason = report.reason;
+      return false;
+    }
+    out->T = pair.motion;
+    out->a = pair.log_gain;
+    out->b = pair.bias;
     return true;
   }
 
@@ -305,8 +159,8 @@ struct Tracker::Impl {
 
   // Fills covariance, cost, inliers, overlap and the status from the finest level's sums.
   void finish(FrameResult* res, const Estimate& e) {
-    const ReduceSums& s = cur;
-    res->final_cost = mean_cost(s);
+    const ReduceSums& s = report.finest[0];
+    res->final_cost = s.valid > 0 ? s.cost / s.valid : HUGE_VAL;
     res->inlier_fraction = s.valid > 0 ? s.inlier / s.valid : 0.0;
     res->overlap = s.ref > 0 ? s.valid / s.ref : 0.0;
     res->log_gain = e.a;
@@ -315,7 +169,7 @@ struct Tracker::Impl {
     const double dof = std::max(1.0, s.valid - n);
     // Floored at min_sigma: noise-free synthetic images would otherwise claim zero variance.
     const double s2 = std::max(s.wrr / dof, opt.min_sigma * opt.min_sigma);
-    res->sigma = finest_sigma;
+    res->sigma = report.finest_sigma[0];
     MatrixJ A = s.JtWJ.topLeftCorner(n, n);
     Eigen::LDLT<MatrixJ> ldlt(A);
     MatrixJ I = MatrixJ::Identity(n, n);
@@ -323,7 +177,7 @@ struct Tracker::Impl {
     res->covariance = s2 * inv.topLeftCorner(3, 3);
     if (!res->covariance.allFinite()) res->covariance = lost_covariance();
 
-    const ReduceSums& st = finest_stats;
+    const ReduceSums& st = report.finest_stats[0];
     const double var_ref = st.valid > 0 ? st.iref2 / st.valid - std::pow(st.iref / st.valid, 2) : 0.0;
     const double ratio = st.valid > 0 && var_ref > 0 ? (st.rr / st.valid) / var_ref : HUGE_VAL;
     if (!(ratio <= opt.lost_residual_ratio)) {
@@ -459,7 +313,7 @@ struct Tracker::Impl {
       while (coarse > 0 && (live.levels[static_cast<size_t>(coarse)].width < kMinLevelSide ||
                             live.levels[static_cast<size_t>(coarse)].height < kMinLevelSide))
         --coarse;
-      const double texture = self_texture(live, coarse);
+      const double texture = aligner.texture(live, coarse);
       if (!(texture >= kMinSelfTexture)) {
         res.status = Status::Lost;
         res.reason = kNoTexture;
@@ -480,7 +334,7 @@ struct Tracker::Impl {
     const char* reason = "";
     bool ok = align(live, init, &est, &res, &reason);
     if (ok) finish(&res, est);
-    if ((!ok || res.status == Status::Lost) && reason != kNoLiveTexture &&
+    if ((!ok || res.status == Status::Lost) && reason != kAlignNoLiveTexture &&
         !(predicted.x == 0 && predicted.y == 0 && predicted.theta == 0)) {
       FrameResult retry = res;
       const char* reason2 = "";
@@ -498,7 +352,7 @@ struct Tracker::Impl {
         }
       }
     }
-    if (!ok) return lost(reason, reason != kNoLiveTexture);
+    if (!ok) return lost(reason, reason != kAlignNoLiveTexture);
     if (res.status == Status::Lost) return lost(res.reason, true);
     if (time_problem && res.status == Status::Ok) {
       res.status = Status::Degraded;

@@ -14,6 +14,7 @@
 #include "core/se2.h"
 #include "image/camera.h"
 #include "image/pyramid.h"
+#include "track/aligner.h"
 #include "track/warp_reduce.h"
 
 namespace planarvo::ocl {
@@ -22,49 +23,20 @@ class Runtime;
 
 namespace planarvo::track {
 
-inline constexpr int kMaxLevels = 8;
-
-struct TrackerOptions {
-  // Pyramid levels used, coarsest first: levels - 1 down to finest_level. Levels smaller than
-  // 8x8 pixels are skipped.
-  int levels = 4;
-  // The finest level tracked: 0 is full resolution; 1 stops at half resolution, a third of
-  // the time for 5-8 instead of 2-3 micrometres RMS per frame at 640x480 on the simulator
-  // (README.md). -1 (the default): the coarsest level at least min_finest_width pixels wide
-  // (level 1 at 640x480, level 0 at 320x240).
-  int finest_level = -1;
-  int min_finest_width = 320;
+// The alignment's options (levels, iterations, robust scale, damping, kernel) are the aligner's
+// (aligner.h); the tracker adds keyframes and the judgement of each frame.
+struct TrackerOptions : AlignerOptions {
   // With finest_level > 0: a frame that is to become the keyframe is refined down to level 0,
   // so that the chain of keyframes (what the pose drifts by) has full-resolution accuracy.
   bool refine_keyframes = false;
-  // Gauss-Newton steps per level, index = level (each step costs one fused pass at that level
-  // except the last, which is applied without checking when it is below convergence_px).
-  std::array<int, kMaxLevels> max_iterations = {2, 6, 10, 12, 12, 12, 12, 12};
-  // Convergence: a step that moves no pixel of the level (its corners and centre) by more than
-  // this many pixels of that level ends the level.
-  double convergence_px = 0.05;
-  // Huber threshold k = huber_factor * sigma, sigma = 1.4826 * median |r| per level (clamped
-  // to [min_sigma, max_sigma]), measured at the level's first pass. That pass is weighted
-  // with the previous frame's sigma (initial_sigma at first); when the new one differs by
-  // more than a factor rescale_ratio the level restarts with it (one more pass), so that the
-  // cost is one function within a level.
-  double huber_factor = 2.0;
-  double initial_sigma = 8.0, min_sigma = 0.5, max_sigma = 40.0;  // grey levels
-  double rescale_ratio = 1.25;
-  // Estimate the affine brightness change (r = e^a I_l + b - I_r) jointly with the motion.
-  bool estimate_brightness = true;
-  // Levenberg damping: H + lambda diag(H); lambda starts at 0 (Gauss-Newton) and grows by
-  // lambda_up (from lambda_min) when a step increases the cost, shrinks by lambda_down after
-  // an accepted step.
-  double lambda_min = 1e-4, lambda_up = 10.0, lambda_down = 10.0;
   // Keyframes: the live frame becomes the keyframe when the fraction of valid keyframe pixels
   // that land inside the live image, on valid pixels, falls below keyframe_overlap.
   double keyframe_overlap = 0.7;
   // Bad input. A frame interval longer than max_gap_factor times the usual interval is a gap
   // (status at best Degraded); longer than max_gap_seconds, the constant-velocity prediction is
   // not used (zero motion is). Live texture below min_texture_ratio of the keyframe's (mean
-  // squared gradient over the overlap) is Lost. Too few valid pixels (min_valid_fraction of
-  // the level's pixels) is Lost. The residual's mean square relative to the keyframe's
+  // squared gradient over the overlap) is Lost, and so are too few valid pixels
+  // (min_valid_fraction of the level's pixels; both AlignerOptions). The residual's mean square relative to the keyframe's
   // intensity variance over the overlap (about 1 for unrelated images after the brightness
   // fit; 0.02-0.1 on the simulator at 640x480, up to 0.26 at 320x240 where pixel noise
   // dominates): above lost_residual_ratio Lost, above degraded_residual_ratio Degraded.
@@ -76,8 +48,6 @@ struct TrackerOptions {
   // 1.9-3.5), or the heading's exceeds max_heading_std (typical: 2-10 um, 1e-5 rad).
   double max_gap_factor = 2.5;
   double max_gap_seconds = 0.5;
-  double min_texture_ratio = 0.1;
-  double min_valid_fraction = 0.05;
   double lost_residual_ratio = 0.75;
   double degraded_residual_ratio = 0.5;
   double min_inlier_fraction = 0.6;
@@ -85,8 +55,6 @@ struct TrackerOptions {
   double max_position_std = 1e-4;  // metres
   double max_std_ratio = 10.0;
   double max_heading_std = 1e-3;   // radians
-  // The fused pass's work-group shape etc. (stats and debug_output are set by the tracker).
-  WarpReduceOptions kernel = default_kernel_options();
 
   static WarpReduceOptions default_kernel_options();
 };

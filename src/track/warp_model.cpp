@@ -16,10 +16,17 @@ Eigen::Matrix3d plane_map(const Eigen::Matrix4d& T, const Eigen::Vector3d& n, do
   return T.topLeftCorner<3, 3>() - T.topRightCorner<3, 1>() * n.transpose() / z;
 }
 
+// [v]_x, the cross-product matrix.
+Eigen::Matrix3d skew(const Eigen::Vector3d& v) {
+  Eigen::Matrix3d m;
+  m << 0, -v.z(), v.y(), v.z(), 0, -v.x(), -v.y(), v.x(), 0;
+  return m;
+}
+
 }  // namespace
 
 MotionHomography motion_homography(const Eigen::Matrix3d& K, const Extrinsics& e,
-                                   const SE2& motion) {
+                                   const SE2& motion, bool with_orientation) {
   const Eigen::Matrix4d T_vc = e.T_vc();
   Eigen::Matrix4d T_cv = Eigen::Matrix4d::Identity();
   T_cv.topLeftCorner<3, 3>() = T_vc.topLeftCorner<3, 3>().transpose();
@@ -49,13 +56,47 @@ MotionHomography motion_homography(const Eigen::Matrix3d& K, const Extrinsics& e
     out.dH[static_cast<size_t>(i)] = dHu / s - Hu * dHu(2, 2) / (s * s);
     out.G[static_cast<size_t>(i)] = Hinv * out.dH[static_cast<size_t>(i)];
   }
+  if (!with_orientation) return out;
+  // Eqs. 21-24 (header comment): the tilt about the robot's x and y axes through the camera centre.
+  out.nparam = kMotionParams + kOrientationParams;
+  const Eigen::Matrix4d T_inv = motion.inverse().matrix3d();
+  const Eigen::Matrix4d M = T_cv * right;
+  const Eigen::Vector3d t = e.t_vc();
+  const Eigen::Matrix3d R_cv = T_cv.topLeftCorner<3, 3>();
+  for (int i = 0; i < kOrientationParams; ++i) {
+    const Eigen::Matrix3d Gi = skew(Eigen::Vector3d::Unit(i));
+    Eigen::Matrix4d A = Eigen::Matrix4d::Zero();
+    A.topLeftCorner<3, 3>() = Gi;
+    A.topRightCorner<3, 1>() = -Gi * t;
+    const Eigen::Matrix4d dM = T_cv * (T_inv * A - A * T_inv) * T_vc;
+    const Eigen::Vector3d dn = -R_cv * Gi * Eigen::Vector3d::UnitZ();
+    const Eigen::Matrix3d dP = plane_map(dM, n, e.z) - M.topRightCorner<3, 1>() * dn.transpose() / e.z;
+    const Eigen::Matrix3d dHu = K * dP * Kinv;
+    const auto k = static_cast<size_t>(kMotionParams + i);
+    out.dH[k] = dHu / s - Hu * dHu(2, 2) / (s * s);
+    out.G[k] = Hinv * out.dH[k];
+  }
   return out;
+}
+
+Extrinsics rotate_orientation(const Extrinsics& e, const Eigen::Vector2d& y) {
+  Eigen::Matrix4d T = e.T_vc();
+  const Eigen::Vector3d w(y.x(), y.y(), 0.0);
+  const double angle = w.norm();
+  if (angle > 0.0)
+    T.topLeftCorner<3, 3>() = Eigen::AngleAxisd(angle, w / angle).toRotationMatrix() * T.topLeftCorner<3, 3>();
+  return Extrinsics::from_matrix(T);
 }
 
 double max_pixel_displacement(const Eigen::Matrix3d& K, const Extrinsics& e, const SE2& a,
                               const SE2& b, int width, int height) {
-  const Eigen::Matrix3d Ha = ground_homography(K, e, a.matrix3d());
-  const Eigen::Matrix3d Hb = ground_homography(K, e, b.matrix3d());
+  return max_pixel_displacement(K, e, a, e, b, width, height);
+}
+
+double max_pixel_displacement(const Eigen::Matrix3d& K, const Extrinsics& ea, const SE2& a,
+                              const Extrinsics& eb, const SE2& b, int width, int height) {
+  const Eigen::Matrix3d Ha = ground_homography(K, ea, a.matrix3d());
+  const Eigen::Matrix3d Hb = ground_homography(K, eb, b.matrix3d());
   const double w = width - 1.0, h = height - 1.0;
   const double pts[5][2] = {{0, 0}, {w, 0}, {0, h}, {w, h}, {0.5 * w, 0.5 * h}};
   double worst = 0.0;

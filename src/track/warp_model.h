@@ -20,8 +20,22 @@
 // needs (its Jacobian uses the reference image's gradient at the reference pixel), and the
 // reference-side generators
 //     G_i = Ĥ^-1 dH_i       (∂π(G(x) p)/∂x_i = ∂π/∂h|_p G_i p, the motion field in reference pixels)
-// are what the fused kernel takes (warp_reduce.h). Any other parameter of the homography (the
-// camera's roll and pitch, section 5.1) enters the kernel the same way, as Ĥ^-1 ∂H/∂y_i.
+// are what the fused kernel takes (warp_reduce.h). Any other parameter of the homography enters
+// the kernel the same way, as Ĥ^-1 ∂H/∂y_i: the camera's orientation to the ground (section 5.1,
+// below).
+//
+// Orientation (section 5.1, eqs. 19-24, in conventions.md's frames). The camera's tilt is updated
+// by a rotation about the camera centre through the robot's x and y axes,
+//     R_vc <- exp([y1, y2, 0]_x) R_vc,          t_vc unchanged                         (eq. 20)
+// (the paper's R̂_cv <- R̂_cv R(ŷ) is the same update written for R_cv = R_vc^T, with R(y) acting
+// on the other side). A rotation about the robot's z axis would be yaw, which planar motions
+// absorb, so two generators G_x = [e_x]_x, G_y = [e_y]_x span exactly the tilts of the camera
+// (the tangent space of the ground normal n_c). With A_i = [[G_i, -G_i t_vc], [0, 0]] the
+// derivative of T_vc(y) = exp(y_i A_i) T_vc, the camera motion M = T_cv T̂^-1 T_vc has
+//     dM/dy_i = T_cv (T̂^-1 A_i - A_i T̂^-1) T_vc                                  (eqs. 22-24)
+// (eq. 24's G M T N - M T N G, with the paper's M and N absorbed into the 4x4 transforms), and
+// the plane normal n_c = R_vc^T e_z moves by dn_c/dy_i = -R_vc^T G_i e_z, so
+//     dH/dy_i ~ K (top3(dM_i) P + top3(M) [0; -dn_c^T / z]) K^-1.
 #pragma once
 #include <array>
 
@@ -32,21 +46,34 @@
 
 namespace planarvo::track {
 
+inline constexpr int kMotionParams = 3;       // x, y, theta of the planar motion
+inline constexpr int kOrientationParams = 2;  // the camera's tilt (section 5.1)
+
 struct MotionHomography {
-  Eigen::Matrix3d H;                 // reference -> live pixels, H(2,2) = 1
-  std::array<Eigen::Matrix3d, 3> dH;  // ∂H/∂x_i at x = 0
-  std::array<Eigen::Matrix3d, 3> G;   // Ĥ^-1 dH_i: reference-side generators
+  Eigen::Matrix3d H;  // reference -> live pixels, H(2,2) = 1
+  int nparam = kMotionParams;  // 3, or 5 with the orientation (motion first)
+  std::array<Eigen::Matrix3d, kMotionParams + kOrientationParams> dH;  // ∂H/∂x_i, then ∂H/∂y_i at 0
+  std::array<Eigen::Matrix3d, kMotionParams + kOrientationParams> G;   // Ĥ^-1 dH_i: reference side
 };
 
 // H, dH and G for the motion estimate T̂ (live pose in the reference robot frame), for the
-// camera matrix K of the pyramid level in use. In double, analytic.
+// camera matrix K of the pyramid level in use; with_orientation adds the two tilt parameters
+// (eqs. 21-24). In double, analytic.
 MotionHomography motion_homography(const Eigen::Matrix3d& K, const Extrinsics& extrinsics,
-                                   const SE2& motion);
+                                   const SE2& motion, bool with_orientation = false);
+
+// The orientation update of eq. 20: R_vc <- exp([y1, y2, 0]_x) R_vc about the camera centre,
+// returned as extrinsics (roll, pitch and yaw re-read from the rotation; yaw moves only at second
+// order). Translation unchanged.
+Extrinsics rotate_orientation(const Extrinsics& extrinsics, const Eigen::Vector2d& y);
 
 // The largest displacement, in pixels of the image the camera matrix K belongs to, of the
 // corners and the centre of a width x height image between the homographies of motion a and
 // motion b (both live poses in the reference robot frame) : the tracker's step size measure.
 double max_pixel_displacement(const Eigen::Matrix3d& K, const Extrinsics& extrinsics,
                               const SE2& a, const SE2& b, int width, int height);
+// The same between the homographies of (extrinsics a, motion a) and (extrinsics b, motion b).
+double max_pixel_displacement(const Eigen::Matrix3d& K, const Extrinsics& ea, const SE2& a,
+                              const Extrinsics& eb, const SE2& b, int width, int height);
 
 }  // namespace planarvo::track

@@ -2,6 +2,7 @@
 // analytic derivatives of the homography against central differences of ground_homography,
 // the reference-side generators against the composition of planar motions, and the homography
 // of a motion against projecting ground points with the camera.
+#include <algorithm>
 #include <cmath>
 #include <random>
 
@@ -56,6 +57,55 @@ TEST(TrackWarpModel, DerivativesMatchCentralDifferences) {
       EXPECT_LT((mh.H * mh.G[static_cast<size_t>(i)] - analytic).norm(), 1e-9 * (1.0 + analytic.norm()));
     }
   }
+}
+
+TEST(TrackWarpModel, OrientationDerivativesMatchCentralDifferences) {
+  // Section 5.1's tilt parameters (eqs. 21-24) against central differences of ground_homography
+  // with the orientation update of eq. 20; the motion's derivatives are unchanged by them.
+  std::mt19937 rng(12);
+  std::uniform_real_distribution<double> u(-1, 1);
+  for (int trial = 0; trial < 50; ++trial) {
+    Extrinsics e{0.3 * u(rng), 0.1 * u(rng), 0.15 + 0.3 * (u(rng) + 1), 30 * kDeg * u(rng),
+                 30 * kDeg * u(rng), M_PI * u(rng)};
+    if (trial % 2 == 0) e = Extrinsics{0, 0, 1, e.roll, e.pitch, 0};  // the estimator's own frame
+    const Eigen::Matrix3d K = camera_matrix(200 + 300 * (u(rng) + 1), 320 + 10 * u(rng), 240 + 10 * u(rng));
+    const SE2 m(0.05 * u(rng), 0.05 * u(rng), 0.3 * u(rng));
+    const MotionHomography plain = motion_homography(K, e, m);
+    const MotionHomography mh = motion_homography(K, e, m, true);
+    ASSERT_EQ(mh.nparam, 5);
+    EXPECT_LT((mh.H - plain.H).norm(), 1e-12);
+    for (size_t i = 0; i < 3; ++i) EXPECT_LT((mh.dH[i] - plain.dH[i]).norm(), 1e-12);
+    for (int i = 0; i < 2; ++i) {
+      const double h = 1e-6;
+      Eigen::Vector2d dy = Eigen::Vector2d::Zero();
+      dy(i) = h;
+      const Eigen::Matrix3d Hp = ground_homography(K, rotate_orientation(e, dy), m.matrix3d());
+      const Eigen::Matrix3d Hm = ground_homography(K, rotate_orientation(e, -dy), m.matrix3d());
+      const Eigen::Matrix3d numeric = (Hp - Hm) / (2 * h);
+      const Eigen::Matrix3d& analytic = mh.dH[static_cast<size_t>(3 + i)];
+      EXPECT_LT((numeric - analytic).norm(), 1e-6 * (1.0 + analytic.norm()))
+          << "tilt " << i << "\nnumeric\n" << numeric << "\nanalytic\n" << analytic;
+      EXPECT_LT((mh.H * mh.G[static_cast<size_t>(3 + i)] - analytic).norm(), 1e-9 * (1.0 + analytic.norm()));
+    }
+  }
+}
+
+TEST(TrackWarpModel, OrientationUpdateTiltsTheGroundNormal) {
+  // exp([y1, y2, 0]_x) R_vc: the camera centre stays, the ground normal in camera coordinates
+  // turns by |y| (about an axis perpendicular to it), and a pure tilt about the robot's x axis of
+  // a camera with zero yaw is a change of roll.
+  const Extrinsics e = config1();
+  const Eigen::Vector2d y(0.03, -0.02);
+  const Extrinsics r = rotate_orientation(e, y);
+  EXPECT_DOUBLE_EQ(r.x, e.x);
+  EXPECT_DOUBLE_EQ(r.z, e.z);
+  const double angle = std::acos(std::clamp(r.plane_normal_camera().dot(e.plane_normal_camera()), -1.0, 1.0));
+  EXPECT_NEAR(angle, y.norm(), 1e-12);
+  const Extrinsics level{0, 0, 1, 0.1, 0.0, 0.0};
+  const Extrinsics rolled = rotate_orientation(level, Eigen::Vector2d(0.05, 0.0));
+  EXPECT_NEAR(rolled.roll, 0.15, 1e-12);
+  EXPECT_NEAR(rolled.pitch, 0.0, 1e-12);
+  EXPECT_NEAR(rolled.yaw, 0.0, 1e-12);
 }
 
 TEST(TrackWarpModel, IncrementActsOnTheReferenceSideInExponentialCoordinates) {

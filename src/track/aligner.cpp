@@ -1,0 +1,319 @@
+#include "track/aligner.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+#include <Eigen/Cholesky>
+
+#include "ocl/runtime.h"
+#include "track/warp_model.h"
+
+namespace planarvo::track {
+
+const char* const kAlignFewValid = "too few valid pixels";
+const char* const kAlignNoLiveTexture = "no texture in the live frame";
+const char* const kAlignDiverged = "diverged";
+
+namespace {
+
+constexpr int kMinLevelSide = 8;
+constexpr double kMadToSigma = 1.4826;
+
+using Vector5d = Aligner::Vector5d;
+using Matrix52d = Aligner::Matrix52d;
+// At most 5x5, on the stack.
+using MatrixL = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 5, 5>;
+using MatrixL2 = Eigen::Matrix<double, Eigen::Dynamic, 2, 0, 5, 2>;
+using VectorL = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 5, 1>;
+
+WarpReduceOptions kernel_options(const AlignerOptions& o, bool stats) {
+  WarpReduceOptions k = o.kernel;
+  k.stats = stats;
+  k.debug_output = false;
+  return k;
+}
+
+bool finite(const SE2& m) { return std::isfinite(m.x) && std::isfinite(m.y) && std::isfinite(m.theta); }
+
+double mean_cost(const std::vector<ReduceSums>& sums) {
+  double cost = 0.0, valid = 0.0;
+  for (const ReduceSums& s : sums) {
+    cost += s.cost;
+    valid += s.valid;
+  }
+  return valid > 0 ? cost / valid : HUGE_VAL;
+}
+
+// One pair's block of the normal equations in the order (motion, brightness | orientation):
+// where each parameter sits in the pass's sums (motion 0-2, orientation 3-4 when NPARAM is 5,
+// then brightness).
+struct PairBlock {
+  Eigen::Matrix<double, 5, 5> A_ll = Eigen::Matrix<double, 5, 5>::Zero();
+  Matrix52d A_ls = Matrix52d::Zero();
+  Eigen::Matrix2d A_ss = Eigen::Matrix2d::Zero();
+  Vector5d g_l = Vector5d::Zero();
+  Eigen::Vector2d g_s = Eigen::Vector2d::Zero();
+};
+
+PairBlock pair_block(const ReduceSums& s, int nl, bool orientation) {
+  const int np = orientation ? kMotionParams + kOrientationParams : kMotionParams;
+  int local[5] = {0, 1, 2, np, np + 1};
+  const int shared[2] = {kMotionParams, kMotionParams + 1};
+  PairBlock b;
+  for (int i = 0; i < nl; ++i) {
+    b.g_l(i) = s.JtWr(local[i]);
+    for (int j = 0; j < nl; ++j) b.A_ll(i, j) = s.JtWJ(local[i], local[j]);
+    if (orientation)
+      for (int j = 0; j < 2; ++j) b.A_ls(i, j) = s.JtWJ(local[i], shared[j]);
+  }
+  if (orientation)
+    for (int i = 0; i < 2; ++i) {
+      b.g_s(i) = s.JtWr(shared[i]);
+      for (int j = 0; j < 2; ++j) b.A_ss(i, j) = s.JtWJ(shared[i], shared[j]);
+    }
+  return b;
+}
+
+// Levenberg's damping H_ii (1 + lambda) plus a ridge of 1e-12 of the largest diagonal entry, so
+// that a parameter the images do not constrain at all gives a finite step.
+template <typename M>
+void damp(M* A, int n, double lambda) {
+  double largest = 0.0;
+  for (int i = 0; i < n; ++i) largest = std::max(largest, std::abs((*A)(i, i)));
+  for (int i = 0; i < n; ++i) (*A)(i, i) = (*A)(i, i) * (1.0 + lambda) + 1e-12 * largest;
+}
+
+}  // namespace
+
+Aligner::Aligner(ocl::Runtime& runtime, const Eigen::Matrix3d& K, const AlignerOptions& options,
+                 bool with_orientation)
+    : runtime_(runtime), K_(K), options_(options), with_orientation_(with_orientation),
+      pass_(runtime, with_orientation ? kMotionParams + kOrientationParams : kMotionParams,
+            kernel_options(options, false)),
+      stats_pass_(runtime, with_orientation ? kMotionParams + kOrientationParams : kMotionParams,
+                  kernel_options(options, true)) {}
+
+AlignmentLevels Aligner::levels(const Pyramid& reference, const Pyramid& live) const {
+  AlignmentLevels r;
+  int n = std::min({options_.levels, live.num_levels(), reference.num_levels(), kMaxLevels});
+  while (n > 1 && (live.levels[static_cast<size_t>(n - 1)].width < kMinLevelSide ||
+                   live.levels[static_cast<size_t>(n - 1)].height < kMinLevelSide))
+    --n;
+  r.coarsest = std::max(0, n - 1);
+  int finest = options_.finest_level;
+  if (finest < 0) {
+    finest = 0;
+    while (finest < r.coarsest &&
+           live.levels[static_cast<size_t>(finest + 1)].width >= options_.min_finest_width)
+      ++finest;
+  }
+  r.finest = std::clamp(finest, 0, r.coarsest);
+  return r;
+}
+
+double Aligner::texture(const Pyramid& pyramid, int level) {
+  const PyramidLevel& L = pyramid.levels[static_cast<size_t>(level)];
+  WarpInputs in;
+  in.nparam = with_orientation_ ? kMotionParams + kOrientationParams : kMotionParams;
+  for (Eigen::Matrix3d& G : in.G) G.setZero();
+  in.huber_k = 1e30;
+  ReduceSums s;
+  stats_pass_.run(L.data, L.width, L.height, L.data, L.width, L.height, in, &s);
+  return s.valid > 0 ? s.gref / s.valid : 0.0;
+}
+
+void Aligner::evaluate(const AlignmentPair& pair, const Extrinsics& e, int level, bool stats,
+                       ReduceSums* out) {
+  const PyramidLevel& R = pair.reference->levels[static_cast<size_t>(level)];
+  const PyramidLevel& L = pair.live->levels[static_cast<size_t>(level)];
+  const MotionHomography mh = motion_homography(level_camera_matrix(K_, level), e, pair.motion, with_orientation_);
+  WarpInputs in;
+  in.H = mh.H;
+  in.nparam = mh.nparam;
+  for (size_t i = 0; i < static_cast<size_t>(mh.nparam); ++i) in.G[i] = mh.G[i];
+  in.gain = std::exp(pair.log_gain);
+  in.bias = pair.bias;
+  in.huber_k = options_.huber_factor * pair.sigma[static_cast<size_t>(level)];
+  (stats ? stats_pass_ : pass_).run(R.data, R.width, R.height, L.data, L.width, L.height, in, out);
+}
+
+// The damped Gauss-Newton step of the whole system: each pair's own block eliminated onto the
+// shared orientation (Schur complement), or on its own when nothing is shared. False when a
+// block is not positive definite at this damping.
+bool Aligner::solve(const std::vector<ReduceSums>& sums, double lambda, Step* step) const {
+  const int nl = local_size();
+  step->local.resize(sums.size());
+  step->X.resize(sums.size());
+  step->x.resize(sums.size());
+  step->orientation.setZero();
+  Eigen::Matrix2d S = Eigen::Matrix2d::Zero();
+  Eigen::Vector2d r = Eigen::Vector2d::Zero();
+  std::vector<Matrix52d>& X = step->X;
+  std::vector<Vector5d>& x = step->x;
+  for (size_t p = 0; p < sums.size(); ++p) {
+    PairBlock b = pair_block(sums[p], nl, with_orientation_);
+    damp(&b.A_ll, nl, lambda);
+    const Eigen::LDLT<MatrixL> ldlt(MatrixL(b.A_ll.topLeftCorner(nl, nl)));
+    if (ldlt.info() != Eigen::Success || !(ldlt.vectorD().minCoeff() > 0.0)) return false;
+    x[p].setZero();
+    x[p].head(nl) = ldlt.solve(VectorL(b.g_l.head(nl)));
+    if (!with_orientation_) {
+      step->local[p] = -x[p];
+      if (!step->local[p].allFinite()) return false;
+      continue;
+    }
+    X[p].setZero();
+    X[p].topRows(nl) = ldlt.solve(MatrixL2(b.A_ls.topRows(nl)));
+    damp(&b.A_ss, 2, lambda);
+    S += b.A_ss - b.A_ls.topRows(nl).transpose() * X[p].topRows(nl);
+    r += b.g_s - b.A_ls.topRows(nl).transpose() * x[p].head(nl);
+  }
+  if (!with_orientation_) return true;
+  const Eigen::LDLT<Eigen::Matrix2d> ldlt(S);
+  if (ldlt.info() != Eigen::Success || !(ldlt.vectorD().minCoeff() > 0.0)) return false;
+  step->orientation = -ldlt.solve(r);
+  if (!step->orientation.allFinite()) return false;
+  for (size_t p = 0; p < sums.size(); ++p) {
+    step->local[p] = -(x[p] + X[p] * step->orientation);
+    if (!step->local[p].allFinite()) return false;
+  }
+  return true;
+}
+
+Eigen::Matrix2d Aligner::orientation_information(const std::vector<ReduceSums>& sums) const {
+  const int nl = local_size();
+  Eigen::Matrix2d S = Eigen::Matrix2d::Zero();
+  for (const ReduceSums& s : sums) {
+    const PairBlock b = pair_block(s, nl, true);
+    const Eigen::LDLT<MatrixL> ldlt(MatrixL(b.A_ll.topLeftCorner(nl, nl)));
+    const MatrixL2 X = ldlt.solve(MatrixL2(b.A_ls.topRows(nl)));
+    S += b.A_ss - b.A_ls.topRows(nl).transpose() * X;
+  }
+  return S;
+}
+
+AlignmentReport Aligner::align(std::vector<AlignmentPair>& pairs, Extrinsics* extrinsics,
+                               const AlignmentLevels& levels) {
+  AlignmentReport report;
+  const size_t P = pairs.size();
+  cur_.resize(P);
+  next_.resize(P);
+  report.finest_sigma.assign(P, 0.0);
+  std::vector<double>& measured = measured_;
+  measured.assign(P, 0.0);
+  Extrinsics ext = *extrinsics;
+  auto fail = [&](const char* why, size_t p) {
+    report.ok = false;
+    report.reason = why;
+    report.failed_pair = static_cast<int>(p);
+    *extrinsics = ext;
+    return report;
+  };
+  for (AlignmentPair& pair : pairs)
+    for (double& s : pair.sigma)
+      if (!(s > 0.0)) s = options_.initial_sigma;
+
+  for (int level = levels.coarsest; level >= levels.finest; --level) {
+    ++report.levels_used;
+    const auto level_start = std::chrono::steady_clock::now();
+    const auto L = static_cast<size_t>(level);
+    const Eigen::Matrix3d Kl = level_camera_matrix(K_, level);
+    int& passes = report.passes[L];
+    for (size_t p = 0; p < P; ++p) {
+      AlignmentPair& pair = pairs[p];
+      const PyramidLevel& R = pair.reference->levels[L];
+      evaluate(pair, ext, level, true, &cur_[p]);
+      ++passes;
+      if (!(cur_[p].valid >= options_.min_valid_fraction * R.width * R.height)) return fail(kAlignFewValid, p);
+      if (!(cur_[p].glive >= options_.min_texture_ratio * cur_[p].gref)) return fail(kAlignNoLiveTexture, p);
+      // The level's robust scale from this pass's residuals. The threshold in use came with the
+      // pair (a tracker's previous frame); when the scale has moved by more than rescale_ratio
+      // (the robot starts moving after standing still, the exposure jumps, something covers the
+      // ground), the level restarts with the new threshold: one more pass, and the cost stays
+      // one function within the level.
+      measured[p] = std::clamp(kMadToSigma * cur_[p].median_abs_residual(), options_.min_sigma, options_.max_sigma);
+      double& used = pair.sigma[L];
+      if (!(measured[p] <= used * options_.rescale_ratio && measured[p] >= used / options_.rescale_ratio)) {
+        used = measured[p];
+        evaluate(pair, ext, level, true, &cur_[p]);
+        ++passes;
+      }
+    }
+    if (level == levels.finest) {
+      report.finest_stats = cur_;
+      report.finest_sigma = measured;
+    }
+
+    double lambda = 0.0;
+    int steps = 0;
+    const int max_steps = std::max(1, options_.max_iterations[L]);
+    Step& step = step_;
+    std::vector<AlignmentPair>& cand = cand_;
+    cand = pairs;
+    while (steps < max_steps) {
+      if (!solve(cur_, lambda, &step)) {
+        if (lambda >= 1e8) break;
+        lambda = lambda == 0.0 ? options_.lambda_min : lambda * options_.lambda_up;
+        continue;
+      }
+      ++steps;
+      const Extrinsics cand_ext = with_orientation_ ? rotate_orientation(ext, step.orientation) : ext;
+      double step_px = 0.0;
+      for (size_t p = 0; p < P; ++p) {
+        const Vector5d& d = step.local[p];
+        cand[p] = pairs[p];
+        cand[p].motion = pairs[p].motion * SE2::exp(d.head<3>());
+        cand[p].log_gain = pairs[p].log_gain + d(3);
+        cand[p].bias = pairs[p].bias + d(4);
+        const PyramidLevel& R = pairs[p].reference->levels[L];
+        step_px = std::max(step_px, max_pixel_displacement(Kl, ext, pairs[p].motion, cand_ext, cand[p].motion,
+                                                           R.width, R.height));
+      }
+      if (!(step_px < 1e6)) {
+        lambda = lambda == 0.0 ? options_.lambda_min : lambda * options_.lambda_up;
+        continue;
+      }
+      // A step below the convergence threshold, or a small last one, is applied without the
+      // passes that would check it.
+      if (step_px < options_.convergence_px || (steps == max_steps && step_px < 0.5)) {
+        pairs.swap(cand);
+        ext = cand_ext;
+        break;
+      }
+      bool valid = true;
+      for (size_t p = 0; p < P; ++p) {
+        evaluate(cand[p], cand_ext, level, false, &next_[p]);
+        ++passes;
+        const PyramidLevel& R = pairs[p].reference->levels[L];
+        valid = valid && next_[p].valid >= options_.min_valid_fraction * R.width * R.height;
+      }
+      if (valid && mean_cost(next_) <= mean_cost(cur_)) {
+        pairs.swap(cand);
+        ext = cand_ext;
+        cur_.swap(next_);
+        lambda = lambda / options_.lambda_down < options_.lambda_min ? 0.0 : lambda / options_.lambda_down;
+      } else {
+        lambda = lambda == 0.0 ? options_.lambda_min : lambda * options_.lambda_up;
+      }
+    }
+    for (size_t p = 0; p < P; ++p) pairs[p].sigma[L] = measured[p];
+    report.level_ms[L] =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - level_start).count();
+    for (size_t p = 0; p < P; ++p)
+      if (!finite(pairs[p].motion) || !std::isfinite(pairs[p].log_gain) || !std::isfinite(pairs[p].bias))
+        return fail(kAlignDiverged, p);
+    if (!std::isfinite(ext.roll) || !std::isfinite(ext.pitch)) return fail(kAlignDiverged, 0);
+  }
+  report.finest = cur_;
+  for (const ReduceSums& s : cur_) {
+    report.total_wrr += s.wrr;
+    report.total_valid += s.valid;
+  }
+  if (with_orientation_) report.orientation_information = orientation_information(cur_);
+  report.ok = true;
+  *extrinsics = ext;
+  return report;
+}
+
+}  // namespace planarvo::track

@@ -1,0 +1,164 @@
+// The one coarse-to-fine damped Gauss-Newton (ESM) aligner of the engine (paper eqs. 10-13 and
+// 19-24), used by the planar tracker (one image pair; the motion and an affine brightness change)
+// and by the roll/pitch estimator of section 5.1 (several keyframe pairs sharing the camera's
+// orientation to the ground).
+//
+// Each image pair p has its own block of parameters, its planar motion T_p (3) and brightness
+// (a_p, b_p) (2, optional), and all pairs may share the camera's tilt y (2, warp_model.h). Each
+// pair is one fused pass (kernels/warp_reduce.cl, NPARAM 3 or 5: a fixed size whatever the
+// number of pairs) whose sums give that pair's block of the normal equations; the joint system
+// over all pairs has the block-arrow structure of a bundle adjustment and is solved on the host
+// by eliminating each pair's block (Schur complement onto y). Levenberg damping on the total
+// robust cost; robust scale per pair and level from the STATS pass's histogram.
+#pragma once
+#include <array>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "core/extrinsics.h"
+#include "core/se2.h"
+#include "image/pyramid.h"
+#include "track/warp_reduce.h"
+
+namespace planarvo::ocl {
+class Runtime;
+}
+
+namespace planarvo::track {
+
+inline constexpr int kMaxLevels = 8;
+
+// What the alignment does at each pyramid level (the tracker's options inherit these).
+struct AlignerOptions {
+  // Pyramid levels used, coarsest first: levels - 1 down to finest_level. Levels smaller than
+  // 8x8 pixels are skipped.
+  int levels = 4;
+  // The finest level aligned: 0 is full resolution; 1 stops at half resolution, a third of
+  // the time for 5-8 instead of 2-3 micrometres RMS per frame at 640x480 on the simulator
+  // (src/track/README.md). -1 (the default): the coarsest level at least min_finest_width pixels
+  // wide (level 1 at 640x480, level 0 at 320x240).
+  int finest_level = -1;
+  int min_finest_width = 320;
+  // Gauss-Newton steps per level, index = level (each step costs one fused pass per pair at that
+  // level except the last, which is applied without checking when it is below convergence_px).
+  std::array<int, kMaxLevels> max_iterations = {2, 6, 10, 12, 12, 12, 12, 12};
+  // Convergence: a step that moves no pixel of the level (its corners and centre, in any pair)
+  // by more than this many pixels of that level ends the level.
+  double convergence_px = 0.05;
+  // Huber threshold k = huber_factor * sigma, sigma = 1.4826 * median |r| per pair and level
+  // (clamped to [min_sigma, max_sigma]), measured at the level's first pass. That pass is
+  // weighted with the sigma the pair brought (initial_sigma at first); when the new one differs
+  // by more than a factor rescale_ratio the level restarts with it (one more pass), so that the
+  // cost is one function within a level.
+  double huber_factor = 2.0;
+  double initial_sigma = 8.0, min_sigma = 0.5, max_sigma = 40.0;  // grey levels
+  double rescale_ratio = 1.25;
+  // Estimate the affine brightness change (r = e^a I_l + b - I_r) jointly with the motion.
+  bool estimate_brightness = true;
+  // Levenberg damping: H + lambda diag(H); lambda starts at 0 (Gauss-Newton) and grows by
+  // lambda_up (from lambda_min) when a step increases the cost, shrinks by lambda_down after
+  // an accepted step.
+  double lambda_min = 1e-4, lambda_up = 10.0, lambda_down = 10.0;
+  // A pair fails (the reason says which) with fewer valid pixels than min_valid_fraction of the
+  // level's, or with live texture (mean squared gradient over the overlap) below
+  // min_texture_ratio of the reference's.
+  double min_valid_fraction = 0.05;
+  double min_texture_ratio = 0.1;
+  // The fused pass's work-group shape etc. (stats and debug_output are set by the aligner).
+  WarpReduceOptions kernel = WarpReduceOptions();
+};
+
+// One image pair and the estimate of its own parameters: the live robot pose in the reference
+// robot frame and the brightness of the live image relative to the reference.
+struct AlignmentPair {
+  const Pyramid* reference = nullptr;
+  const Pyramid* live = nullptr;
+  SE2 motion;
+  double log_gain = 0.0, bias = 0.0;
+  // The robust scale per level (grey levels): brought in (a tracker keeps it from frame to
+  // frame; 0 means initial_sigma) and left as measured.
+  std::array<double, kMaxLevels> sigma{};
+};
+
+struct AlignmentLevels {
+  int coarsest = 0, finest = 0;
+};
+
+struct AlignmentReport {
+  bool ok = false;
+  const char* reason = "";  // why not ok (one of the reasons below)
+  int failed_pair = -1;
+  std::array<int, kMaxLevels> passes{};      // fused passes per level, all pairs
+  std::array<double, kMaxLevels> level_ms{};  // wall time per level
+  int levels_used = 0;
+  // Per pair, at the finest level: the sums of the last pass at the estimate (its J^T W J for
+  // the covariance), the STATS pass that opened the level, and the robust scale measured there.
+  std::vector<ReduceSums> finest;
+  std::vector<ReduceSums> finest_stats;
+  std::vector<double> finest_sigma;
+  // With the orientation: its information (Schur complement of the whole system at the finest
+  // level, undamped, unscaled: J^T W J in grey levels^-2 units) and sum of w r^2 and valid pixels
+  // over all pairs, for the covariance sigma^2 S^-1.
+  Eigen::Matrix2d orientation_information = Eigen::Matrix2d::Zero();
+  double total_wrr = 0.0, total_valid = 0.0;
+};
+
+// Reasons (compared by address by the callers).
+extern const char* const kAlignFewValid;       // "too few valid pixels"
+extern const char* const kAlignNoLiveTexture;  // "no texture in the live frame"
+extern const char* const kAlignDiverged;       // "diverged"
+
+class Aligner {
+ public:
+  // K: the camera matrix of level 0 (undistorted pinhole). with_orientation: the pairs share the
+  // camera's tilt (NPARAM 5) and align() updates the extrinsics' roll and pitch.
+  Aligner(ocl::Runtime& runtime, const Eigen::Matrix3d& K, const AlignerOptions& options,
+          bool with_orientation);
+
+  // The levels to align for pyramids like these (options' levels and finest_level).
+  AlignmentLevels levels(const Pyramid& reference, const Pyramid& live) const;
+
+  // Aligns every pair from its current estimate, coarse to fine over `levels`, updating the
+  // pairs' motions, brightness and scales and (with the orientation) *extrinsics. The report
+  // says whether it worked; the estimates are finite either way (the last good ones).
+  AlignmentReport align(std::vector<AlignmentPair>& pairs, Extrinsics* extrinsics,
+                        const AlignmentLevels& levels);
+
+  // Texture of a pyramid level on its own: mean squared gradient (grey levels^2 per pixel^2, a
+  // pass of the level against itself), for a frame that has nothing to be compared with.
+  double texture(const Pyramid& pyramid, int level);
+
+  // J^T W J of a pair's local block (motion and brightness, the orientation marginalised out
+  // is not included): the inverse of its motion block's covariance up to sigma^2. n = 3 or 5.
+  int local_size() const { return options_.estimate_brightness ? 5 : 3; }
+  bool with_orientation() const { return with_orientation_; }
+  const AlignerOptions& options() const { return options_; }
+
+  using Vector5d = Eigen::Matrix<double, 5, 1>;
+  using Matrix52d = Eigen::Matrix<double, 5, 2>;
+
+ private:
+  // A step of the whole system, and the solve's scratch (kept, so a frame allocates nothing).
+  struct Step {
+    std::vector<Vector5d> local;  // per pair: motion (3), then a, b
+    Eigen::Vector2d orientation = Eigen::Vector2d::Zero();
+    std::vector<Matrix52d> X;     // per pair: A_ll^-1 A_ls
+    std::vector<Vector5d> x;      // per pair: A_ll^-1 g_l
+  };
+  void evaluate(const AlignmentPair& pair, const Extrinsics& e, int level, bool stats, ReduceSums* out);
+  bool solve(const std::vector<ReduceSums>& sums, double lambda, Step* step) const;
+  Eigen::Matrix2d orientation_information(const std::vector<ReduceSums>& sums) const;
+
+  ocl::Runtime& runtime_;
+  Eigen::Matrix3d K_;
+  AlignerOptions options_;
+  bool with_orientation_;
+  WarpReduce pass_, stats_pass_;
+  std::vector<ReduceSums> cur_, next_;
+  std::vector<AlignmentPair> cand_;
+  std::vector<double> measured_;
+  Step step_;
+};
+
+}  // namespace planarvo::track
