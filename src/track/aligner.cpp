@@ -34,6 +34,17 @@ WarpReduceOptions kernel_options(const AlignerOptions& o, bool stats) {
   return k;
 }
 
+// The fused pass's variants with the default options (the tracker's NPARAM 3 and the roll/pitch
+// estimator's 5, each plain and STATS), registered before main() so that exported kernel
+// binaries hold them without an aligner having been made (FPGA flows cannot compile at run time).
+const bool kDefaultVariantsRegistered = [] {
+  for (int nparam : {kMotionParams, kMotionParams + kOrientationParams})
+    for (bool stats : {false, true})
+      ocl::Runtime::register_build_options("warp_reduce",
+                                           WarpReduce::build_options(nparam, kernel_options(AlignerOptions(), stats)));
+  return true;
+}();
+
 bool finite(const SE2& m) { return std::isfinite(m.x) && std::isfinite(m.y) && std::isfinite(m.theta); }
 
 double mean_cost(const std::vector<ReduceSums>& sums) {

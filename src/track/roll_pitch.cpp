@@ -1,0 +1,347 @@
+#include "track/roll_pitch.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+
+#include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
+
+#include "core/error.h"
+#include "image/pipeline.h"
+#include "track/tracker.h"
+
+namespace planarvo::track {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double ms_since(Clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+}
+
+// The camera's frame of section 5.1 (eq. 14): on the robot's origin, one unit above the ground,
+// no yaw; only the tilt is the camera's.
+Extrinsics camera_frame(double roll, double pitch) { return Extrinsics{0.0, 0.0, 1.0, roll, pitch, 0.0}; }
+
+// A camera motion counts as moving above these (camera heights, radians).
+constexpr double kMovedTranslation = 2e-3, kMovedRotation = 2e-3;
+
+std::string degrees(double rad) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%.2f deg", rad * 180.0 / M_PI);
+  return b;
+}
+
+}  // namespace
+
+const char* status_name(RollPitchResult::Status s) {
+  switch (s) {
+    case RollPitchResult::Status::Ok: return "ok";
+    case RollPitchResult::Status::TooLittleTexture: return "too little texture";
+    case RollPitchResult::Status::TooLittleMotion: return "too little motion";
+    case RollPitchResult::Status::Failed: return "failed";
+  }
+  return "?";
+}
+
+AlignerOptions RollPitchOptions::default_align() {
+  AlignerOptions o;
+  o.finest_level = 0;
+  o.max_iterations = {4, 8, 10, 12, 12, 12, 12, 12};
+  o.convergence_px = 0.02;
+  return o;
+}
+
+struct RollPitchEstimator::Impl {
+  ocl::Runtime& rt;
+  CameraModel camera;
+  RollPitchOptions opt;
+  ImagePipeline pipeline;
+  Tracker tracker;
+  Aligner aligner;
+
+  Pyramid spare;
+  std::vector<Pyramid> keyframes;
+  std::vector<SE2> motions;  // between consecutive keyframes, from the tracker
+  std::vector<int> keyframe_frames;
+  SE2 since_keyframe;
+  bool moved = false, done = false;
+  int frames = 0, frames_moving = 0, untextured = 0, restarts = 0;
+  double track_ms = 0.0;
+
+  static TrackerOptions tracker_options(const RollPitchOptions& o) {
+    TrackerOptions t;
+    t.levels = o.align.levels;
+    t.kernel = o.align.kernel;
+    t.keyframe_overlap = o.keyframe_overlap;
+    // At a wrong tilt the ground's homography cannot align two frames exactly: the residual stays
+    // large but the motion is roughly right, which is all the map needs from this tracker (the
+    // joint alignment decides). Only frames that cannot be aligned at all are lost.
+    t.lost_residual_ratio = 2.0;
+    t.degraded_residual_ratio = 2.0;
+    t.min_inlier_fraction = 0.0;
+    t.max_log_gain = 3.0;
+    return t;
+  }
+
+  static const RollPitchOptions& validated(const RollPitchOptions& o) {
+    if (o.min_keyframes < 2 || o.max_keyframes < o.min_keyframes)
+      throw_invalid_argument("roll/pitch: need 2 <= min_keyframes <= max_keyframes");
+    if (!(o.keyframe_overlap > 0.0 && o.keyframe_overlap < 1.0))
+      throw_invalid_argument("roll/pitch: keyframe_overlap must be in (0, 1)");
+    if (o.max_frames < 0 || o.max_rounds < 1) throw_invalid_argument("roll/pitch: max_frames >= 0, max_rounds >= 1");
+    if (!std::isfinite(o.initial_roll) || !std::isfinite(o.initial_pitch))
+      throw_invalid_argument("roll/pitch: the initial orientation must be finite");
+    return o;
+  }
+
+  Impl(ocl::Runtime& r, const CameraModel& c, const RollPitchOptions& o)
+      : rt(r), camera(c), opt(validated(o)), pipeline(r, c, o.align.levels),
+        tracker(r, c, camera_frame(o.initial_roll, o.initial_pitch), tracker_options(o)),
+        aligner(r, c.K(), o.align, true) {}
+
+  bool add_frame(const uint8_t* gray, int width, int height, size_t stride, double t) {
+    if (done) return true;
+    const auto t0 = Clock::now();
+    ++frames;
+    if (moved) ++frames_moving;
+    if (!gray || width != camera.width || height != camera.height || stride < static_cast<size_t>(width)) {
+      ++untextured;  // not usable: counted with the frames that could not be tracked
+      return finish_frame(t0);
+    }
+    pipeline.process(gray, width, height, stride, spare);
+    const FrameResult r = tracker.track(spare, t);
+    if (r.status == FrameResult::Status::First) {
+      keyframes.clear();
+      motions.clear();
+      keyframe_frames.clear();
+      keyframes.push_back(std::move(spare));
+      keyframe_frames.push_back(frames - 1);
+      spare = Pyramid();
+      since_keyframe = SE2();
+      return finish_frame(t0);
+    }
+    if (r.status == FrameResult::Status::Lost) {
+      ++untextured;
+      if (r.keyframe) restart_map();  // the chain of motions is broken here
+      return finish_frame(t0);
+    }
+    since_keyframe = since_keyframe * r.motion;
+    if (!moved && (std::hypot(since_keyframe.x, since_keyframe.y) > kMovedTranslation ||
+                   std::abs(since_keyframe.theta) > kMovedRotation))
+      moved = true;
+    if (r.keyframe) {
+      keyframes.push_back(std::move(spare));
+      keyframe_frames.push_back(frames - 1);
+      spare = Pyramid();
+      motions.push_back(since_keyframe);
+      since_keyframe = SE2();
+    }
+    return finish_frame(t0);
+  }
+
+  // A lost frame became the tracker's new keyframe: keep the map if it is already usable, else
+  // start a new one from this frame.
+  void restart_map() {
+    if (static_cast<int>(keyframes.size()) >= opt.min_keyframes) {
+      done = true;
+      return;
+    }
+    ++restarts;
+    keyframes.clear();
+    motions.clear();
+    keyframe_frames.clear();
+    keyframes.push_back(std::move(spare));
+    keyframe_frames.push_back(frames - 1);
+    spare = Pyramid();
+    since_keyframe = SE2();
+  }
+
+  bool finish_frame(Clock::time_point t0) {
+    if (static_cast<int>(keyframes.size()) >= opt.max_keyframes) done = true;
+    if (opt.max_frames > 0 && frames_moving >= opt.max_frames) done = true;
+    track_ms += ms_since(t0);
+    return done;
+  }
+
+  std::vector<AlignmentPair> initial_pairs() const {
+    std::vector<AlignmentPair> pairs(motions.size());
+    for (size_t k = 0; k < motions.size(); ++k) {
+      pairs[k].reference = &keyframes[k];
+      pairs[k].live = &keyframes[k + 1];
+      pairs[k].motion = motions[k];
+    }
+    return pairs;
+  }
+
+  // A pair's residual mean square over its keyframe's intensity variance, from the STATS pass
+  // that opened the finest level (about 1 for unrelated images; 0.02-0.1 when aligned).
+  static double residual_ratio(const ReduceSums& s) {
+    const double var = s.valid > 0 ? s.iref2 / s.valid - std::pow(s.iref / s.valid, 2) : 0.0;
+    return s.valid > 0 && var > 0 ? (s.rr / s.valid) / var : HUGE_VAL;
+  }
+
+  struct Run {
+    AlignmentReport report;
+    std::vector<AlignmentPair> pairs;
+    Extrinsics ext;
+    double ratio = HUGE_VAL;  // the worst pair's residual ratio
+    int rounds = 0, passes = 0, dropped = 0;
+  };
+
+  // Joint alignments over `levels` from the previous one's result until the orientation settles.
+  void rounds(Run* run, const AlignmentLevels& levels, int max_rounds) {
+    for (int round = 0; round < max_rounds; ++round) {
+      const Extrinsics before = run->ext;
+      run->report = aligner.align(run->pairs, &run->ext, levels);
+      ++run->rounds;
+      for (int p : run->report.passes) run->passes += p;
+      if (!run->report.ok) return;
+      if (std::hypot(run->ext.roll - before.roll, run->ext.pitch - before.pitch) < opt.round_tolerance) break;
+    }
+    run->ratio = 0.0;
+    for (const ReduceSums& s : run->report.finest_stats) run->ratio = std::max(run->ratio, residual_ratio(s));
+
+  }
+
+  // Pairs that do not align at the joint estimate (the tracker's motion for them was too far
+  // off, or they do not overlap) leave the map, and the rest is aligned again, as long as
+  // min_keyframes - 1 pairs remain.
+  void drop_unaligned(Run* run, const AlignmentLevels& levels) {
+    if (!run->report.ok || run->ratio <= opt.search_residual_ratio) return;
+    std::vector<AlignmentPair> kept;
+    for (size_t p = 0; p < run->pairs.size(); ++p)
+      if (residual_ratio(run->report.finest_stats[p]) <= opt.search_residual_ratio) kept.push_back(run->pairs[p]);
+    if (static_cast<int>(kept.size()) < opt.min_keyframes - 1 || kept.size() == run->pairs.size()) return;
+    run->dropped += static_cast<int>(run->pairs.size() - kept.size());
+    run->pairs = std::move(kept);
+    rounds(run, levels, opt.max_rounds);
+  }
+
+  Run start(double roll, double pitch) {
+    Run run;
+    run.pairs = initial_pairs();
+    run.ext = camera_frame(roll, pitch);
+    return run;
+  }
+
+  RollPitchResult estimate() {
+    RollPitchResult res;
+    res.frames_used = frames;
+    res.keyframes = static_cast<int>(keyframes.size());
+    res.keyframe_frames = keyframe_frames;
+    res.track_ms = track_ms;
+    const int K = res.keyframes;
+    if (K < opt.min_keyframes) {
+      if (untextured * 2 > frames || K == 0) {
+        res.status = RollPitchResult::Status::TooLittleTexture;
+        res.reason = std::to_string(untextured) + " of " + std::to_string(frames) +
+                     " frames could not be tracked (no texture on the ground, or unusable frames)";
+      } else {
+        res.status = RollPitchResult::Status::TooLittleMotion;
+        res.reason = "the camera moved too little in " + std::to_string(frames) + " frames (" + std::to_string(K) +
+                     " keyframes, " + std::to_string(opt.min_keyframes) +
+                     " needed): drive over the ground (forwards, backwards or along an arc) while these frames are "
+                     "taken, or give more frames";
+      }
+      return res;
+    }
+    for (const SE2& m : motions) res.translation += std::hypot(m.x, m.y);
+    if (res.translation < opt.min_translation) {
+      res.status = RollPitchResult::Status::TooLittleMotion;
+      res.reason = "the camera translated " + std::to_string(res.translation) +
+                   " camera heights over the map, " + std::to_string(opt.min_translation) +
+                   " needed: turning about the camera's own vertical axis does not determine roll and pitch; drive "
+                   "forwards, backwards or along an arc";
+      return res;
+    }
+
+    const auto t0 = Clock::now();
+    const AlignmentLevels levels = aligner.levels(keyframes.front(), keyframes.back());
+    Run best = start(opt.initial_roll, opt.initial_pitch);
+    rounds(&best, levels, opt.max_rounds);
+    drop_unaligned(&best, levels);
+    res.rounds = best.rounds;
+    res.passes = best.passes;
+    if (opt.search && (!best.report.ok || best.ratio > opt.search_residual_ratio)) {
+      // A coarse search over the two angles: each start aligned at the coarse levels only (one
+      // round), the best by its residual taken down to full resolution.
+      AlignmentLevels coarse = levels;
+      coarse.finest = std::max(levels.finest, levels.coarsest - 1);
+      const int n = static_cast<int>(std::floor(opt.search_range / opt.search_step + 1e-9));
+      Run found;
+      for (int i = -n; i <= n; ++i)
+        for (int j = -n; j <= n; ++j) {
+          Run r = start(opt.initial_roll + i * opt.search_step, opt.initial_pitch + j * opt.search_step);
+          rounds(&r, coarse, 1);
+          res.rounds += r.rounds;
+          res.passes += r.passes;
+          if (r.report.ok && (!found.report.ok || r.ratio < found.ratio)) found = std::move(r);
+        }
+      if (found.report.ok) {
+        rounds(&found, levels, opt.max_rounds);
+        drop_unaligned(&found, levels);
+        res.rounds += found.rounds;
+        res.passes += found.passes;
+        if (found.report.ok && (!best.report.ok || found.ratio < best.ratio)) best = std::move(found);
+      }
+    }
+    res.align_ms = ms_since(t0);
+    if (!best.report.ok) {
+      res.status = RollPitchResult::Status::Failed;
+      res.reason = std::string("the joint alignment of the keyframes failed: ") + best.report.reason;
+      return res;
+    }
+    res.residual_ratio = best.ratio;
+    res.pairs = static_cast<int>(best.pairs.size());
+    res.roll = best.ext.roll;
+    res.pitch = best.ext.pitch;
+    for (const AlignmentPair& p : best.pairs)
+      res.pair_motions.push_back({static_cast<int>(p.reference - keyframes.data()),
+                                  static_cast<int>(p.live - keyframes.data()), p.motion});
+
+    // sigma^2 S^-1, with every pair's motion and brightness marginalised (aligner.h).
+    const double dof = std::max(1.0, best.report.total_valid - static_cast<double>(
+                                          best.pairs.size() * static_cast<size_t>(aligner.local_size()) + 2));
+    const double s2 = std::max(best.report.total_wrr / dof, opt.align.min_sigma * opt.align.min_sigma);
+    const Eigen::Matrix2d S = best.report.orientation_information;
+    const Eigen::LDLT<Eigen::Matrix2d> ldlt(S);
+    const bool invertible = ldlt.info() == Eigen::Success && ldlt.vectorD().minCoeff() > 0.0;
+    res.covariance = invertible ? Eigen::Matrix2d(opt.covariance_inflation * opt.covariance_inflation * s2 *
+                                                  ldlt.solve(Eigen::Matrix2d::Identity()))
+                                : Eigen::Matrix2d::Identity() * 1e6;
+    const double worst_sigma = std::sqrt(std::max(res.covariance(0, 0), res.covariance(1, 1)));
+    if (!(worst_sigma <= opt.max_sigma)) {
+      res.status = RollPitchResult::Status::TooLittleMotion;
+      res.reason = "the motion does not determine roll and pitch (standard deviation " + degrees(worst_sigma) +
+                   ", at most " + degrees(opt.max_sigma) +
+                   " allowed): drive forwards, backwards or along an arc; turning about the camera's own vertical "
+                   "axis does not determine them";
+      return res;
+    }
+    if (best.ratio > opt.search_residual_ratio) {
+      res.status = RollPitchResult::Status::Failed;
+      res.reason = "the keyframes do not align (residual " + std::to_string(best.ratio) +
+                   " of the image's variance): the ground is not planar, or the frames are not of one surface";
+      return res;
+    }
+    res.status = RollPitchResult::Status::Ok;
+    return res;
+  }
+};
+
+RollPitchEstimator::RollPitchEstimator(ocl::Runtime& runtime, const CameraModel& camera,
+                                       const RollPitchOptions& options)
+    : impl_(std::make_unique<Impl>(runtime, camera, options)) {}
+RollPitchEstimator::~RollPitchEstimator() = default;
+bool RollPitchEstimator::add_frame(const uint8_t* gray, int width, int height, size_t stride, double timestamp) {
+  return impl_->add_frame(gray, width, height, stride, timestamp);
+}
+bool RollPitchEstimator::complete() const { return impl_->done; }
+int RollPitchEstimator::keyframes() const { return static_cast<int>(impl_->keyframes.size()); }
+RollPitchResult RollPitchEstimator::estimate() { return impl_->estimate(); }
+
+}  // namespace planarvo::track

@@ -1,0 +1,137 @@
+// The camera's roll and pitch from images alone (paper section 5.1, eqs. 14-24): a local dense
+// map of keyframes, the planar motions between consecutive keyframes and the camera's
+// orientation to the ground estimated jointly by the one aligner (aligner.h) with the camera at
+// x = y = 0, z = 1, yaw = 0 (eq. 14), so the motions are the camera's own planar motions in
+// units of its height.
+//
+// Frames are fed one at a time. A tracker at the initial orientation picks the keyframes (a frame
+// joins the map when its overlap with the last keyframe falls below keyframe_overlap) and gives
+// each keyframe pair its first motion; estimate() then aligns all pairs jointly, coarse to fine,
+// repeated from its own result until the orientation stops moving, with a coarse search over
+// the two angles when that does not converge.
+//
+// Which motions determine the tilt. Between two views of the ground, x_l ~ K (R - t n^T / z)
+// K^-1 x_r: the plane enters only through t n^T, so a camera that does not translate (standing
+// still, or turning about the vertical through its own centre, which for a camera looking
+// straight down is a rotation about its optical axis) sees the infinite homography K R K^-1,
+// from which the normal is at best the rotation's axis, confounded at first order with a
+// translation over a level plane: too little motion. Any translation of the camera over the
+// ground determines n (t n^T has 4 degrees of freedom for t in the plane and n of unit length),
+// with an information that grows with |t| / z and with the field of view; a rotation adds to it
+// but is not needed. estimate() refuses (TooLittleMotion) when the pairs' camera translation is
+// below min_translation heights in total or the estimated standard deviation exceeds max_sigma.
+#pragma once
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "core/se2.h"
+#include "image/camera.h"
+#include "track/aligner.h"
+
+namespace planarvo::ocl {
+class Runtime;
+}
+
+namespace planarvo::track {
+
+struct RollPitchOptions {
+  // The joint alignment, down to full resolution (the tilt is a small effect: the finest level
+  // decides its accuracy).
+  AlignerOptions align = default_align();
+  // Start of the estimate: a camera looking straight down unless given (radians).
+  double initial_roll = 0.0, initial_pitch = 0.0;
+  // The map: a frame becomes a keyframe when its overlap with the last one falls below this
+  // (0.9: pairs a tenth of the view apart; at 0.7, a tilted camera's pairs span more than a camera
+  // height, near and far field swap resolution between the two views and the pairs stop aligning,
+  // measured on the simulator at 30 degrees of roll); the estimate needs min_keyframes (5 to 50 in the paper) and the map stops growing at
+  // max_keyframes. max_frames > 0 stops it after that many frames counted from the first frame
+  // in which the camera moved (a standing start costs nothing); 0: no limit but max_keyframes.
+  double keyframe_overlap = 0.9;
+  int min_keyframes = 5;
+  int max_keyframes = 12;
+  int max_frames = 0;
+  // Joint alignments from the previous one's result until roll and pitch move less than this
+  // (radians), at most max_rounds.
+  int max_rounds = 4;
+  double round_tolerance = 1e-5;
+  // When the joint alignment does not converge (the pairs' residuals stay above
+  // search_residual_ratio of the keyframes' intensity variance), it is started again from each
+  // point of a grid of roll and pitch within search_range of the initial orientation, search_step
+  // apart, and the lowest final cost wins.
+  bool search = true;
+  double search_range = 0.6, search_step = 0.3;  // radians
+  double search_residual_ratio = 0.3;
+  // Covariance: inflation^2 sigma^2 S^-1, S the orientation's information with every pair's
+  // motion and brightness marginalised, sigma^2 the weighted residual variance (at least
+  // align.min_sigma^2); inflation accounts for residuals that are not independent from pixel to
+  // pixel (src/track/README.md).
+  double covariance_inflation = 1.0;
+  // Refusals: too little motion when the camera's translation summed over the pairs is below
+  // min_translation camera heights, or a standard deviation of roll or pitch above max_sigma.
+  double min_translation = 0.2;
+  double max_sigma = 0.5 * 3.14159265358979 / 180.0;
+
+  static AlignerOptions default_align();
+};
+
+struct RollPitchResult {
+  enum class Status {
+    Ok,
+    TooLittleTexture,  // the frames could not be tracked: no texture on the ground
+    TooLittleMotion,   // the camera did not translate enough over the ground
+    Failed,            // the joint alignment failed (reason says how)
+  };
+  Status status = Status::Failed;
+  std::string reason;  // "" when Ok; otherwise what went wrong and what would fix it
+  double roll = 0.0, pitch = 0.0;  // radians (conventions.md)
+  Eigen::Matrix2d covariance = Eigen::Matrix2d::Zero();  // of (roll, pitch), rad^2
+  int frames_used = 0;   // frames fed before the map was complete
+  int keyframes = 0;
+  int pairs = 0;         // keyframe pairs in the estimate (consecutive keyframes that align)
+  int rounds = 0;        // joint alignments run (search included)
+  int passes = 0;        // fused passes of the joint alignments
+  double translation = 0.0;  // the camera's translation summed over the pairs, camera heights
+  double residual_ratio = 0.0;  // worst pair's residual mean square over its keyframe's variance
+  double track_ms = 0.0, align_ms = 0.0;  // picking the keyframes, the joint alignment
+  // The map: which frames (0-based, in the order fed) are its keyframes, and the camera's planar
+  // motion of each pair in the estimate (reference keyframe index, live keyframe index, motion in
+  // units of the camera height).
+  std::vector<int> keyframe_frames;
+  struct Pair {
+    int reference = 0, live = 0;
+    SE2 motion;
+  };
+  std::vector<Pair> pair_motions;
+  bool ok() const { return status == Status::Ok; }
+};
+
+const char* status_name(RollPitchResult::Status s);
+
+class RollPitchEstimator {
+ public:
+  // camera: the distorted camera the frames come from (the image pipeline undistorts them).
+  RollPitchEstimator(ocl::Runtime& runtime, const CameraModel& camera, const RollPitchOptions& options = {});
+  ~RollPitchEstimator();
+  RollPitchEstimator(const RollPitchEstimator&) = delete;
+  RollPitchEstimator& operator=(const RollPitchEstimator&) = delete;
+
+  // Feeds one frame (8-bit grey, the camera's size, rows stride bytes apart; timestamp in
+  // seconds). Returns true once the map is complete; later frames are ignored. A frame of the
+  // wrong size or without texture is counted and skipped, as the tracker does.
+  bool add_frame(const uint8_t* gray, int width, int height, size_t stride, double timestamp);
+  bool complete() const;
+  int keyframes() const;
+
+  // Estimates roll and pitch from the map (any number of keyframes; fewer than min_keyframes
+  // is TooLittleMotion or TooLittleTexture with the reason).
+  RollPitchResult estimate();
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace planarvo::track
