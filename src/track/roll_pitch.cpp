@@ -249,13 +249,11 @@ struct RollPitchEstimator::Impl {
       }
       return res;
     }
-    for (const SE2& m : motions) res.translation += std::hypot(m.x, m.y);
-    if (res.translation < opt.min_translation) {
+    for (const SE2& m : motions) res.motion += std::hypot(m.x, m.y) + std::abs(m.theta);
+    if (res.motion < opt.min_motion) {
       res.status = RollPitchResult::Status::TooLittleMotion;
-      res.reason = "the camera translated " + std::to_string(res.translation) +
-                   " camera heights over the map, " + std::to_string(opt.min_translation) +
-                   " needed: turning about the camera's own vertical axis does not determine roll and pitch; drive "
-                   "forwards, backwards or along an arc";
+      res.reason = "the camera moved " + std::to_string(res.motion) + " (camera heights plus radians) over the map, " +
+                   std::to_string(opt.min_motion) + " needed: drive or turn while these frames are taken";
       return res;
     }
 
@@ -318,8 +316,7 @@ struct RollPitchEstimator::Impl {
       res.status = RollPitchResult::Status::TooLittleMotion;
       res.reason = "the motion does not determine roll and pitch (standard deviation " + degrees(worst_sigma) +
                    ", at most " + degrees(opt.max_sigma) +
-                   " allowed): drive forwards, backwards or along an arc; turning about the camera's own vertical "
-                   "axis does not determine them";
+                   " allowed): drive forwards, backwards or along an arc, or turn further";
       return res;
     }
     if (best.ratio > opt.search_residual_ratio) {

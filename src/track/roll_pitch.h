@@ -11,15 +11,17 @@
 // the two angles when that does not converge.
 //
 // Which motions determine the tilt. Between two views of the ground, x_l ~ K (R - t n^T / z)
-// K^-1 x_r: the plane enters only through t n^T, so a camera that does not translate (standing
-// still, or turning about the vertical through its own centre, which for a camera looking
-// straight down is a rotation about its optical axis) sees the infinite homography K R K^-1,
-// from which the normal is at best the rotation's axis, confounded at first order with a
-// translation over a level plane: too little motion. Any translation of the camera over the
-// ground determines n (t n^T has 4 degrees of freedom for t in the plane and n of unit length),
-// with an information that grows with |t| / z and with the field of view; a rotation adds to it
-// but is not needed. estimate() refuses (TooLittleMotion) when the pairs' camera translation is
-// below min_translation heights in total or the estimated standard deviation exceeds max_sigma.
+// K^-1 x_r. A translation t of the camera over the ground determines n: t n^T has 4 degrees of
+// freedom (t in the plane, n of unit length), with an information that grows with |t| / z and
+// the field of view. A camera that only rotates (turning about the vertical through its own
+// centre; for a camera looking straight down, about its optical axis) sees K R_n(theta) K^-1,
+// a rotation about the ground normal itself: the image turns about the point K n, which
+// determines n for any rotation that is not small (measured: 0.2 rad between keyframes, 0.002
+// degrees of error, sigma 0.007 degrees; the test RollPitch.TurningAboutTheCamera...). So the
+// only degenerate motion is none at all (standing still), and weak ones are small rotations
+// without translation. estimate() refuses (TooLittleMotion) when the map's camera motion, in
+// camera heights of translation plus radians of rotation summed over its pairs, is below
+// min_motion, or when the estimated standard deviation of roll or pitch exceeds max_sigma.
 #pragma once
 #include <memory>
 #include <string>
@@ -69,9 +71,10 @@ struct RollPitchOptions {
   // align.min_sigma^2); inflation accounts for residuals that are not independent from pixel to
   // pixel (src/track/README.md).
   double covariance_inflation = 1.0;
-  // Refusals: too little motion when the camera's translation summed over the pairs is below
-  // min_translation camera heights, or a standard deviation of roll or pitch above max_sigma.
-  double min_translation = 0.2;
+  // Refusals: too little motion when the camera's motion summed over the pairs (camera heights of
+  // translation plus radians of rotation) is below min_motion, or a standard deviation of roll
+  // or pitch above max_sigma.
+  double min_motion = 0.2;
   double max_sigma = 0.5 * 3.14159265358979 / 180.0;
 
   static AlignerOptions default_align();
@@ -93,7 +96,7 @@ struct RollPitchResult {
   int pairs = 0;         // keyframe pairs in the estimate (consecutive keyframes that align)
   int rounds = 0;        // joint alignments run (search included)
   int passes = 0;        // fused passes of the joint alignments
-  double translation = 0.0;  // the camera's translation summed over the pairs, camera heights
+  double motion = 0.0;  // the camera's motion summed over the pairs: heights of translation + radians
   double residual_ratio = 0.0;  // worst pair's residual mean square over its keyframe's variance
   double track_ms = 0.0, align_ms = 0.0;  // picking the keyframes, the joint alignment
   // The map: which frames (0-based, in the order fed) are its keyframes, and the camera's planar
