@@ -1,10 +1,10 @@
-// The simulator's ground renderer (src/io/simulator.h, src/io/SIMULATOR.md).
+// The simulator's ground renderer (src/sim/simulator.h, src/sim/SIMULATOR.md).
 //
 // One work-item per output pixel. Each pixel averages S*S subsamples; a subsample's undistorted
 // ray (from a table computed on the host in 64-bit precision) maps through the frame's homography to
 // texture coordinates, and is looked up trilinearly in the mirror-tiled mip pyramid at the
 // level of the pixel's footprint on the ground divided by S. render_reference() in
-// src/io/simulator_render.cpp is the plain C++ reference of this kernel: keep them in step.
+// src/sim/simulator_render.cpp is the plain C++ reference of this kernel: keep them in step.
 //
 // Buffers:
 //   tex     all mip levels, row-major, one after another

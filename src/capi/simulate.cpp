@@ -1,4 +1,4 @@
-// C API: the simulator (src/io/simulator.h). The defaults of planarvo_sim_options are those of
+// C API: the simulator (src/sim/simulator.h). The defaults of planarvo_sim_options are those of
 // sim::Options, so they are stated in one place.
 #include <cstring>
 #include <string>
@@ -6,7 +6,7 @@
 #include "capi/convert.h"
 #include "capi/handles.h"
 #include "capi/status.h"
-#include "io/simulator.h"
+#include "sim/simulator.h"
 
 using planarvo::capi::guard;
 using planarvo::capi::require;

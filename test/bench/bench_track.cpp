@@ -29,8 +29,8 @@
 
 #include "core/se2.h"
 #include "image/undistort.h"
-#include "io/simulator.h"
 #include "ocl/runtime.h"
+#include "sim/simulator.h"
 #include "track/evaluation.h"
 #include "track/tracker.h"
 #include "track/warp_model.h"

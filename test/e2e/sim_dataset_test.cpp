@@ -10,8 +10,8 @@
 #include "common/test_util.h"
 #include "core/error.h"
 #include "io/dataset.h"
-#include "io/simulator.h"
 #include "ocl/runtime.h"
+#include "sim/simulator.h"
 
 namespace planarvo::sim {
 namespace {

@@ -9,8 +9,8 @@
 
 #include "common/test_util.h"
 #include "io/dataset.h"
-#include "io/simulator.h"
 #include "ocl/runtime.h"
+#include "sim/simulator.h"
 #include "track/evaluation.h"
 #include "track/tracker.h"
 

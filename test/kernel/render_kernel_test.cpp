@@ -5,8 +5,8 @@
 
 #include <gtest/gtest.h>
 
-#include "io/simulator.h"
 #include "ocl/runtime.h"
+#include "sim/simulator.h"
 
 namespace planarvo::sim {
 namespace {

@@ -4,7 +4,7 @@
 
 #include <gtest/gtest.h>
 
-#include "io/simulator.h"
+#include "sim/simulator.h"
 
 namespace planarvo::sim {
 namespace {

@@ -10,7 +10,7 @@
 
 #include "common/test_util.h"
 #include "core/error.h"
-#include "io/simulator.h"
+#include "sim/simulator.h"
 
 namespace planarvo::sim {
 namespace {

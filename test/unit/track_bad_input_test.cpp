@@ -10,8 +10,8 @@
 
 #include "common/test_util.h"
 #include "core/error.h"
-#include "io/simulator.h"
 #include "ocl/runtime.h"
+#include "sim/simulator.h"
 #include "track/tracker.h"
 #include "unit/track_test_pyramid.h"
 

@@ -10,8 +10,8 @@
 
 #include "common/test_util.h"
 #include "image/undistort.h"
-#include "io/simulator.h"
 #include "ocl/runtime.h"
+#include "sim/simulator.h"
 #include "track/tracker.h"
 #include "track/warp_model.h"
 #include "unit/track_test_pyramid.h"

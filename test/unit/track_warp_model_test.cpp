@@ -11,7 +11,7 @@
 
 #include "core/extrinsics.h"
 #include "core/se2.h"
-#include "io/simulator.h"
+#include "sim/simulator.h"
 #include "track/warp_model.h"
 
 namespace planarvo::track {

@@ -6,7 +6,7 @@
 #include <string>
 
 #include "core/error.h"
-#include "io/simulator.h"
+#include "sim/simulator.h"
 
 namespace planarvo::sim {
 

@@ -9,8 +9,8 @@
 #include <opencv2/imgproc.hpp>
 
 #include "core/error.h"
-#include "io/simulator.h"
 #include "ocl/runtime.h"
+#include "sim/simulator.h"
 
 namespace planarvo::sim {
 

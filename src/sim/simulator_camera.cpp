@@ -4,7 +4,7 @@
 #include <cmath>
 
 #include "core/error.h"
-#include "io/simulator.h"
+#include "sim/simulator.h"
 
 namespace planarvo::sim {
 

@@ -1,5 +1,5 @@
 // The simulator: renders test sequences of a downward-looking camera on a differential-drive
-// robot over a textured ground plane, with exact ground truth (see src/io/SIMULATOR.md).
+// robot over a textured ground plane, with exact ground truth (see src/sim/SIMULATOR.md).
 //
 // Geometry follows shared/spec/conventions.md: robot pose T_wv in SE(2), camera pose
 // T_wc = T_wv * T_vc, ground plane z = 0. The ground texture is the photograph tiled over the

@@ -10,8 +10,8 @@
 
 #include "core/error.h"
 #include "io/formats.h"
-#include "io/simulator.h"
 #include "ocl/runtime.h"
+#include "sim/simulator.h"
 
 namespace planarvo::sim {
 
