@@ -22,7 +22,7 @@
 
 #include <opencv2/imgcodecs.hpp>
 
-#include "io/simulator.h"
+#include "sim/simulator.h"
 #include "ocl/runtime.h"
 #include "track/roll_pitch.h"
 

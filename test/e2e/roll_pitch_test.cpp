@@ -11,7 +11,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "common/test_util.h"
-#include "io/simulator.h"
+#include "sim/simulator.h"
 #include "ocl/runtime.h"
 #include "track/roll_pitch.h"
 
