@@ -174,8 +174,8 @@ PLANARVO_API planarvo_status planarvo_calibrate(const planarvo_motion_pair* pair
       const planarvo_motion_pair& p = pairs[i];
       planarvo::graph::MotionSample& s = samples[i];
       s.interval = p.interval;
-      s.sensor = planarvo::capi::to_cpp(p.sensor);
-      if (p.has_odometry) s.odometry = planarvo::capi::to_cpp(p.odometry);
+      s.sensor.value = planarvo::capi::to_cpp(p.sensor);
+      if (p.has_odometry) s.odometry = planarvo::Motion{planarvo::capi::to_cpp(p.odometry)};
       if (p.has_direction) {
         require(p.direction >= -1 && p.direction <= 1, "planarvo_calibrate: a direction is not -1, 0 or +1");
         s.direction = p.direction;
