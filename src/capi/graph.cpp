@@ -116,9 +116,9 @@ PLANARVO_API planarvo_status planarvo_motion_pairs_load(const char* path, planar
       planarvo_motion_pair& o = pairs[i];
       std::memset(&o, 0, sizeof o);
       o.interval = p.interval;
-      o.sensor = planarvo::capi::to_c(p.sensor);
+      o.sensor = planarvo::capi::to_c(p.sensor.value);
       o.has_odometry = p.odometry.has_value();
-      if (p.odometry) o.odometry = planarvo::capi::to_c(*p.odometry);
+      if (p.odometry) o.odometry = planarvo::capi::to_c(p.odometry->value);
       o.has_direction = p.direction.has_value();
       if (p.direction) o.direction = *p.direction;
     }

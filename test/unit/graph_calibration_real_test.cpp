@@ -23,8 +23,8 @@ std::vector<MotionSample> censi(const std::string& name) {
   for (const io::MotionPair& p : pairs.pairs) {
     MotionSample s;
     s.interval = p.interval;
-    s.sensor.value = p.sensor;
-    if (p.odometry) s.odometry = Motion{*p.odometry};
+    s.sensor = p.sensor;
+    s.odometry = p.odometry;
     s.direction = p.direction;
     samples.push_back(s);
   }
