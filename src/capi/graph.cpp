@@ -30,10 +30,8 @@ void send_lines(planarvo_log_fn log, void* user, const std::string& text) {
 
 void fill_summary(const planarvo::graph::SolverSummary& s, double initial_chi2, double final_chi2,
                   planarvo_solver_summary* out) {
-  const size_t size = out->struct_size;
   planarvo_solver_summary o;
   std::memset(&o, 0, sizeof o);
-  o.struct_size = size;
   o.converged = s.converged() ? 1 : 0;
   planarvo::capi::copy_string(o.termination, sizeof o.termination, s.message.empty() ? to_string(s.termination) : s.message);
   o.iterations = s.num_iterations;
@@ -41,7 +39,7 @@ void fill_summary(const planarvo::graph::SolverSummary& s, double initial_chi2, 
   o.initial_chi2 = initial_chi2;
   o.final_chi2 = final_chi2;
   o.seconds = s.total_time_s;
-  std::memcpy(out, &o, std::min(size, sizeof o));
+  planarvo::capi::write_versioned(o, out);
 }
 
 constexpr size_t kSummaryEnd = offsetof(planarvo_solver_summary, seconds) + sizeof(double);
@@ -73,7 +71,7 @@ PLANARVO_API planarvo_status planarvo_posegraph_optimize(const char* in_path, co
       planarvo::capi::require_struct_size(options->struct_size,
                                           offsetof(planarvo_posegraph_options, log_user_data) + sizeof(void*),
                                           "planarvo_posegraph_options");
-      o = *options;
+      o = planarvo::capi::read_versioned(*options, o);
     }
     require(o.max_iterations > 0, "planarvo_posegraph_options.max_iterations must be positive");
     require(o.init == PLANARVO_POSEGRAPH_INIT_NONE || o.init == PLANARVO_POSEGRAPH_INIT_ROTATION_FIRST,
@@ -153,7 +151,7 @@ PLANARVO_API planarvo_status planarvo_calibrate(const planarvo_motion_pair* pair
       planarvo::capi::require_struct_size(options->struct_size,
                                           offsetof(planarvo_calibration_options, log_user_data) + sizeof(void*),
                                           "planarvo_calibration_options");
-      o = *options;
+      o = planarvo::capi::read_versioned(*options, o);
     }
     require(o.method == PLANARVO_CALIBRATE_ODOMETRY || o.method == PLANARVO_CALIBRATE_NONHOLONOMIC,
             "planarvo_calibration_options.method is not a planarvo_calibration_method");
@@ -185,20 +183,19 @@ PLANARVO_API planarvo_status planarvo_calibrate(const planarvo_motion_pair* pair
     send_lines(o.log, o.log_user_data, r.summary.full_report());
     planarvo_calibration_result out;
     std::memset(&out, 0, sizeof out);
-    out.struct_size = result->struct_size;
     for (int i = 0; i < 4; ++i) {
       out.value[i] = r.value[static_cast<size_t>(i)];
       out.estimated[i] = r.estimated[static_cast<size_t>(i)];
       out.observable[i] = r.observable[static_cast<size_t>(i)];
-      for (int j = 0; j < 4; ++j) out.covariance[i * 4 + j] = r.covariance(i, j);
     }
+    planarvo::capi::matrix_to_c<4>(r.covariance, out.covariance);
     out.ambiguous = r.ambiguous;
     out.outliers = r.outliers;
     out.ok = r.ok();
     planarvo::capi::copy_string(out.unobservable_reason, sizeof out.unobservable_reason, r.unobservable_reason);
     out.summary.struct_size = sizeof out.summary;
     fill_summary(r.summary, 2.0 * r.summary.initial_cost, 2.0 * r.summary.final_cost, &out.summary);
-    *result = out;
+    planarvo::capi::write_versioned(out, result);
     ok = r.ok();
     reason = r.ambiguous ? std::string("ambiguous: (x, yaw) and (-x, yaw + 180 deg) fit equally; give direction "
                                        "labels or odometry")
