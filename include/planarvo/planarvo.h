@@ -457,19 +457,36 @@ PLANARVO_API planarvo_status planarvo_posegraph_optimize(const char* in_path, co
 
 /* One interval of planar motion: the sensor's own motion (its frame at the interval's start;
  * translation in metres for a metric sensor, in units of the camera height for the tracker run
- * at height 1), optionally the robot's motion from wheel odometry and a direction label. */
+ * at height 1), optionally the robot's motion from wheel odometry and a direction label.
+ * Versioned like the option structs: set struct_size with planarvo_motion_pair_init. In an array
+ * the stride between elements is pairs[0].struct_size, and every element has the same one, so an
+ * array built against an older header keeps working (its missing fields take their defaults). */
 typedef struct planarvo_motion_pair {
+  size_t struct_size;       /* sizeof(planarvo_motion_pair) */
   double interval;          /* seconds */
   planarvo_se2 sensor;
   int32_t has_odometry;
   planarvo_se2 odometry;
   int32_t has_direction;
   int32_t direction;        /* +1 forwards, -1 backwards, 0 no linear motion */
+  /* Covariances of the motions, 3x3 row-major, order x y theta, in the motions' units (the
+   * sensor's units, metres for odometry; radians): of the right perturbation xi in motion*exp(xi),
+   * as the tracker reports it. Without one (has_ 0, the default) planarvo_calibrate uses the
+   * options' noise model (sensor_sigma_..., odometry_sigma_...). */
+  int32_t has_sensor_covariance;
+  double sensor_covariance[9];
+  int32_t has_odometry_covariance; /* needs has_odometry */
+  double odometry_covariance[9];
 } planarvo_motion_pair;
+
+/* Zeroes *pair (no odometry, direction or covariances) and sets its struct_size. */
+PLANARVO_API void planarvo_motion_pair_init(planarvo_motion_pair* pair);
 
 /* Reads a motion-pair CSV (columns interval_s, [odo_dx, odo_dy, odo_dtheta,] sensor_dx, sensor_dy,
  * sensor_dtheta[, direction]; without a direction column the odometry's forward motion gives it).
- * Call with pairs = NULL for the count, then with capacity >= count. */
+ * Call with pairs = NULL for the count, then with capacity >= count and pairs[0].struct_size set
+ * (planarvo_motion_pair_init): every element is written at that stride, no further than that
+ * size, with that struct_size and no covariances (the file has none). */
 PLANARVO_API planarvo_status planarvo_motion_pairs_load(const char* path, planarvo_motion_pair* pairs,
                                                         size_t capacity, size_t* count);
 
@@ -506,9 +523,9 @@ typedef struct planarvo_calibration_result {
 } planarvo_calibration_result;
 
 PLANARVO_API void planarvo_calibration_options_init(planarvo_calibration_options* options);
-/* Calibrates from count motion pairs. Returns PLANARVO_ERROR_FAILED (with the reason as the
- * message) when the result is not ok: unobservable, ambiguous or not converged; the result is
- * filled in either case. */
+/* Calibrates from an array of count motion pairs (stride pairs[0].struct_size). Returns
+ * PLANARVO_ERROR_FAILED (with the reason as the message) when the result is not ok: unobservable,
+ * ambiguous or not converged; the result is filled in either case. */
 PLANARVO_API planarvo_status planarvo_calibrate(const planarvo_motion_pair* pairs, size_t count,
                                                 const planarvo_calibration_options* options,
                                                 planarvo_calibration_result* result);

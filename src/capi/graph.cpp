@@ -43,6 +43,62 @@ void fill_summary(const planarvo::graph::SolverSummary& s, double initial_chi2, 
 }
 
 constexpr size_t kSummaryEnd = offsetof(planarvo_solver_summary, seconds) + sizeof(double);
+// The first versioned planarvo_motion_pair ended with direction; the covariances came after.
+constexpr size_t kMotionPairEnd = offsetof(planarvo_motion_pair, direction) + sizeof(int32_t);
+
+// Element i of a caller's array of planarvo_motion_pair, whose stride is its struct_size.
+const void* element(const planarvo_motion_pair* pairs, size_t stride, size_t i) {
+  return reinterpret_cast<const unsigned char*>(pairs) + i * stride;
+}
+void* element(planarvo_motion_pair* pairs, size_t stride, size_t i) {
+  return reinterpret_cast<unsigned char*>(pairs) + i * stride;
+}
+
+// The array's stride, pairs[0].struct_size, checked against the first version's size.
+size_t motion_pair_stride(const planarvo_motion_pair* pairs) {
+  size_t stride = 0;
+  std::memcpy(&stride, pairs, sizeof stride);
+  planarvo::capi::require_struct_size(stride, kMotionPairEnd, "planarvo_motion_pair");
+  return stride;
+}
+
+// Pair i of the caller's array as a sample: fields beyond its struct_size take their defaults.
+planarvo::graph::MotionSample read_pair(const planarvo_motion_pair* pairs, size_t stride, size_t i) {
+  planarvo_motion_pair p;
+  planarvo_motion_pair_init(&p);
+  std::memcpy(static_cast<void*>(&p), element(pairs, stride, i), std::min(stride, sizeof p));
+  const std::string where = "planarvo_calibrate: pairs[" + std::to_string(i) + "]";
+  if (p.struct_size != stride)
+    planarvo::throw_invalid_argument(where + ".struct_size is " + std::to_string(p.struct_size) + ", pairs[0]'s " +
+                                     std::to_string(stride) + ": every element needs the same (planarvo_motion_pair_init)");
+  auto require_covariance = [&](int32_t has, const double* c, const char* name) {
+    if (!has) return;
+    bool zero = true;
+    for (int k = 0; k < 9; ++k) {
+      if (!std::isfinite(c[k])) planarvo::throw_invalid_argument(where + "." + name + " is not finite");
+      zero = zero && c[k] == 0.0;
+    }
+    if (zero)
+      planarvo::throw_invalid_argument(where + "." + name + " is zero: clear has_" + name +
+                                       " to use the options' noise model");
+  };
+  require_covariance(p.has_sensor_covariance, p.sensor_covariance, "sensor_covariance");
+  require_covariance(p.has_odometry_covariance, p.odometry_covariance, "odometry_covariance");
+  if (p.has_odometry_covariance && !p.has_odometry)
+    planarvo::throw_invalid_argument(where + " has an odometry_covariance but no odometry");
+  planarvo::graph::MotionSample s;
+  s.interval = p.interval;
+  s.sensor = planarvo::capi::motion_from_c(p.sensor, p.has_sensor_covariance, p.sensor_covariance);
+  if (p.has_odometry)
+    s.odometry = planarvo::capi::motion_from_c(p.odometry, p.has_odometry_covariance, p.odometry_covariance);
+  if (p.has_direction) {
+    if (p.direction < -1 || p.direction > 1)
+      planarvo::throw_invalid_argument(where + ".direction is " + std::to_string(p.direction) +
+                                       ", not -1, 0 or +1");
+    s.direction = p.direction;
+  }
+  return s;
+}
 
 }  // namespace
 
@@ -109,18 +165,28 @@ PLANARVO_API planarvo_status planarvo_motion_pairs_load(const char* path, planar
     if (capacity < m.pairs.size())
       throw planarvo::capi::BufferTooSmall("planarvo_motion_pairs_load: " + std::to_string(m.pairs.size()) +
                                            " pairs, capacity " + std::to_string(capacity));
+    const size_t stride = motion_pair_stride(pairs);
     for (size_t i = 0; i < m.pairs.size(); ++i) {
       const planarvo::io::MotionPair& p = m.pairs[i];
-      planarvo_motion_pair& o = pairs[i];
-      std::memset(&o, 0, sizeof o);
+      planarvo_motion_pair o;
+      planarvo_motion_pair_init(&o);
+      o.struct_size = stride;
       o.interval = p.interval;
-      o.sensor = planarvo::capi::to_c(p.sensor.value);
+      planarvo::capi::motion_to_c(p.sensor, &o.sensor, &o.has_sensor_covariance, o.sensor_covariance);
       o.has_odometry = p.odometry.has_value();
-      if (p.odometry) o.odometry = planarvo::capi::to_c(p.odometry->value);
+      if (p.odometry)
+        planarvo::capi::motion_to_c(*p.odometry, &o.odometry, &o.has_odometry_covariance, o.odometry_covariance);
       o.has_direction = p.direction.has_value();
       if (p.direction) o.direction = *p.direction;
+      std::memcpy(element(pairs, stride, i), &o, std::min(stride, sizeof o));
     }
   });
+}
+
+PLANARVO_API void planarvo_motion_pair_init(planarvo_motion_pair* pair) {
+  if (!pair) return;
+  std::memset(pair, 0, sizeof *pair);
+  pair->struct_size = sizeof *pair;
 }
 
 PLANARVO_API void planarvo_calibration_options_init(planarvo_calibration_options* o) {
@@ -167,18 +233,10 @@ PLANARVO_API planarvo_status planarvo_calibrate(const planarvo_motion_pair* pair
     co.nonholonomic_form = o.velocity_form ? planarvo::graph::CalibrationOptions::NonholonomicForm::Velocity
                                            : planarvo::graph::CalibrationOptions::NonholonomicForm::Arc;
     co.solver.max_iterations = o.max_iterations;
-    std::vector<planarvo::graph::MotionSample> samples(count);
-    for (size_t i = 0; i < count; ++i) {
-      const planarvo_motion_pair& p = pairs[i];
-      planarvo::graph::MotionSample& s = samples[i];
-      s.interval = p.interval;
-      s.sensor.value = planarvo::capi::to_cpp(p.sensor);
-      if (p.has_odometry) s.odometry = planarvo::Motion{planarvo::capi::to_cpp(p.odometry)};
-      if (p.has_direction) {
-        require(p.direction >= -1 && p.direction <= 1, "planarvo_calibrate: a direction is not -1, 0 or +1");
-        s.direction = p.direction;
-      }
-    }
+    const size_t stride = motion_pair_stride(pairs);
+    std::vector<planarvo::graph::MotionSample> samples;
+    samples.reserve(count);
+    for (size_t i = 0; i < count; ++i) samples.push_back(read_pair(pairs, stride, i));
     const planarvo::graph::CalibrationResult r = planarvo::graph::calibrate(samples, co);
     send_lines(o.log, o.log_user_data, r.summary.full_report());
     planarvo_calibration_result out;

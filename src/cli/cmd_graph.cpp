@@ -110,6 +110,7 @@ int cmd_calibrate(int argc, char** argv) {
   size_t n = 0;
   check(planarvo_motion_pairs_load(path.c_str(), nullptr, 0, &n));
   std::vector<planarvo_motion_pair> pairs(n);
+  for (planarvo_motion_pair& p : pairs) planarvo_motion_pair_init(&p);
   check(planarvo_motion_pairs_load(path.c_str(), pairs.data(), n, &n));
   planarvo_calibration_result r{};
   r.struct_size = sizeof r;
