@@ -495,6 +495,13 @@ typedef enum planarvo_calibration_method {
   PLANARVO_CALIBRATE_NONHOLONOMIC = 1 /* x, yaw from the nonholonomic constraint; y from labels */
 } planarvo_calibration_method;
 
+typedef enum planarvo_robust_loss {
+  PLANARVO_ROBUST_LOSS_NONE = 0,   /* plain least squares */
+  PLANARVO_ROBUST_LOSS_HUBER = 1,
+  PLANARVO_ROBUST_LOSS_CAUCHY = 2,
+  PLANARVO_ROBUST_LOSS_TUKEY = 3
+} planarvo_robust_loss;
+
 typedef struct planarvo_calibration_options {
   size_t struct_size;
   planarvo_calibration_method method;  /* default ODOMETRY */
@@ -507,6 +514,29 @@ typedef struct planarvo_calibration_options {
   int32_t max_iterations;   /* default 100 */
   planarvo_log_fn log;      /* the solver's iteration table; NULL for none */
   void* log_user_data;
+  /* The noise model: standard deviations of a motion's (x, y, theta) for pairs that carry no
+   * covariance. Translation sqrt(floor^2 + (relative * |t|)^2), rotation
+   * sqrt(theta^2 + (relative * |dtheta|)^2): relative per unit of travel and per radian turned.
+   * Sensor in the sensor's units (those of its motions), odometry in metres; radians. All finite
+   * and >= 0; the theta ones > 0, and floor and relative not both 0. */
+  double sensor_sigma_relative;   /* default 0.01 */
+  double sensor_sigma_floor;      /* default 1e-4 (sensor units) */
+  double sensor_sigma_theta;      /* default 1e-3 rad */
+  double odometry_sigma_relative; /* default 0.01 */
+  double odometry_sigma_floor;    /* default 1e-4 m */
+  double odometry_sigma_theta;    /* default 2e-3 rad */
+  /* Gross errors (failed scan matches, tracking glitches): a first solve with the robust loss,
+   * then gating: a pair whose normalised squared residual exceeds gate_sigma^2 (times the
+   * residuals' own robust variance factor where that exceeds 1) loses its sensor motion, and the
+   * rest is re-solved by plain least squares, repeated while the gate drops more (outliers counts
+   * them). gate_sigma 0: no gating; the loss then stays on in the one solve. */
+  planarvo_robust_loss loss;      /* default PLANARVO_ROBUST_LOSS_CAUCHY */
+  double loss_scale;              /* where the loss starts, in standard deviations; default 3, > 0 */
+  double gate_sigma;              /* default 5; >= 0 */
+  /* Direction labels of pairs with odometry but no label (the nonholonomic method uses them): 0
+   * (no linear motion) when the odometry's forward speed is below this, else its sign. m/s,
+   * default 1e-3; >= 0. */
+  double still_speed;
 } planarvo_calibration_options;
 
 typedef struct planarvo_calibration_result {
@@ -519,7 +549,10 @@ typedef struct planarvo_calibration_result {
   int32_t outliers;         /* samples rejected as gross errors */
   int32_t ok;               /* converged, every estimated parameter observable, not ambiguous */
   char unobservable_reason[512];
-  planarvo_solver_summary summary;
+  planarvo_solver_summary summary; /* the final solve's */
+  int32_t total_iterations; /* Levenberg-Marquardt iterations over all solves (start, robust, gated) */
+  double total_seconds;     /* the whole calibration */
+  double variance_factor;   /* a-posteriori max(1, chi2/dof) of the final fit: covariance includes it */
 } planarvo_calibration_result;
 
 PLANARVO_API void planarvo_calibration_options_init(planarvo_calibration_options* options);

@@ -46,6 +46,58 @@ constexpr size_t kSummaryEnd = offsetof(planarvo_solver_summary, seconds) + size
 // The first versioned planarvo_motion_pair ended with direction; the covariances came after.
 constexpr size_t kMotionPairEnd = offsetof(planarvo_motion_pair, direction) + sizeof(int32_t);
 
+constexpr size_t kCalibrationResultEnd =
+    offsetof(planarvo_calibration_result, summary) + sizeof(planarvo_solver_summary);
+
+planarvo_robust_loss to_c(planarvo::graph::RobustLoss l) {
+  switch (l) {
+    case planarvo::graph::RobustLoss::None: return PLANARVO_ROBUST_LOSS_NONE;
+    case planarvo::graph::RobustLoss::Huber: return PLANARVO_ROBUST_LOSS_HUBER;
+    case planarvo::graph::RobustLoss::Cauchy: return PLANARVO_ROBUST_LOSS_CAUCHY;
+    case planarvo::graph::RobustLoss::Tukey: return PLANARVO_ROBUST_LOSS_TUKEY;
+  }
+  return PLANARVO_ROBUST_LOSS_CAUCHY;
+}
+planarvo::graph::RobustLoss to_cpp(planarvo_robust_loss l) {
+  switch (l) {
+    case PLANARVO_ROBUST_LOSS_NONE: return planarvo::graph::RobustLoss::None;
+    case PLANARVO_ROBUST_LOSS_HUBER: return planarvo::graph::RobustLoss::Huber;
+    case PLANARVO_ROBUST_LOSS_CAUCHY: return planarvo::graph::RobustLoss::Cauchy;
+    case PLANARVO_ROBUST_LOSS_TUKEY: return planarvo::graph::RobustLoss::Tukey;
+  }
+  planarvo::throw_invalid_argument("planarvo_calibration_options.loss is not a planarvo_robust_loss");
+}
+
+// The noise-model options in the header's words (graph::calibrate checks the same, in its own).
+void validate_noise_model(const planarvo_calibration_options& o) {
+  auto non_negative = [](double v, const char* name) {
+    if (!(std::isfinite(v) && v >= 0.0))
+      planarvo::throw_invalid_argument(std::string("planarvo_calibration_options.") + name +
+                                       " must be >= 0 and finite");
+  };
+  auto positive = [](double v, const char* name) {
+    if (!(std::isfinite(v) && v > 0.0))
+      planarvo::throw_invalid_argument(std::string("planarvo_calibration_options.") + name +
+                                       " must be > 0 and finite");
+  };
+  non_negative(o.sensor_sigma_relative, "sensor_sigma_relative");
+  non_negative(o.sensor_sigma_floor, "sensor_sigma_floor");
+  positive(o.sensor_sigma_theta, "sensor_sigma_theta");
+  non_negative(o.odometry_sigma_relative, "odometry_sigma_relative");
+  non_negative(o.odometry_sigma_floor, "odometry_sigma_floor");
+  positive(o.odometry_sigma_theta, "odometry_sigma_theta");
+  if (o.sensor_sigma_floor == 0.0 && o.sensor_sigma_relative == 0.0)
+    planarvo::throw_invalid_argument("planarvo_calibration_options.sensor_sigma_floor and sensor_sigma_relative are "
+                                     "both 0: a translation's standard deviation would be 0");
+  if (o.odometry_sigma_floor == 0.0 && o.odometry_sigma_relative == 0.0)
+    planarvo::throw_invalid_argument("planarvo_calibration_options.odometry_sigma_floor and odometry_sigma_relative "
+                                     "are both 0: a translation's standard deviation would be 0");
+  (void)to_cpp(o.loss);  // throws for a value that is not a planarvo_robust_loss
+  positive(o.loss_scale, "loss_scale");
+  non_negative(o.gate_sigma, "gate_sigma");
+  non_negative(o.still_speed, "still_speed");
+}
+
 // Element i of a caller's array of planarvo_motion_pair, whose stride is its struct_size.
 const void* element(const planarvo_motion_pair* pairs, size_t stride, size_t i) {
   return reinterpret_cast<const unsigned char*>(pairs) + i * stride;
@@ -199,6 +251,16 @@ PLANARVO_API void planarvo_calibration_options_init(planarvo_calibration_options
   o->fixed_scale = d.fixed_scale;
   o->velocity_form = 0;
   o->max_iterations = d.solver.max_iterations;
+  o->sensor_sigma_relative = d.sensor_sigma_relative;
+  o->sensor_sigma_floor = d.sensor_sigma_floor;
+  o->sensor_sigma_theta = d.sensor_sigma_theta;
+  o->odometry_sigma_relative = d.odometry_sigma_relative;
+  o->odometry_sigma_floor = d.odometry_sigma_floor;
+  o->odometry_sigma_theta = d.odometry_sigma_theta;
+  o->loss = to_c(d.loss);
+  o->loss_scale = d.loss_scale;
+  o->gate_sigma = d.gate_sigma;
+  o->still_speed = d.still_speed;
 }
 
 PLANARVO_API planarvo_status planarvo_calibrate(const planarvo_motion_pair* pairs, size_t count,
@@ -208,8 +270,7 @@ PLANARVO_API planarvo_status planarvo_calibrate(const planarvo_motion_pair* pair
   std::string reason;
   const planarvo_status st = guard([&] {
     require(result != nullptr, "planarvo_calibrate: result is NULL");
-    planarvo::capi::require_struct_size(result->struct_size, sizeof(planarvo_calibration_result),
-                                        "planarvo_calibration_result");
+    planarvo::capi::require_struct_size(result->struct_size, kCalibrationResultEnd, "planarvo_calibration_result");
     require(count > 0 && pairs != nullptr, "planarvo_calibrate: no motion pairs");
     planarvo_calibration_options o;
     planarvo_calibration_options_init(&o);
@@ -224,6 +285,7 @@ PLANARVO_API planarvo_status planarvo_calibrate(const planarvo_motion_pair* pair
     require(o.max_iterations > 0, "planarvo_calibration_options.max_iterations must be positive");
     require(!o.fix_scale || (std::isfinite(o.fixed_scale) && o.fixed_scale > 0),
             "planarvo_calibration_options.fixed_scale must be positive");
+    validate_noise_model(o);
     planarvo::graph::CalibrationOptions co;
     co.method = o.method == PLANARVO_CALIBRATE_ODOMETRY ? planarvo::graph::CalibrationMethod::Odometry
                                                         : planarvo::graph::CalibrationMethod::Nonholonomic;
@@ -233,6 +295,16 @@ PLANARVO_API planarvo_status planarvo_calibrate(const planarvo_motion_pair* pair
     co.nonholonomic_form = o.velocity_form ? planarvo::graph::CalibrationOptions::NonholonomicForm::Velocity
                                            : planarvo::graph::CalibrationOptions::NonholonomicForm::Arc;
     co.solver.max_iterations = o.max_iterations;
+    co.sensor_sigma_relative = o.sensor_sigma_relative;
+    co.sensor_sigma_floor = o.sensor_sigma_floor;
+    co.sensor_sigma_theta = o.sensor_sigma_theta;
+    co.odometry_sigma_relative = o.odometry_sigma_relative;
+    co.odometry_sigma_floor = o.odometry_sigma_floor;
+    co.odometry_sigma_theta = o.odometry_sigma_theta;
+    co.loss = to_cpp(o.loss);
+    co.loss_scale = o.loss_scale;
+    co.gate_sigma = o.gate_sigma;
+    co.still_speed = o.still_speed;
     const size_t stride = motion_pair_stride(pairs);
     std::vector<planarvo::graph::MotionSample> samples;
     samples.reserve(count);
@@ -253,6 +325,9 @@ PLANARVO_API planarvo_status planarvo_calibrate(const planarvo_motion_pair* pair
     planarvo::capi::copy_string(out.unobservable_reason, sizeof out.unobservable_reason, r.unobservable_reason);
     out.summary.struct_size = sizeof out.summary;
     fill_summary(r.summary, 2.0 * r.summary.initial_cost, 2.0 * r.summary.final_cost, &out.summary);
+    out.total_iterations = r.total_iterations;
+    out.total_seconds = r.total_time_s;
+    out.variance_factor = r.variance_factor;
     planarvo::capi::write_versioned(out, result);
     ok = r.ok();
     reason = r.ambiguous ? std::string("ambiguous: (x, yaw) and (-x, yaw + 180 deg) fit equally; give direction "

@@ -98,6 +98,18 @@ CalibrationOptions graph_options(const planarvo_calibration_options& o) {
                                                      : graph::CalibrationMethod::Nonholonomic;
   g.fix_scale = o.fix_scale != 0;
   g.fixed_scale = o.fixed_scale;
+  g.sensor_sigma_relative = o.sensor_sigma_relative;
+  g.sensor_sigma_floor = o.sensor_sigma_floor;
+  g.sensor_sigma_theta = o.sensor_sigma_theta;
+  g.odometry_sigma_relative = o.odometry_sigma_relative;
+  g.odometry_sigma_floor = o.odometry_sigma_floor;
+  g.odometry_sigma_theta = o.odometry_sigma_theta;
+  const graph::RobustLoss losses[4] = {graph::RobustLoss::None, graph::RobustLoss::Huber, graph::RobustLoss::Cauchy,
+                                       graph::RobustLoss::Tukey};
+  g.loss = losses[o.loss];
+  g.loss_scale = o.loss_scale;
+  g.gate_sigma = o.gate_sigma;
+  g.still_speed = o.still_speed;
   return g;
 }
 
@@ -121,6 +133,8 @@ void expect_same(const planarvo_calibration_result& c, const CalibrationResult& 
   EXPECT_EQ(c.ok != 0, g.ok());
   EXPECT_EQ(c.summary.iterations, g.summary.num_iterations);
   EXPECT_STREQ(c.unobservable_reason, g.unobservable_reason.c_str());
+  EXPECT_EQ(c.total_iterations, g.total_iterations);
+  EXPECT_NEAR(c.variance_factor, g.variance_factor, 1e-12 * g.variance_factor);
 }
 
 bool same_values(const planarvo_calibration_result& a, const planarvo_calibration_result& b) {
@@ -377,6 +391,178 @@ TEST(CApiCalibrate, RejectsUnusablePairs) {
   p = good;
   p[6].direction = 2;
   expect_rejected(p, "pairs[6].direction");
+}
+
+TEST(CApiCalibrationOptions, InitTakesTheGraphDefaults) {
+  planarvo_calibration_options o;
+  planarvo_calibration_options_init(&o);
+  const CalibrationOptions d;
+  EXPECT_EQ(o.struct_size, sizeof o);
+  EXPECT_EQ(o.sensor_sigma_relative, d.sensor_sigma_relative);
+  EXPECT_EQ(o.sensor_sigma_floor, d.sensor_sigma_floor);
+  EXPECT_EQ(o.sensor_sigma_theta, d.sensor_sigma_theta);
+  EXPECT_EQ(o.odometry_sigma_relative, d.odometry_sigma_relative);
+  EXPECT_EQ(o.odometry_sigma_floor, d.odometry_sigma_floor);
+  EXPECT_EQ(o.odometry_sigma_theta, d.odometry_sigma_theta);
+  EXPECT_EQ(o.loss, PLANARVO_ROBUST_LOSS_CAUCHY);
+  EXPECT_EQ(d.loss, graph::RobustLoss::Cauchy);
+  EXPECT_EQ(o.loss_scale, d.loss_scale);
+  EXPECT_EQ(o.gate_sigma, d.gate_sigma);
+  EXPECT_EQ(o.still_speed, d.still_speed);
+}
+
+// Each noise-model option changes the result, and exactly as it changes graph::calibrate's.
+TEST(CApiCalibrationOptions, NoiseModelReachesTheSolver) {
+  const auto samples = without_covariances(test::simulate_motions(kTruth, noisy_sim(8)).samples);
+  const auto pairs = to_pairs(samples);
+  planarvo_calibration_options d;
+  planarvo_calibration_options_init(&d);
+  const auto base = calibrate_c(pairs.data(), pairs.size(), d);
+  EXPECT_GT(base.outliers, 0);
+  struct Variant {
+    const char* name;
+    void (*set)(planarvo_calibration_options*);
+  };
+  const Variant variants[] = {
+      {"sensor_sigma_relative", [](planarvo_calibration_options* o) { o->sensor_sigma_relative = 0.03; }},
+      {"sensor_sigma_floor", [](planarvo_calibration_options* o) { o->sensor_sigma_floor = 0.01; }},
+      {"sensor_sigma_theta", [](planarvo_calibration_options* o) { o->sensor_sigma_theta = 0.01; }},
+      {"odometry_sigma_relative", [](planarvo_calibration_options* o) { o->odometry_sigma_relative = 0.03; }},
+      {"odometry_sigma_floor", [](planarvo_calibration_options* o) { o->odometry_sigma_floor = 0.003; }},
+      {"odometry_sigma_theta", [](planarvo_calibration_options* o) { o->odometry_sigma_theta = 0.01; }},
+      {"loss none", [](planarvo_calibration_options* o) { o->loss = PLANARVO_ROBUST_LOSS_NONE; }},
+      {"loss huber", [](planarvo_calibration_options* o) { o->loss = PLANARVO_ROBUST_LOSS_HUBER; }},
+      {"loss tukey", [](planarvo_calibration_options* o) { o->loss = PLANARVO_ROBUST_LOSS_TUKEY; }},
+      {"loss_scale", [](planarvo_calibration_options* o) { o->loss_scale = 1.0; }},
+      {"gate_sigma 3", [](planarvo_calibration_options* o) { o->gate_sigma = 3.0; }},
+      {"gate_sigma 0", [](planarvo_calibration_options* o) { o->gate_sigma = 0.0; }},
+  };
+  for (const Variant& v : variants) {
+    planarvo_calibration_options o = d;
+    v.set(&o);
+    const auto c = calibrate_c(pairs.data(), pairs.size(), o);
+    SCOPED_TRACE(v.name);
+    expect_same(c, graph::calibrate(samples, graph_options(o)));
+    EXPECT_FALSE(same_values(c, base));
+  }
+  // Gating on (5) and off (0): the gross errors are dropped, or only down-weighted.
+  planarvo_calibration_options no_gate = d;
+  no_gate.gate_sigma = 0.0;
+  EXPECT_EQ(calibrate_c(pairs.data(), pairs.size(), no_gate).outliers, 0);
+}
+
+// still_speed labels the intervals that carry odometry but no label: at 0, turning in place
+// (odometry's forward motion exactly 0) counts as backwards, which moves y.
+TEST(CApiCalibrationOptions, StillSpeedLabelsFromOdometry) {
+  CalibrationSim sim;
+  sim.sensor_sigma_t = 0.003 / kTruth[2];
+  sim.sensor_sigma_theta = 0.003;
+  sim.labels = false;
+  const auto samples = without_covariances(test::simulate_motions(kTruth, sim).samples);
+  const auto pairs = to_pairs(samples);
+  planarvo_calibration_options o = metric_options();
+  o.method = PLANARVO_CALIBRATE_NONHOLONOMIC;
+  const auto labelled = calibrate_c(pairs.data(), pairs.size(), o);
+  expect_same(labelled, graph::calibrate(samples, graph_options(o)));
+  EXPECT_NEAR(labelled.value[1], kTruth[1], 0.002);
+  o.still_speed = 0.0;
+  const auto zero = calibrate_c(pairs.data(), pairs.size(), o, PLANARVO_ERROR_FAILED);
+  expect_same(zero, graph::calibrate(samples, graph_options(o)));
+  EXPECT_NE(zero.value[1], labelled.value[1]);
+}
+
+TEST(CApiCalibrationOptions, AnOlderOptionsStructTakesTheDefaults) {
+  const auto samples = without_covariances(test::simulate_motions(kTruth, noisy_sim(9)).samples);
+  const auto pairs = to_pairs(samples);
+  planarvo_calibration_options d;
+  planarvo_calibration_options_init(&d);
+  const auto base = calibrate_c(pairs.data(), pairs.size(), d);
+  planarvo_calibration_options old = d;
+  old.struct_size = offsetof(planarvo_calibration_options, log_user_data) + sizeof(void*);
+  old.sensor_sigma_theta = -1.0;  // beyond the caller's struct: never read
+  old.gate_sigma = std::nan("");
+  old.loss = static_cast<planarvo_robust_loss>(99);
+  EXPECT_TRUE(same_values(calibrate_c(pairs.data(), pairs.size(), old), base));
+}
+
+TEST(CApiCalibrationOptions, InvalidNoiseModelNamesTheField) {
+  const auto samples = test::simulate_motions(kTruth, CalibrationSim{}).samples;
+  const auto pairs = to_pairs(samples);
+  planarvo_calibration_options d;
+  planarvo_calibration_options_init(&d);
+  auto expect_rejected = [&](const planarvo_calibration_options& o, const std::string& message) {
+    calibrate_c(pairs.data(), pairs.size(), o, PLANARVO_ERROR_INVALID_ARGUMENT);
+    EXPECT_NE(std::string(planarvo_last_error()).find(message), std::string::npos) << planarvo_last_error();
+  };
+  double planarvo_calibration_options::*const non_negative[] = {
+      &planarvo_calibration_options::sensor_sigma_relative, &planarvo_calibration_options::sensor_sigma_floor,
+      &planarvo_calibration_options::odometry_sigma_relative, &planarvo_calibration_options::odometry_sigma_floor,
+      &planarvo_calibration_options::gate_sigma, &planarvo_calibration_options::still_speed};
+  const char* const non_negative_names[] = {"sensor_sigma_relative",   "sensor_sigma_floor", "odometry_sigma_relative",
+                                            "odometry_sigma_floor",    "gate_sigma",         "still_speed"};
+  for (size_t i = 0; i < 6; ++i)
+    for (double bad : {-1e-9, std::nan(""), HUGE_VAL}) {
+      planarvo_calibration_options o = d;
+      o.*non_negative[i] = bad;
+      expect_rejected(o, std::string("planarvo_calibration_options.") + non_negative_names[i] + " must be >= 0");
+    }
+  double planarvo_calibration_options::*const positive[] = {&planarvo_calibration_options::sensor_sigma_theta,
+                                                            &planarvo_calibration_options::odometry_sigma_theta,
+                                                            &planarvo_calibration_options::loss_scale};
+  const char* const positive_names[] = {"sensor_sigma_theta", "odometry_sigma_theta", "loss_scale"};
+  for (size_t i = 0; i < 3; ++i)
+    for (double bad : {0.0, -1.0, std::nan("")}) {
+      planarvo_calibration_options o = d;
+      o.*positive[i] = bad;
+      expect_rejected(o, std::string("planarvo_calibration_options.") + positive_names[i] + " must be > 0");
+    }
+  planarvo_calibration_options o = d;
+  o.sensor_sigma_floor = o.sensor_sigma_relative = 0.0;
+  expect_rejected(o, "planarvo_calibration_options.sensor_sigma_floor and sensor_sigma_relative");
+  o = d;
+  o.odometry_sigma_floor = o.odometry_sigma_relative = 0.0;
+  expect_rejected(o, "planarvo_calibration_options.odometry_sigma_floor and odometry_sigma_relative");
+  o = d;
+  o.loss = static_cast<planarvo_robust_loss>(4);
+  expect_rejected(o, "planarvo_calibration_options.loss");
+  // Zero floor or relative part alone is a valid model.
+  o = d;
+  o.sensor_sigma_floor = 0.0;
+  o.odometry_sigma_relative = 0.0;
+  calibrate_c(pairs.data(), pairs.size(), o);
+}
+
+TEST(CApiCalibrationResult, TotalsCoverEverySolve) {
+  const auto samples = without_covariances(test::simulate_motions(kTruth, noisy_sim(10)).samples);
+  const auto pairs = to_pairs(samples);
+  planarvo_calibration_options o;
+  planarvo_calibration_options_init(&o);
+  const auto c = calibrate_c(pairs.data(), pairs.size(), o);
+  const CalibrationResult g = graph::calibrate(samples, graph_options(o));
+  expect_same(c, g);  // total_iterations and variance_factor included
+  EXPECT_GT(c.total_iterations, c.summary.iterations);  // a robust pass, then gated ones
+  EXPECT_GT(c.variance_factor, 0.0);
+  EXPECT_GE(c.total_seconds, c.summary.seconds);
+  EXPECT_GT(c.total_seconds, 0.0);
+}
+
+TEST(CApiCalibrationResult, AnOlderResultStructIsWrittenNoFurther) {
+  const auto samples = test::simulate_motions(kTruth, CalibrationSim{}).samples;
+  const auto pairs = to_pairs(samples);
+  planarvo_calibration_options o;
+  planarvo_calibration_options_init(&o);
+  const size_t first = offsetof(planarvo_calibration_result, summary) + sizeof(planarvo_solver_summary);
+  planarvo_calibration_result r;
+  std::memset(&r, 0x5a, sizeof r);
+  r.struct_size = first;
+  ASSERT_EQ(planarvo_calibrate(pairs.data(), pairs.size(), &o, &r), PLANARVO_OK) << planarvo_last_error();
+  EXPECT_EQ(r.struct_size, first);
+  EXPECT_NEAR(r.value[0], kTruth[0], 1e-9);
+  std::vector<unsigned char> tail(sizeof r - first, 0x5a);
+  EXPECT_EQ(std::memcmp(reinterpret_cast<const unsigned char*>(&r) + first, tail.data(), tail.size()), 0);
+  r.struct_size = first - 1;
+  EXPECT_EQ(planarvo_calibrate(pairs.data(), pairs.size(), &o, &r), PLANARVO_ERROR_INVALID_ARGUMENT);
+  EXPECT_NE(std::string(planarvo_last_error()).find("planarvo_calibration_result.struct_size"), std::string::npos);
 }
 
 }  // namespace
