@@ -457,19 +457,36 @@ PLANARVO_API planarvo_status planarvo_posegraph_optimize(const char* in_path, co
 
 /* One interval of planar motion: the sensor's own motion (its frame at the interval's start;
  * translation in metres for a metric sensor, in units of the camera height for the tracker run
- * at height 1), optionally the robot's motion from wheel odometry and a direction label. */
+ * at height 1), optionally the robot's motion from wheel odometry and a direction label.
+ * Versioned like the option structs: set struct_size with planarvo_motion_pair_init. In an array
+ * the stride between elements is pairs[0].struct_size, and every element has the same one, so an
+ * array built against an older header keeps working (its missing fields take their defaults). */
 typedef struct planarvo_motion_pair {
+  size_t struct_size;       /* sizeof(planarvo_motion_pair) */
   double interval;          /* seconds */
   planarvo_se2 sensor;
   int32_t has_odometry;
   planarvo_se2 odometry;
   int32_t has_direction;
   int32_t direction;        /* +1 forwards, -1 backwards, 0 no linear motion */
+  /* Covariances of the motions, 3x3 row-major, order x y theta, in the motions' units (the
+   * sensor's units, metres for odometry; radians): of the right perturbation xi in motion*exp(xi),
+   * as the tracker reports it. Without one (has_ 0, the default) planarvo_calibrate uses the
+   * options' noise model (sensor_sigma_..., odometry_sigma_...). */
+  int32_t has_sensor_covariance;
+  double sensor_covariance[9];
+  int32_t has_odometry_covariance; /* needs has_odometry */
+  double odometry_covariance[9];
 } planarvo_motion_pair;
+
+/* Zeroes *pair (no odometry, direction or covariances) and sets its struct_size. */
+PLANARVO_API void planarvo_motion_pair_init(planarvo_motion_pair* pair);
 
 /* Reads a motion-pair CSV (columns interval_s, [odo_dx, odo_dy, odo_dtheta,] sensor_dx, sensor_dy,
  * sensor_dtheta[, direction]; without a direction column the odometry's forward motion gives it).
- * Call with pairs = NULL for the count, then with capacity >= count. */
+ * Call with pairs = NULL for the count, then with capacity >= count and pairs[0].struct_size set
+ * (planarvo_motion_pair_init): every element is written at that stride, no further than that
+ * size, with that struct_size and no covariances (the file has none). */
 PLANARVO_API planarvo_status planarvo_motion_pairs_load(const char* path, planarvo_motion_pair* pairs,
                                                         size_t capacity, size_t* count);
 
@@ -477,6 +494,13 @@ typedef enum planarvo_calibration_method {
   PLANARVO_CALIBRATE_ODOMETRY = 0,    /* x, y, scale (height), yaw against wheel odometry */
   PLANARVO_CALIBRATE_NONHOLONOMIC = 1 /* x, yaw from the nonholonomic constraint; y from labels */
 } planarvo_calibration_method;
+
+typedef enum planarvo_robust_loss {
+  PLANARVO_ROBUST_LOSS_NONE = 0,   /* plain least squares */
+  PLANARVO_ROBUST_LOSS_HUBER = 1,
+  PLANARVO_ROBUST_LOSS_CAUCHY = 2,
+  PLANARVO_ROBUST_LOSS_TUKEY = 3
+} planarvo_robust_loss;
 
 typedef struct planarvo_calibration_options {
   size_t struct_size;
@@ -490,6 +514,29 @@ typedef struct planarvo_calibration_options {
   int32_t max_iterations;   /* default 100 */
   planarvo_log_fn log;      /* the solver's iteration table; NULL for none */
   void* log_user_data;
+  /* The noise model: standard deviations of a motion's (x, y, theta) for pairs that carry no
+   * covariance. Translation sqrt(floor^2 + (relative * |t|)^2), rotation
+   * sqrt(theta^2 + (relative * |dtheta|)^2): relative per unit of travel and per radian turned.
+   * Sensor in the sensor's units (those of its motions), odometry in metres; radians. All finite
+   * and >= 0; the theta ones > 0, and floor and relative not both 0. */
+  double sensor_sigma_relative;   /* default 0.01 */
+  double sensor_sigma_floor;      /* default 1e-4 (sensor units) */
+  double sensor_sigma_theta;      /* default 1e-3 rad */
+  double odometry_sigma_relative; /* default 0.01 */
+  double odometry_sigma_floor;    /* default 1e-4 m */
+  double odometry_sigma_theta;    /* default 2e-3 rad */
+  /* Gross errors (failed scan matches, tracking glitches): a first solve with the robust loss,
+   * then gating: a pair whose normalised squared residual exceeds gate_sigma^2 (times the
+   * residuals' own robust variance factor where that exceeds 1) loses its sensor motion, and the
+   * rest is re-solved by plain least squares, repeated while the gate drops more (outliers counts
+   * them). gate_sigma 0: no gating; the loss then stays on in the one solve. */
+  planarvo_robust_loss loss;      /* default PLANARVO_ROBUST_LOSS_CAUCHY */
+  double loss_scale;              /* where the loss starts, in standard deviations; default 3, > 0 */
+  double gate_sigma;              /* default 5; >= 0 */
+  /* Direction labels of pairs with odometry but no label (the nonholonomic method uses them): 0
+   * (no linear motion) when the odometry's forward speed is below this, else its sign. m/s,
+   * default 1e-3; >= 0. */
+  double still_speed;
 } planarvo_calibration_options;
 
 typedef struct planarvo_calibration_result {
@@ -502,13 +549,16 @@ typedef struct planarvo_calibration_result {
   int32_t outliers;         /* samples rejected as gross errors */
   int32_t ok;               /* converged, every estimated parameter observable, not ambiguous */
   char unobservable_reason[512];
-  planarvo_solver_summary summary;
+  planarvo_solver_summary summary; /* the final solve's */
+  int32_t total_iterations; /* Levenberg-Marquardt iterations over all solves (start, robust, gated) */
+  double total_seconds;     /* the whole calibration */
+  double variance_factor;   /* a-posteriori max(1, chi2/dof) of the final fit: covariance includes it */
 } planarvo_calibration_result;
 
 PLANARVO_API void planarvo_calibration_options_init(planarvo_calibration_options* options);
-/* Calibrates from count motion pairs. Returns PLANARVO_ERROR_FAILED (with the reason as the
- * message) when the result is not ok: unobservable, ambiguous or not converged; the result is
- * filled in either case. */
+/* Calibrates from an array of count motion pairs (stride pairs[0].struct_size). Returns
+ * PLANARVO_ERROR_FAILED (with the reason as the message) when the result is not ok: unobservable,
+ * ambiguous or not converged; the result is filled in either case. */
 PLANARVO_API planarvo_status planarvo_calibrate(const planarvo_motion_pair* pairs, size_t count,
                                                 const planarvo_calibration_options* options,
                                                 planarvo_calibration_result* result);

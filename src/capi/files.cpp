@@ -61,8 +61,7 @@ PLANARVO_API planarvo_status planarvo_extrinsics_save(const char* path, const pl
     f.value = planarvo::capi::to_cpp(*e);
     for (double v : {e->x, e->y, e->z, e->roll, e->pitch, e->yaw})
       require(std::isfinite(v), "planarvo_extrinsics_save: a value is NaN or inf");
-    if (covariance)
-      for (int i = 0; i < 36; ++i) f.covariance(i / 6, i % 6) = covariance[i];
+    if (covariance) f.covariance = planarvo::capi::matrix_from_c<6>(covariance);
     if (estimated) {
       std::stringstream ss(estimated);
       std::string name;

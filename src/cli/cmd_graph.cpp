@@ -1,6 +1,7 @@
 // `planarvo posegraph` and `planarvo calibrate`: graph optimisation, no OpenCL device.
 #include <cmath>
 #include <cstdio>
+#include <initializer_list>
 #include <string>
 #include <vector>
 
@@ -12,6 +13,28 @@ namespace {
 constexpr double kDeg = M_PI / 180.0;
 
 void print_line(void*, const char* line) { std::printf("  %s\n", line); }
+
+// "a,b,c" with up to 6 significant digits, for the help's defaults.
+std::string join(std::initializer_list<double> v) {
+  std::string s;
+  char buf[32];
+  for (double x : v) {
+    std::snprintf(buf, sizeof buf, "%.6g", x);
+    s += (s.empty() ? "" : ",") + std::string(buf);
+  }
+  return s;
+}
+
+// --sensor-sigma / --odometry-sigma REL,FLOOR,THETA_DEG into the options' three fields.
+void set_sigmas(const Args& args, const std::string& name, double* relative, double* floor, double* theta) {
+  if (!args.has(name)) return;
+  const auto v = args.get_doubles(name, 3);
+  if (!(v[0] >= 0 && v[1] >= 0 && v[2] > 0 && (v[0] > 0 || v[1] > 0)))
+    throw UsageError("--" + name + " REL,FLOOR,THETA_DEG: REL and FLOOR >= 0, not both 0, and THETA_DEG > 0");
+  *relative = v[0];
+  *floor = v[1];
+  *theta = v[2] * kDeg;
+}
 
 }  // namespace
 
@@ -54,6 +77,8 @@ int cmd_posegraph(int argc, char** argv) {
 }
 
 int cmd_calibrate(int argc, char** argv) {
+  planarvo_calibration_options o;
+  planarvo_calibration_options_init(&o);
   const std::vector<OptionSpec> specs = {
       {"motions", "FILE.csv", "motion pairs (interval_s, [odo_dx, odo_dy, odo_dtheta,] sensor_dx, sensor_dy, "
                               "sensor_dtheta[, direction])", ""},
@@ -62,6 +87,15 @@ int cmd_calibrate(int argc, char** argv) {
       {"height", "METRES", "the camera height is known: hold the scale at it", ""},
       {"initial", "x,y,scale,yaw", "start here (metres, degrees) instead of the built-in initialisation", ""},
       {"velocity-form", "", "nonholonomic: the paper's velocity form instead of the exact arc form", ""},
+      {"sensor-sigma", "REL,FLOOR,THETA_DEG", "noise of the sensor's motions: relative part (per unit of travel and "
+                                              "per radian), translation floor (sensor units), rotation floor (deg)",
+       join({o.sensor_sigma_relative, o.sensor_sigma_floor, o.sensor_sigma_theta / kDeg})},
+      {"odometry-sigma", "REL,FLOOR,THETA_DEG", "noise of the odometry's motions, as --sensor-sigma (floor in metres)",
+       join({o.odometry_sigma_relative, o.odometry_sigma_floor, o.odometry_sigma_theta / kDeg})},
+      {"loss", "KIND", "robust loss of the first solve: none | huber | cauchy | tukey", "cauchy"},
+      {"loss-scale", "SIGMAS", "where the loss starts, in standard deviations", join({o.loss_scale})},
+      {"gate-sigma", "SIGMAS", "drop motions whose residual exceeds this many standard deviations; 0: no gating",
+       join({o.gate_sigma})},
       {"output", "FILE", "write the extrinsics YAML to FILE (also -o)", ""},
       {"verbose", "", "print the solver's iteration table", ""},
       {"help", "", "show this help", ""}};
@@ -76,8 +110,6 @@ int cmd_calibrate(int argc, char** argv) {
     return args.has("help") ? kExitOk : kExitUsage;
   }
   if (!args.positionals().empty()) throw UsageError("unexpected argument " + args.positionals()[0]);
-  planarvo_calibration_options o;
-  planarvo_calibration_options_init(&o);
   const std::string method = args.get("method", "odometry");
   if (method == "odometry") o.method = PLANARVO_CALIBRATE_ODOMETRY;
   else if (method == "nonholonomic") o.method = PLANARVO_CALIBRATE_NONHOLONOMIC;
@@ -104,12 +136,25 @@ int cmd_calibrate(int argc, char** argv) {
     o.initial[3] = v[3] * kDeg;
   }
   o.velocity_form = args.has("velocity-form") ? 1 : 0;
+  set_sigmas(args, "sensor-sigma", &o.sensor_sigma_relative, &o.sensor_sigma_floor, &o.sensor_sigma_theta);
+  set_sigmas(args, "odometry-sigma", &o.odometry_sigma_relative, &o.odometry_sigma_floor, &o.odometry_sigma_theta);
+  const std::string loss = args.get("loss", "cauchy");
+  if (loss == "none") o.loss = PLANARVO_ROBUST_LOSS_NONE;
+  else if (loss == "huber") o.loss = PLANARVO_ROBUST_LOSS_HUBER;
+  else if (loss == "cauchy") o.loss = PLANARVO_ROBUST_LOSS_CAUCHY;
+  else if (loss == "tukey") o.loss = PLANARVO_ROBUST_LOSS_TUKEY;
+  else throw UsageError("--loss must be none, huber, cauchy or tukey, not \"" + loss + "\"");
+  o.loss_scale = args.get_double("loss-scale", o.loss_scale);
+  if (!(o.loss_scale > 0)) throw UsageError("--loss-scale must be positive");
+  o.gate_sigma = args.get_double("gate-sigma", o.gate_sigma);
+  if (!(o.gate_sigma >= 0)) throw UsageError("--gate-sigma must be >= 0");
   if (args.has("verbose")) o.log = &print_line;
 
   const std::string path = args.get("motions");
   size_t n = 0;
   check(planarvo_motion_pairs_load(path.c_str(), nullptr, 0, &n));
   std::vector<planarvo_motion_pair> pairs(n);
+  for (planarvo_motion_pair& p : pairs) planarvo_motion_pair_init(&p);
   check(planarvo_motion_pairs_load(path.c_str(), pairs.data(), n, &n));
   planarvo_calibration_result r{};
   r.struct_size = sizeof r;
@@ -131,7 +176,9 @@ int cmd_calibrate(int argc, char** argv) {
     std::printf("  %-5s %10.3f %-3s  +- %.3f%s\n", names[i], r.value[i] * k, unit, sd * k,
                 r.observable[i] ? "" : "  UNOBSERVABLE");
   }
-  std::printf("solver: %d iterations, %s\n", r.summary.iterations, r.summary.termination);
+  std::printf("solver: %d iterations over all solves, %.3f s; the final solve: %d iterations, %s\n",
+              r.total_iterations, r.total_seconds, r.summary.iterations, r.summary.termination);
+  std::printf("variance factor %.3g (included in the +-)\n", r.variance_factor);
   if (r.ambiguous) std::printf("ambiguous: (-x, -y, yaw + 180 deg) fits equally well\n");
   if (r.unobservable_reason[0]) std::printf("%s\n", r.unobservable_reason);
 

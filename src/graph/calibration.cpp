@@ -73,16 +73,16 @@ void validate(const std::vector<MotionSample>& samples, const CalibrationOptions
     const std::string where = "calibrate: sample " + std::to_string(i) + ": ";
     if (!(s.interval > 0.0) || !std::isfinite(s.interval))
       throw_invalid_argument(where + "the interval must be positive and finite");
-    if (!finite(s.sensor)) throw_invalid_argument(where + "the sensor motion is not finite");
-    if (s.odometry && !finite(*s.odometry))
+    if (!finite(s.sensor.value)) throw_invalid_argument(where + "the sensor motion is not finite");
+    if (s.odometry && !finite(s.odometry->value))
       throw_invalid_argument(where + "the odometry motion is not finite");
     if (o.method == CalibrationMethod::Odometry && !s.odometry)
       throw_invalid_argument(where + "no odometry (the odometry method needs it on every sample)");
     if (s.direction && (*s.direction < -1 || *s.direction > 1))
       throw_invalid_argument(where + "the direction must be -1, 0 or +1");
-    if (s.sensor_covariance && !spd(*s.sensor_covariance))
+    if (s.sensor.has_covariance() && !spd(s.sensor.covariance))
       throw_invalid_argument(where + "the sensor covariance is not symmetric positive definite");
-    if (s.odometry_covariance && !spd(*s.odometry_covariance))
+    if (s.odometry && s.odometry->has_covariance() && !spd(s.odometry->covariance))
       throw_invalid_argument(where + "the odometry covariance is not symmetric positive definite");
   }
   auto positive = [](double v) { return v > 0.0 && std::isfinite(v); };
@@ -110,10 +110,13 @@ void validate(const std::vector<MotionSample>& samples, const CalibrationOptions
   }
 }
 
-// Covariance of a motion's (x, y, θ): given, or the options' model.
-Eigen::Matrix3d model_covariance(const SE2& m, double relative, double floor, double sigma_theta) {
-  const double t2 = sq(floor) + sq(relative * std::hypot(m.x, m.y));
-  const double r2 = sq(sigma_theta) + sq(relative * m.theta);
+// Covariance of a motion's (x, y, θ) as numbers (what the factors and the variance propagation
+// below take): the given one (of the right perturbation, so rotated into the motion's start
+// frame), or the options' model (isotropic in translation: the same in either frame).
+Eigen::Matrix3d motion_covariance(const Motion& m, double relative, double floor, double sigma_theta) {
+  if (m.has_covariance()) return component_covariance(m);
+  const double t2 = sq(floor) + sq(relative * std::hypot(m.value.x, m.value.y));
+  const double r2 = sq(sigma_theta) + sq(relative * m.value.theta);
   return Eigen::Vector3d(t2, t2, r2).asDiagonal();
 }
 
@@ -173,15 +176,11 @@ struct Context {
   Context(const std::vector<MotionSample>& s, const CalibrationOptions& o)
       : samples(s), options(o), inlier(s.size(), 1) {
     for (const MotionSample& m : s) {
-      sensor_cov.push_back(m.sensor_covariance
-                               ? *m.sensor_covariance
-                               : model_covariance(m.sensor, o.sensor_sigma_relative,
-                                                  o.sensor_sigma_floor, o.sensor_sigma_theta));
-      odo_cov.push_back(m.odometry_covariance ? *m.odometry_covariance
-                        : m.odometry ? model_covariance(*m.odometry, o.odometry_sigma_relative,
-                                                        o.odometry_sigma_floor,
-                                                        o.odometry_sigma_theta)
-                                     : Eigen::Matrix3d(Eigen::Matrix3d::Identity()));
+      sensor_cov.push_back(motion_covariance(m.sensor, o.sensor_sigma_relative, o.sensor_sigma_floor,
+                                             o.sensor_sigma_theta));
+      odo_cov.push_back(m.odometry ? motion_covariance(*m.odometry, o.odometry_sigma_relative,
+                                                       o.odometry_sigma_floor, o.odometry_sigma_theta)
+                                   : Eigen::Matrix3d(Eigen::Matrix3d::Identity()));
     }
   }
   void record(const SolverSummary& s) {
@@ -193,7 +192,7 @@ struct Context {
     std::vector<SE2> m;
     for (size_t i = 0; i < samples.size(); ++i)
       if (inlier[i]) {
-        m.push_back(samples[i].sensor);
+        m.push_back(samples[i].sensor.value);
         sigma_t->push_back(std::sqrt(0.5 * (sensor_cov[i](0, 0) + sensor_cov[i](1, 1))));
         sigma_theta->push_back(std::sqrt(sensor_cov[i](2, 2)));
       }
@@ -354,13 +353,13 @@ OdometryGraph build_odometry_graph(const Context& ctx, const std::vector<SE2>& p
   for (size_t i = 0; i < ctx.samples.size(); ++i) {
     const MotionSample& s = ctx.samples[i];
     og.odometry_factor.push_back(g.add_factor(
-        std::make_unique<OdometryFactor>(og.poses[i], og.poses[i + 1], *s.odometry,
-                                         motion_information(ctx.odo_cov[i], s.odometry->theta)),
+        std::make_unique<OdometryFactor>(og.poses[i], og.poses[i + 1], s.odometry->value,
+                                         motion_information(ctx.odo_cov[i], s.odometry->value.theta)),
         kernel));
     og.sensor_factor.push_back(
         ctx.inlier[i] ? g.add_factor(std::make_unique<SensorMotionFactor>(
-                                         og.poses[i], og.poses[i + 1], og.z, s.sensor,
-                                         motion_information(ctx.sensor_cov[i], s.sensor.theta)),
+                                         og.poses[i], og.poses[i + 1], og.z, s.sensor.value,
+                                         motion_information(ctx.sensor_cov[i], s.sensor.value.theta)),
                                      kernel)
                       : -1);
   }
@@ -376,14 +375,14 @@ CalibrationResult calibrate_odometry(Context& ctx) {
     z = Vector4((*o.initial)[0], (*o.initial)[1], (*o.initial)[2], (*o.initial)[3]);
   } else {
     std::vector<SE2> robot, sensor;
-    for (const MotionSample& s : ctx.samples) robot.push_back(*s.odometry), sensor.push_back(s.sensor);
+    for (const MotionSample& s : ctx.samples) robot.push_back(s.odometry->value), sensor.push_back(s.sensor.value);
     const auto c = cd::odometry_closed_form(robot, sensor, o.fix_scale, o.fixed_scale);
     z = Vector4(c[0], c[1], c[2], c[3]);
     if (!z.allFinite()) z = Vector4(0.0, 0.0, o.fix_scale ? o.fixed_scale : 1.0, 0.0);
   }
   if (o.fix_scale) z[CI::kHeight] = o.fixed_scale;
   std::vector<SE2> poses = {SE2()};
-  for (const MotionSample& s : ctx.samples) poses.push_back(poses.back() * *s.odometry);
+  for (const MotionSample& s : ctx.samples) poses.push_back(poses.back() * s.odometry->value);
 
   OdometryGraph og;
   auto solve_pass = [&](RobustKernelPtr kernel) {
@@ -505,7 +504,7 @@ NonholonomicGraph build_nonholonomic_graph(const Context& ctx, const Vector4& z,
       ng.factor_of.push_back(-1);
       continue;
     }
-    const SE2& m = ctx.samples[i].sensor;
+    const SE2& m = ctx.samples[i].sensor.value;
     const double info = 1.0 / nonholonomic_variance(m, ctx.sensor_cov[i], z, ctx.options.nonholonomic_form);
     ng.factor_of.push_back(
         ng.graph.add_factor(std::make_unique<NonholonomicFactor>(ng.z, m, info, form), kernel));
@@ -520,9 +519,9 @@ std::vector<std::optional<int>> direction_labels(const Context& ctx) {
     if (s.direction)
       labels.push_back(*s.direction);
     else if (s.odometry)
-      labels.push_back(std::abs(s.odometry->x) < ctx.options.still_speed * s.interval
+      labels.push_back(std::abs(s.odometry->value.x) < ctx.options.still_speed * s.interval
                            ? 0
-                           : (s.odometry->x > 0.0 ? 1 : -1));
+                           : (s.odometry->value.x > 0.0 ? 1 : -1));
     else
       labels.push_back(std::nullopt);
   }
@@ -536,7 +535,7 @@ int branch_vote(const Context& ctx, const std::vector<std::optional<int>>& label
   int agree = 0, disagree = 0;
   for (size_t i = 0; i < ctx.samples.size(); ++i) {
     if (!ctx.inlier[i] || !labels[i] || *labels[i] == 0) continue;
-    const SE2& m = ctx.samples[i].sensor;
+    const SE2& m = ctx.samples[i].sensor.value;
     const double fx = sensor_to_robot_motion(m, z.data()).x;
     if (sq(fx) <= 9.0 * forward_variance(m, ctx.sensor_cov[i], z)) continue;
     ((fx > 0.0) == (*labels[i] > 0) ? agree : disagree)++;
@@ -566,7 +565,7 @@ std::vector<cd::PriorTerm> prior_terms(const Context& ctx, const std::vector<std
   z0[CI::kY] = 0.0;
   for (size_t i = 0; i < ctx.samples.size(); ++i) {
     if (!ctx.inlier[i] || !labels[i]) continue;
-    const SE2& m = ctx.samples[i].sensor;
+    const SE2& m = ctx.samples[i].sensor.value;
     cd::PriorTerm t;
     t.alpha = sensor_to_robot_motion(m, z0.data()).x;
     t.beta = std::sin(m.theta);
@@ -593,7 +592,7 @@ CalibrationResult calibrate_nonholonomic(Context& ctx) {
     z = Vector4((*o.initial)[0], (*o.initial)[1], h, (*o.initial)[3]);
   } else {
     std::vector<SE2> sensor;
-    for (const MotionSample& s : ctx.samples) sensor.push_back(s.sensor);
+    for (const MotionSample& s : ctx.samples) sensor.push_back(s.sensor.value);
     const auto c = cd::nonholonomic_closed_form(sensor, h);
     z = Vector4(std::isfinite(c[0]) ? c[0] : 0.0, 0.0, h, std::isfinite(c[1]) ? c[1] : 0.0);
     if (branch_vote(ctx, labels, z) < 0) z = flipped(z);

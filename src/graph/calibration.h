@@ -18,20 +18,19 @@
 
 #include <Eigen/Core>
 
+#include "core/motion.h"
 #include "core/se2.h"
 #include "graph/solver.h"
 
 namespace planarvo::graph {
 
+// The motions carry optional covariances (core/motion.h: of the right perturbation; e.g. the
+// tracker's); the options' noise model is used where a covariance is zero (not given).
 struct MotionSample {
-  double interval = 0;           // seconds (> 0)
-  SE2 sensor;                    // the sensor's motion in its own frame
-  std::optional<SE2> odometry;   // the robot's motion from wheel odometry (method Odometry)
-  std::optional<int> direction;  // +1 forwards, -1 backwards, 0 no linear motion
-  // Optional per-sample uncertainties (e.g. the tracker's covariance); the options' defaults
-  // are used where absent. Sensor: in the sensor's units; odometry: metres, radians.
-  std::optional<Eigen::Matrix3d> sensor_covariance;
-  std::optional<Eigen::Matrix3d> odometry_covariance;
+  double interval = 0;             // seconds (> 0)
+  Motion sensor;                   // the sensor's motion in its own frame, in the sensor's units
+  std::optional<Motion> odometry;  // the robot's motion from wheel odometry (method Odometry), m
+  std::optional<int> direction;    // +1 forwards, -1 backwards, 0 no linear motion
 };
 
 enum class CalibrationMethod {

@@ -80,14 +80,14 @@ MotionPairs read_motion_pairs(const std::string& path, double still_speed) {
     MotionPair p;
     p.interval = value("interval_s");
     if (!(p.interval > 0)) r.fail("interval_s must be positive");
-    p.sensor = SE2(value("sensor_dx"), value("sensor_dy"), value("sensor_dtheta"));
-    if (out.has_odometry) p.odometry = SE2(value("odo_dx"), value("odo_dy"), value("odo_dtheta"));
+    p.sensor.value = SE2(value("sensor_dx"), value("sensor_dy"), value("sensor_dtheta"));
+    if (out.has_odometry) p.odometry = Motion{SE2(value("odo_dx"), value("odo_dy"), value("odo_dtheta"))};
     if (out.has_direction_column) {
       const double s = value("direction");
       if (s != 1.0 && s != -1.0 && s != 0.0) r.fail("direction must be +1, -1 or 0");
       p.direction = static_cast<int>(s);
     } else if (p.odometry) {
-      const double dx = p.odometry->x;
+      const double dx = p.odometry->value.x;
       p.direction = std::abs(dx) < still_speed * p.interval ? 0 : (dx > 0 ? 1 : -1);
     }
     out.pairs.push_back(p);
@@ -108,8 +108,12 @@ void write_motion_pairs(const std::string& path, const std::vector<MotionPair>& 
   using detail::format_exact;
   for (const MotionPair& p : pairs) {
     std::string row = format_exact(p.interval) + ",";
-    if (odo) row += format_exact(p.odometry->x) + "," + format_exact(p.odometry->y) + "," + format_exact(p.odometry->theta) + ",";
-    row += format_exact(p.sensor.x) + "," + format_exact(p.sensor.y) + "," + format_exact(p.sensor.theta);
+    if (odo) {
+      const SE2& m = p.odometry->value;
+      row += format_exact(m.x) + "," + format_exact(m.y) + "," + format_exact(m.theta) + ",";
+    }
+    const SE2& m = p.sensor.value;
+    row += format_exact(m.x) + "," + format_exact(m.y) + "," + format_exact(m.theta);
     if (dir) row += "," + std::to_string(*p.direction);
     w.write(row + "\n");
   }

@@ -6,15 +6,17 @@
 #include <string>
 #include <vector>
 
-#include "core/se2.h"
+#include "core/motion.h"
 
 namespace planarvo::io {
 
+// The file has no covariance columns: the motions' covariances are zero (not given) when read,
+// and not written.
 struct MotionPair {
-  double interval = 0;            // seconds
-  std::optional<SE2> odometry;    // robot motion from wheel odometry, when the file has it
-  SE2 sensor;                     // the sensor's motion in its own frame
-  std::optional<int> direction;   // +1 / -1 / 0: the file's column, else the odometry's sign
+  double interval = 0;               // seconds
+  std::optional<Motion> odometry;    // robot motion from wheel odometry, when the file has it
+  Motion sensor;                     // the sensor's motion in its own frame
+  std::optional<int> direction;      // +1 / -1 / 0: the file's column, else the odometry's sign
 };
 
 struct MotionPairs {

@@ -86,6 +86,20 @@ TEST(CliCalibrate, CensiLmovAgainstOdometry) {
   EXPECT_NE(yaml.find("estimated"), std::string::npos);
 }
 
+TEST(CliCalibrate, NoiseModelOptionsAndTotals) {
+  const std::string csv = (test::shared_dir() / "data/real/censi2011/lmov_motions.csv").string();
+  auto r = run_cli("calibrate --motions " + csv + " --fix-scale");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("iterations over all solves"), std::string::npos) << r.output;
+  EXPECT_EQ(r.output.find("(0 rejected"), std::string::npos) << r.output;
+  r = run_cli("calibrate --motions " + csv + " --fix-scale --gate-sigma 0 --loss none --sensor-sigma 0.01,0.001,0.1");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("(0 rejected"), std::string::npos) << r.output;
+  EXPECT_EQ(run_cli("calibrate --motions " + csv + " --fix-scale --gate-sigma -1").exit_code, 2);
+  EXPECT_EQ(run_cli("calibrate --motions " + csv + " --fix-scale --loss l2").exit_code, 2);
+  EXPECT_EQ(run_cli("calibrate --motions " + csv + " --fix-scale --odometry-sigma 0,0,1").exit_code, 2);
+}
+
 TEST(CliCalibrate, StraightDrivingIsUnobservableExit1AndNoFile) {
   ScratchDir d;
   const fs::path csv = d / "straight.csv";

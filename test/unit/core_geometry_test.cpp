@@ -8,6 +8,7 @@
 
 #include "core/error.h"
 #include "core/extrinsics.h"
+#include "core/motion.h"
 #include "core/se2.h"
 
 namespace planarvo {
@@ -38,6 +39,33 @@ TEST(SE2, ExpIsTheConstantVelocityArc) {
   const Eigen::Vector3d back = e.log();
   EXPECT_LT((back - xi).norm(), 1e-12);
   EXPECT_LT((SE2::exp(Eigen::Vector3d(1e-9, 2e-9, 1e-8)).log() - Eigen::Vector3d(1e-9, 2e-9, 1e-8)).norm(), 1e-18);
+}
+
+TEST(Motion, CovarianceZeroMeansNotGiven) {
+  Motion m{SE2(0.1, 0.2, 0.3)};
+  EXPECT_FALSE(m.has_covariance());
+  m.covariance(2, 0) = 1e-300;
+  EXPECT_TRUE(m.has_covariance());
+}
+
+TEST(Motion, ComponentCovarianceIsTheRightPerturbationPropagated) {
+  // J: the numeric derivative of value·exp(xi)'s (x, y, theta) by xi at 0; the components'
+  // covariance is J Σ Jᵀ.
+  std::mt19937 rng(2);
+  std::uniform_real_distribution<double> u(-3, 3);
+  for (int i = 0; i < 20; ++i) {
+    Motion m{SE2(u(rng), u(rng), u(rng))};
+    const Eigen::Matrix3d L = Eigen::Matrix3d::Random();
+    m.covariance = L * L.transpose() + 0.1 * Eigen::Matrix3d::Identity();
+    Eigen::Matrix3d J;
+    const double h = 1e-6;
+    for (int k = 0; k < 3; ++k) {
+      const Eigen::Vector3d d = h * Eigen::Vector3d::Unit(k);
+      const SE2 p = m.value * SE2::exp(d), q = m.value * SE2::exp(-d);
+      J.col(k) = Eigen::Vector3d(p.x - q.x, p.y - q.y, wrap_angle(p.theta - q.theta)) / (2 * h);
+    }
+    EXPECT_LT((component_covariance(m) - J * m.covariance * J.transpose()).norm(), 1e-8);
+  }
 }
 
 TEST(Extrinsics, WorkedExampleOfConventions) {

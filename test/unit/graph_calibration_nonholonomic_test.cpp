@@ -47,7 +47,7 @@ double dyaw(const CalibrationResult& r, double yaw) { return wrap_angle(r.value[
 
 TEST(GraphCalibrationNonholonomic, ClosedFormIsExactUpToTheBranch) {
   std::vector<SE2> sensor;
-  for (const MotionSample& s : simulate_motions(kTruth, CalibrationSim{}).samples) sensor.push_back(s.sensor);
+  for (const MotionSample& s : simulate_motions(kTruth, CalibrationSim{}).samples) sensor.push_back(s.sensor.value);
   const auto c = calibration_detail::nonholonomic_closed_form(sensor, kTruth[2]);
   const bool flipped = std::abs(wrap_angle(c[1] - kTruth[3])) > M_PI / 2;
   EXPECT_NEAR(c[0], flipped ? -kTruth[0] : kTruth[0], 1e-9);
@@ -312,10 +312,10 @@ TEST(GraphCalibrationNonholonomic, DirectionPriorMatchesTheFactor) {
   for (size_t i = 0; i < data.samples.size(); ++i) {
     const auto& s = data.samples[i];
     const double w = 1e4 * (1.0 + static_cast<double>(i % 3));
-    g.add_factor(std::make_unique<DirectionPriorFactor>(zid, s.sensor, *s.direction, w));
+    g.add_factor(std::make_unique<DirectionPriorFactor>(zid, s.sensor.value, *s.direction, w));
     calibration_detail::PriorTerm t;
-    t.alpha = sensor_to_robot_motion(s.sensor, z.data()).x;
-    t.beta = std::sin(s.sensor.theta);
+    t.alpha = sensor_to_robot_motion(s.sensor.value, z.data()).x;
+    t.beta = std::sin(s.sensor.value.theta);
     t.weight = w;
     t.label = *s.direction;
     terms.push_back(t);

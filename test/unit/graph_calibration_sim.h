@@ -87,19 +87,20 @@ inline SimulatedMotions simulate_motions(const std::array<double, 4>& z, const C
     const SE2 metric = T.inverse() * robot * T;
     graph::MotionSample s;
     s.interval = o.dt;
-    s.sensor = SE2(metric.x / scale + o.sensor_sigma_t * g(rng),
-                   metric.y / scale + o.sensor_sigma_t * g(rng),
-                   wrap_angle(metric.theta + o.sensor_sigma_theta * g(rng)));
+    s.sensor.value = SE2(metric.x / scale + o.sensor_sigma_t * g(rng),
+                         metric.y / scale + o.sensor_sigma_t * g(rng),
+                         wrap_angle(metric.theta + o.sensor_sigma_theta * g(rng)));
+    // Isotropic in translation: the same as a covariance of the right perturbation.
     if (o.sensor_sigma_t > 0.0 && o.sensor_sigma_theta > 0.0)
-      s.sensor_covariance = Eigen::Vector3d(o.sensor_sigma_t * o.sensor_sigma_t,
+      s.sensor.covariance = Eigen::Vector3d(o.sensor_sigma_t * o.sensor_sigma_t,
                                             o.sensor_sigma_t * o.sensor_sigma_t,
                                             o.sensor_sigma_theta * o.sensor_sigma_theta)
                                 .asDiagonal();
     if (o.odometry) {
-      s.odometry = SE2(robot.x + o.odometry_sigma_t * g(rng), robot.y + o.odometry_sigma_t * g(rng),
-                       wrap_angle(robot.theta + o.odometry_sigma_theta * g(rng)));
+      s.odometry = Motion{SE2(robot.x + o.odometry_sigma_t * g(rng), robot.y + o.odometry_sigma_t * g(rng),
+                              wrap_angle(robot.theta + o.odometry_sigma_theta * g(rng)))};
       if (o.odometry_sigma_t > 0.0 && o.odometry_sigma_theta > 0.0)
-        s.odometry_covariance = Eigen::Vector3d(o.odometry_sigma_t * o.odometry_sigma_t,
+        s.odometry->covariance = Eigen::Vector3d(o.odometry_sigma_t * o.odometry_sigma_t,
                                                 o.odometry_sigma_t * o.odometry_sigma_t,
                                                 o.odometry_sigma_theta * o.odometry_sigma_theta)
                                     .asDiagonal();
@@ -116,8 +117,8 @@ inline SimulatedMotions simulate_motions(const std::array<double, 4>& z, const C
   for (int j = 0; j < n_out; ++j) {
     const int i = order[static_cast<size_t>(j)];
     const double a = 2.0 * M_PI * u(rng), m = o.outlier_size * (0.5 + 0.5 * u(rng)) / scale;
-    out.samples[static_cast<size_t>(i)].sensor.x += m * std::cos(a);
-    out.samples[static_cast<size_t>(i)].sensor.y += m * std::sin(a);
+    out.samples[static_cast<size_t>(i)].sensor.value.x += m * std::cos(a);
+    out.samples[static_cast<size_t>(i)].sensor.value.y += m * std::sin(a);
     out.outliers.push_back(i);
   }
   std::sort(out.outliers.begin(), out.outliers.end());

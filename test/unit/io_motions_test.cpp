@@ -22,8 +22,9 @@ TEST(IoMotions, ReadsTheCensiFiles) {
   ASSERT_GT(m.pairs.size(), 100u);
   const MotionPair& p = m.pairs.front();  // 0.805137,0.00837124346,3.82902531e-06,...
   EXPECT_DOUBLE_EQ(p.interval, 0.805137);
-  EXPECT_DOUBLE_EQ(p.odometry->x, 0.00837124346);
-  EXPECT_DOUBLE_EQ(p.sensor.theta, -0.00353017);
+  EXPECT_DOUBLE_EQ(p.odometry->value.x, 0.00837124346);
+  EXPECT_DOUBLE_EQ(p.sensor.value.theta, -0.00353017);
+  EXPECT_FALSE(p.sensor.has_covariance());
   EXPECT_EQ(*p.direction, 1);
 }
 
@@ -45,14 +46,14 @@ TEST(IoMotions, SensorOnlyWithDirectionColumnRoundTrips) {
   ScratchDir d;
   const std::string path = (d / "m.csv").string();
   std::vector<MotionPair> in(2);
-  in[0] = {0.1, std::nullopt, SE2(0.01, 0.002, 0.1), 1};
-  in[1] = {0.2, std::nullopt, SE2(-0.01, 1e-17, -0.3), 0};
+  in[0] = {0.1, std::nullopt, Motion{SE2(0.01, 0.002, 0.1)}, 1};
+  in[1] = {0.2, std::nullopt, Motion{SE2(-0.01, 1e-17, -0.3)}, 0};
   write_motion_pairs(path, in);
   const auto m = read_motion_pairs(path);
   EXPECT_FALSE(m.has_odometry);
   EXPECT_TRUE(m.has_direction_column);
   ASSERT_EQ(m.pairs.size(), 2u);
-  EXPECT_EQ(m.pairs[1].sensor.y, 1e-17);
+  EXPECT_EQ(m.pairs[1].sensor.value.y, 1e-17);
   EXPECT_EQ(*m.pairs[1].direction, 0);
   EXPECT_FALSE(m.pairs[0].odometry.has_value());
 }
