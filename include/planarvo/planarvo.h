@@ -563,6 +563,109 @@ PLANARVO_API planarvo_status planarvo_calibrate(const planarvo_motion_pair* pair
                                                 const planarvo_calibration_options* options,
                                                 planarvo_calibration_result* result);
 
+/* ------------------------------------------------------------------------------------------ */
+/* Camera calibration from images (the paper's sections 5.1 and 5.2)                           */
+
+/* Why a calibration stage did not give an answer. */
+typedef enum planarvo_calibration_status {
+  PLANARVO_CALIBRATION_OK = 0,
+  PLANARVO_CALIBRATION_TOO_LITTLE_TEXTURE = 1, /* the frames could not be tracked */
+  PLANARVO_CALIBRATION_TOO_LITTLE_MOTION = 2,  /* the camera did not move enough for roll and pitch */
+  PLANARVO_CALIBRATION_UNOBSERVABLE = 3,       /* the drive does not determine x, y, height or yaw */
+  PLANARVO_CALIBRATION_FAILED = 4              /* anything else; the reason says what */
+} planarvo_calibration_status;
+
+/* Roll and pitch from images alone (section 5.1): frames are fed until a local map of keyframes
+ * is complete, then the keyframe motions and the camera's tilt are aligned jointly. No odometry,
+ * no targets, any motion but standing still. */
+typedef struct planarvo_roll_pitch planarvo_roll_pitch;
+
+typedef struct planarvo_roll_pitch_options {
+  size_t struct_size;
+  double initial_roll, initial_pitch; /* start (radians); default 0, 0: looking straight down */
+  int32_t max_frames;     /* frames used, counted from the first in which the camera moves;
+                             default 0: until the map has max_keyframes keyframes */
+  int32_t min_keyframes;  /* default 5 */
+  int32_t max_keyframes;  /* default 12 */
+  double keyframe_overlap;/* a frame joins the map below this overlap with the last keyframe;
+                             default 0.9 */
+  int32_t search;         /* non-zero: a coarse search over the angles when the alignment from
+                             the start does not converge; default 1 */
+} planarvo_roll_pitch_options;
+
+typedef struct planarvo_roll_pitch_result {
+  size_t struct_size;
+  planarvo_calibration_status status; /* OK, TOO_LITTLE_TEXTURE, TOO_LITTLE_MOTION or FAILED */
+  char reason[512];        /* "" when OK */
+  double roll, pitch;      /* radians */
+  double covariance[4];    /* of (roll, pitch), row-major, rad^2 */
+  int32_t frames_used, keyframes, pairs;
+  double seconds;          /* picking keyframes and the joint alignment */
+} planarvo_roll_pitch_result;
+
+PLANARVO_API void planarvo_roll_pitch_options_init(planarvo_roll_pitch_options* options);
+/* camera: the distorted camera the frames come from. options may be NULL. */
+PLANARVO_API planarvo_status planarvo_roll_pitch_create(planarvo_context* context, const planarvo_camera* camera,
+                                                        const planarvo_roll_pitch_options* options,
+                                                        planarvo_roll_pitch** estimator);
+PLANARVO_API void planarvo_roll_pitch_destroy(planarvo_roll_pitch* estimator);
+/* Feeds one frame; *complete (may be NULL) becomes non-zero once the map is complete (later frames
+ * are ignored). A frame of the wrong size or without texture is counted and skipped. */
+PLANARVO_API planarvo_status planarvo_roll_pitch_add_frame(planarvo_roll_pitch* estimator,
+                                                           const planarvo_image* image, double timestamp,
+                                                           int32_t* complete);
+/* Estimates from the frames fed so far. PLANARVO_ERROR_FAILED (the reason as the message) when
+ * the status is not OK; the result is filled in either case. */
+PLANARVO_API planarvo_status planarvo_roll_pitch_estimate(planarvo_roll_pitch* estimator,
+                                                          planarvo_roll_pitch_result* result);
+
+/* The whole calibration: roll and pitch from the first frames with enough motion, the sequence
+ * tracked with them, then x, y, height and yaw from the graph calibration, against wheel
+ * odometry or from the nonholonomic constraint with direction labels and a given height. */
+typedef struct planarvo_camera_calibration_options {
+  size_t struct_size;
+  planarvo_calibration_method method; /* default ODOMETRY */
+  double height;            /* the camera height in metres when known (then held, not estimated);
+                               0 = estimate it (odometry method only); default 0 */
+  int32_t roll_pitch_frames;/* frames for roll and pitch (planarvo_roll_pitch_options.max_frames);
+                               default 0 */
+  int32_t has_initial;      /* non-zero: start from `initial` (roll and pitch for section 5.1,
+                               x, y, z, yaw for the graph) */
+  planarvo_extrinsics initial;
+  int32_t estimate_roll_pitch; /* default 1; 0: roll and pitch are initial's (has_initial needed) */
+  /* The graph's noise model and robustness, and the tracker's options: NULL for the defaults. */
+  const planarvo_calibration_options* graph;
+  const planarvo_tracker_options* tracker;
+  planarvo_progress_fn progress;
+  void* progress_user_data;
+} planarvo_camera_calibration_options;
+
+typedef struct planarvo_camera_calibration_result {
+  size_t struct_size;
+  planarvo_calibration_status status;
+  char reason[512];          /* "" when OK: what failed, and what would fix it */
+  planarvo_extrinsics extrinsics;
+  double covariance[36];     /* 6x6 row-major, order x y z roll pitch yaw; zero rows and columns
+                                for parameters not estimated */
+  int32_t estimated[6];      /* this run estimated the parameter (else it was given) */
+  int32_t observable[6];     /* estimated and determined by the data */
+  planarvo_roll_pitch_result roll_pitch;    /* stage 1 */
+  planarvo_calibration_result graph;        /* stage 3 (x, y, scale = height, yaw) */
+  int32_t frames, frames_ok, frames_degraded, frames_lost, samples;
+  double tracking_median_ms; /* engine time per frame in stage 2 */
+  /* Wall seconds: image decoding (data sets), roll and pitch, tracking, graph, all. */
+  double seconds_decode, seconds_roll_pitch, seconds_tracking, seconds_graph, seconds_total;
+} planarvo_camera_calibration_result;
+
+PLANARVO_API void planarvo_camera_calibration_options_init(planarvo_camera_calibration_options* options);
+/* Calibrates from a data set (its frames, odometry.txt for the odometry method, direction.txt for
+ * the nonholonomic one). PLANARVO_ERROR_INVALID_INPUT when the method's inputs are missing;
+ * PLANARVO_ERROR_FAILED (the reason as the message) when the status is not OK, the result filled
+ * in either case. */
+PLANARVO_API planarvo_status planarvo_calibrate_dataset(planarvo_context* context, planarvo_dataset* dataset,
+                                                        const planarvo_camera_calibration_options* options,
+                                                        planarvo_camera_calibration_result* result);
+
 #ifdef __cplusplus
 }
 #endif

@@ -4,17 +4,13 @@
 #include <string>
 
 #include "capi/convert.h"
+#include "capi/handles.h"
 #include "capi/status.h"
 #include "core/error.h"
 #include "io/dataset.h"
 
 using planarvo::capi::guard;
 using planarvo::capi::require;
-
-struct planarvo_dataset {
-  std::unique_ptr<planarvo::io::Dataset> dataset;
-  cv::Mat frame;  // the last decoded frame, which planarvo_dataset_frame's image points into
-};
 
 extern "C" {
 

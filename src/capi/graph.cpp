@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "capi/convert.h"
+#include "capi/graph_convert.h"
 #include "capi/handles.h"
 #include "capi/status.h"
 #include "core/error.h"
@@ -154,6 +155,69 @@ planarvo::graph::MotionSample read_pair(const planarvo_motion_pair* pairs, size_
 
 }  // namespace
 
+namespace planarvo::capi {
+
+planarvo::graph::CalibrationOptions calibration_options_from_c(const planarvo_calibration_options* options,
+                                                               planarvo_calibration_options* read) {
+  planarvo_calibration_options& o = *read;
+  planarvo_calibration_options_init(&o);
+  if (options) {
+    planarvo::capi::require_struct_size(options->struct_size,
+                                        offsetof(planarvo_calibration_options, log_user_data) + sizeof(void*),
+                                        "planarvo_calibration_options");
+    o = planarvo::capi::read_versioned(*options, o);
+  }
+  require(o.method == PLANARVO_CALIBRATE_ODOMETRY || o.method == PLANARVO_CALIBRATE_NONHOLONOMIC,
+          "planarvo_calibration_options.method is not a planarvo_calibration_method");
+  require(o.max_iterations > 0, "planarvo_calibration_options.max_iterations must be positive");
+  require(!o.fix_scale || (std::isfinite(o.fixed_scale) && o.fixed_scale > 0),
+          "planarvo_calibration_options.fixed_scale must be positive");
+  validate_noise_model(o);
+  planarvo::graph::CalibrationOptions co;
+  co.method = o.method == PLANARVO_CALIBRATE_ODOMETRY ? planarvo::graph::CalibrationMethod::Odometry
+                                                      : planarvo::graph::CalibrationMethod::Nonholonomic;
+  co.fix_scale = o.fix_scale != 0;
+  co.fixed_scale = o.fixed_scale;
+  if (o.has_initial) co.initial = std::array<double, 4>{o.initial[0], o.initial[1], o.initial[2], o.initial[3]};
+  co.nonholonomic_form = o.velocity_form ? planarvo::graph::CalibrationOptions::NonholonomicForm::Velocity
+                                         : planarvo::graph::CalibrationOptions::NonholonomicForm::Arc;
+  co.solver.max_iterations = o.max_iterations;
+  co.sensor_sigma_relative = o.sensor_sigma_relative;
+  co.sensor_sigma_floor = o.sensor_sigma_floor;
+  co.sensor_sigma_theta = o.sensor_sigma_theta;
+  co.odometry_sigma_relative = o.odometry_sigma_relative;
+  co.odometry_sigma_floor = o.odometry_sigma_floor;
+  co.odometry_sigma_theta = o.odometry_sigma_theta;
+  co.loss = ::to_cpp(o.loss);
+  co.loss_scale = o.loss_scale;
+  co.gate_sigma = o.gate_sigma;
+  co.still_speed = o.still_speed;
+  return co;
+}
+
+planarvo_calibration_result calibration_result_to_c(const planarvo::graph::CalibrationResult& r) {
+  planarvo_calibration_result out;
+  std::memset(&out, 0, sizeof out);
+  for (int i = 0; i < 4; ++i) {
+    out.value[i] = r.value[static_cast<size_t>(i)];
+    out.estimated[i] = r.estimated[static_cast<size_t>(i)];
+    out.observable[i] = r.observable[static_cast<size_t>(i)];
+  }
+  planarvo::capi::matrix_to_c<4>(r.covariance, out.covariance);
+  out.ambiguous = r.ambiguous;
+  out.outliers = r.outliers;
+  out.ok = r.ok();
+  planarvo::capi::copy_string(out.unobservable_reason, sizeof out.unobservable_reason, r.unobservable_reason);
+  out.summary.struct_size = sizeof out.summary;
+  fill_summary(r.summary, 2.0 * r.summary.initial_cost, 2.0 * r.summary.final_cost, &out.summary);
+  out.total_iterations = r.total_iterations;
+  out.total_seconds = r.total_time_s;
+  out.variance_factor = r.variance_factor;
+  return out;
+}
+
+}  // namespace planarvo::capi
+
 extern "C" {
 
 PLANARVO_API void planarvo_posegraph_options_init(planarvo_posegraph_options* o) {
@@ -273,61 +337,14 @@ PLANARVO_API planarvo_status planarvo_calibrate(const planarvo_motion_pair* pair
     planarvo::capi::require_struct_size(result->struct_size, kCalibrationResultEnd, "planarvo_calibration_result");
     require(count > 0 && pairs != nullptr, "planarvo_calibrate: no motion pairs");
     planarvo_calibration_options o;
-    planarvo_calibration_options_init(&o);
-    if (options) {
-      planarvo::capi::require_struct_size(options->struct_size,
-                                          offsetof(planarvo_calibration_options, log_user_data) + sizeof(void*),
-                                          "planarvo_calibration_options");
-      o = planarvo::capi::read_versioned(*options, o);
-    }
-    require(o.method == PLANARVO_CALIBRATE_ODOMETRY || o.method == PLANARVO_CALIBRATE_NONHOLONOMIC,
-            "planarvo_calibration_options.method is not a planarvo_calibration_method");
-    require(o.max_iterations > 0, "planarvo_calibration_options.max_iterations must be positive");
-    require(!o.fix_scale || (std::isfinite(o.fixed_scale) && o.fixed_scale > 0),
-            "planarvo_calibration_options.fixed_scale must be positive");
-    validate_noise_model(o);
-    planarvo::graph::CalibrationOptions co;
-    co.method = o.method == PLANARVO_CALIBRATE_ODOMETRY ? planarvo::graph::CalibrationMethod::Odometry
-                                                        : planarvo::graph::CalibrationMethod::Nonholonomic;
-    co.fix_scale = o.fix_scale != 0;
-    co.fixed_scale = o.fixed_scale;
-    if (o.has_initial) co.initial = std::array<double, 4>{o.initial[0], o.initial[1], o.initial[2], o.initial[3]};
-    co.nonholonomic_form = o.velocity_form ? planarvo::graph::CalibrationOptions::NonholonomicForm::Velocity
-                                           : planarvo::graph::CalibrationOptions::NonholonomicForm::Arc;
-    co.solver.max_iterations = o.max_iterations;
-    co.sensor_sigma_relative = o.sensor_sigma_relative;
-    co.sensor_sigma_floor = o.sensor_sigma_floor;
-    co.sensor_sigma_theta = o.sensor_sigma_theta;
-    co.odometry_sigma_relative = o.odometry_sigma_relative;
-    co.odometry_sigma_floor = o.odometry_sigma_floor;
-    co.odometry_sigma_theta = o.odometry_sigma_theta;
-    co.loss = to_cpp(o.loss);
-    co.loss_scale = o.loss_scale;
-    co.gate_sigma = o.gate_sigma;
-    co.still_speed = o.still_speed;
+    const planarvo::graph::CalibrationOptions co = planarvo::capi::calibration_options_from_c(options, &o);
     const size_t stride = motion_pair_stride(pairs);
     std::vector<planarvo::graph::MotionSample> samples;
     samples.reserve(count);
     for (size_t i = 0; i < count; ++i) samples.push_back(read_pair(pairs, stride, i));
     const planarvo::graph::CalibrationResult r = planarvo::graph::calibrate(samples, co);
     send_lines(o.log, o.log_user_data, r.summary.full_report());
-    planarvo_calibration_result out;
-    std::memset(&out, 0, sizeof out);
-    for (int i = 0; i < 4; ++i) {
-      out.value[i] = r.value[static_cast<size_t>(i)];
-      out.estimated[i] = r.estimated[static_cast<size_t>(i)];
-      out.observable[i] = r.observable[static_cast<size_t>(i)];
-    }
-    planarvo::capi::matrix_to_c<4>(r.covariance, out.covariance);
-    out.ambiguous = r.ambiguous;
-    out.outliers = r.outliers;
-    out.ok = r.ok();
-    planarvo::capi::copy_string(out.unobservable_reason, sizeof out.unobservable_reason, r.unobservable_reason);
-    out.summary.struct_size = sizeof out.summary;
-    fill_summary(r.summary, 2.0 * r.summary.initial_cost, 2.0 * r.summary.final_cost, &out.summary);
-    out.total_iterations = r.total_iterations;
-    out.total_seconds = r.total_time_s;
-    out.variance_factor = r.variance_factor;
+    const planarvo_calibration_result out = planarvo::capi::calibration_result_to_c(r);
     planarvo::capi::write_versioned(out, result);
     ok = r.ok();
     reason = r.ambiguous ? std::string("ambiguous: (x, yaw) and (-x, yaw + 180 deg) fit equally; give direction "

@@ -8,6 +8,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "capi/convert.h"
+#include "capi/track_convert.h"
 #include "capi/handles.h"
 #include "capi/status.h"
 #include "core/error.h"
@@ -35,6 +36,10 @@ planarvo_track_status to_c(planarvo::track::FrameResult::Status s) {
   return PLANARVO_TRACK_LOST;
 }
 
+}  // namespace
+
+namespace planarvo::capi {
+
 // The frame as 8-bit grey: a view of the caller's memory when it already is, else converted.
 const uint8_t* grey_view(const planarvo_image& im, cv::Mat& buffer, size_t* stride) {
   const int type = im.format == PLANARVO_GRAY8 ? CV_8UC1
@@ -53,7 +58,31 @@ const uint8_t* grey_view(const planarvo_image& im, cv::Mat& buffer, size_t* stri
   return buffer.data;
 }
 
-}  // namespace
+
+planarvo::track::TrackerOptions tracker_options_from_c(const planarvo_tracker_options* options) {
+  planarvo::track::TrackerOptions o;
+  if (options) {
+    planarvo::capi::require_struct_size(options->struct_size,
+                                        offsetof(planarvo_tracker_options, estimate_brightness) + 4,
+                                        "planarvo_tracker_options");
+    require(options->levels >= 1 && options->levels <= planarvo::track::kMaxLevels,
+            "planarvo_tracker_options.levels must be 1..8");
+    require(options->finest_level >= -1 && options->finest_level < options->levels,
+            "planarvo_tracker_options.finest_level must be -1 (automatic) or 0..levels-1");
+    require(options->max_iterations >= 0, "planarvo_tracker_options.max_iterations must be >= 0");
+    require(options->keyframe_overlap > 0 && options->keyframe_overlap < 1,
+            "planarvo_tracker_options.keyframe_overlap must be in (0, 1)");
+    o.levels = options->levels;
+    o.finest_level = options->finest_level;
+    if (options->max_iterations > 0)
+      for (int& n : o.max_iterations) n = std::min(n, static_cast<int>(options->max_iterations));
+    o.keyframe_overlap = options->keyframe_overlap;
+    o.estimate_brightness = options->estimate_brightness != 0;
+  }
+  return o;
+}
+
+}  // namespace planarvo::capi
 
 extern "C" {
 
@@ -85,25 +114,7 @@ PLANARVO_API planarvo_status planarvo_tracker_create(planarvo_context* context, 
       throw planarvo::Error(planarvo::ErrorCode::InvalidArgument, e.what());
     }
     require(extrinsics->z > 0, "planarvo_tracker_create: extrinsics.z (the camera height) must be positive");
-    planarvo::track::TrackerOptions o;
-    if (options) {
-      planarvo::capi::require_struct_size(options->struct_size,
-                                          offsetof(planarvo_tracker_options, estimate_brightness) + 4,
-                                          "planarvo_tracker_options");
-      require(options->levels >= 1 && options->levels <= planarvo::track::kMaxLevels,
-              "planarvo_tracker_options.levels must be 1..8");
-      require(options->finest_level >= -1 && options->finest_level < options->levels,
-              "planarvo_tracker_options.finest_level must be -1 (automatic) or 0..levels-1");
-      require(options->max_iterations >= 0, "planarvo_tracker_options.max_iterations must be >= 0");
-      require(options->keyframe_overlap > 0 && options->keyframe_overlap < 1,
-              "planarvo_tracker_options.keyframe_overlap must be in (0, 1)");
-      o.levels = options->levels;
-      o.finest_level = options->finest_level;
-      if (options->max_iterations > 0)
-        for (int& n : o.max_iterations) n = std::min(n, static_cast<int>(options->max_iterations));
-      o.keyframe_overlap = options->keyframe_overlap;
-      o.estimate_brightness = options->estimate_brightness != 0;
-    }
+    const planarvo::track::TrackerOptions o = planarvo::capi::tracker_options_from_c(options);
     auto t = std::make_unique<planarvo_tracker>();
     t->tracker = std::make_unique<planarvo::track::Tracker>(*context->runtime, cam,
                                                             planarvo::capi::to_cpp(*extrinsics), o);
@@ -127,7 +138,7 @@ PLANARVO_API planarvo_status planarvo_tracker_track(planarvo_tracker* tracker, c
     require(image->stride >= bpp * static_cast<size_t>(image->width), "planarvo_tracker_track: stride < row size");
     require(std::isfinite(timestamp), "planarvo_tracker_track: timestamp is NaN or inf");
     size_t stride = 0;
-    const uint8_t* grey = grey_view(*image, tracker->grey, &stride);
+    const uint8_t* grey = planarvo::capi::grey_view(*image, tracker->grey, &stride);
     const planarvo::track::FrameResult r =
         tracker->tracker->track(grey, image->width, image->height, stride, timestamp);
     planarvo_track_result out;

@@ -79,9 +79,13 @@ int cmd_posegraph(int argc, char** argv) {
 int cmd_calibrate(int argc, char** argv) {
   planarvo_calibration_options o;
   planarvo_calibration_options_init(&o);
-  const std::vector<OptionSpec> specs = {
-      {"motions", "FILE.csv", "motion pairs (interval_s, [odo_dx, odo_dy, odo_dtheta,] sensor_dx, sensor_dy, "
-                              "sensor_dtheta[, direction])", ""},
+  std::vector<OptionSpec> specs = {
+      {"motions", "FILE.csv", "calibrate from motion pairs (interval_s, [odo_dx, odo_dy, odo_dtheta,] sensor_dx, "
+                              "sensor_dy, sensor_dtheta[, direction]) instead of a data set", ""},
+      {"frames", "N", "DATASET: frames for roll and pitch, counted from the first that moves", "until 12 keyframes"},
+      {"initial-extrinsics", "FILE", "DATASET: start from these extrinsics (YAML)", "looking straight down"},
+      {"video", "FILE", "DATASET: a video file standing in for images/ and frames.txt", ""},
+      {"quiet", "", "no progress bar", ""},
       {"method", "KIND", "odometry | nonholonomic", "odometry"},
       {"fix-scale", "", "a metric sensor (e.g. a laser scan matcher): scale 1, z written as 0", ""},
       {"height", "METRES", "the camera height is known: hold the scale at it", ""},
@@ -99,17 +103,24 @@ int cmd_calibrate(int argc, char** argv) {
       {"output", "FILE", "write the extrinsics YAML to FILE (also -o)", ""},
       {"verbose", "", "print the solver's iteration table", ""},
       {"help", "", "show this help", ""}};
+  for (auto& d : device_options()) specs.push_back(d);
   Args args(specs, argc, argv, 1);
-  if (args.has("help") || !args.has("motions")) {
-    std::printf("usage: planarvo calibrate --motions FILE.csv [--method odometry|nonholonomic] [--fix-scale | "
+  const bool dataset = !args.positionals().empty();
+  if (args.has("help") || (!dataset && !args.has("motions"))) {
+    std::printf("usage: planarvo calibrate DATASET [--method odometry|nonholonomic] [--height METRES] [--frames N]\n"
+                "                          [--initial-extrinsics FILE] -o extrinsics.yaml\n"
+                "       planarvo calibrate --motions FILE.csv [--method odometry|nonholonomic] [--fix-scale | "
                 "--height H] [-o extrinsics.yaml]\n\n"
-                "Calibrates the sensor's pose on the robot (x, y, yaw, and the camera height) from its planar\n"
-                "motions: against wheel odometry, or from the nonholonomic constraint with direction labels.\n"
-                "Exit code 1 when the data cannot determine the answer (it says why).\n\n%s",
+                "Calibrates the camera's pose on the robot. From a data set: roll and pitch from the images, then\n"
+                "x, y, height and yaw against wheel odometry (odometry.txt), or with --method nonholonomic from the\n"
+                "nonholonomic constraint and direction labels (direction.txt) with the height given. From motion\n"
+                "pairs: x, y, yaw and the camera height only. Exit code 1 when the data cannot determine the answer\n"
+                "(it says why; no file is written), 2 when an input the method needs is missing.\n\n%s",
                 format_options(specs).c_str());
     return args.has("help") ? kExitOk : kExitUsage;
   }
-  if (!args.positionals().empty()) throw UsageError("unexpected argument " + args.positionals()[0]);
+  if (dataset && args.has("motions")) throw UsageError("give a DATASET or --motions FILE.csv, not both");
+  if (args.positionals().size() > 1) throw UsageError("unexpected argument " + args.positionals()[1]);
   const std::string method = args.get("method", "odometry");
   if (method == "odometry") o.method = PLANARVO_CALIBRATE_ODOMETRY;
   else if (method == "nonholonomic") o.method = PLANARVO_CALIBRATE_NONHOLONOMIC;
@@ -149,6 +160,7 @@ int cmd_calibrate(int argc, char** argv) {
   o.gate_sigma = args.get_double("gate-sigma", o.gate_sigma);
   if (!(o.gate_sigma >= 0)) throw UsageError("--gate-sigma must be >= 0");
   if (args.has("verbose")) o.log = &print_line;
+  if (dataset) return cmd_calibrate_dataset(args, o);
 
   const std::string path = args.get("motions");
   size_t n = 0;

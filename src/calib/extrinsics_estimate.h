@@ -1,0 +1,40 @@
+// The camera's 6-DoF extrinsics from the two stages of the paper's calibration: roll and pitch
+// from images (section 5.1, track/roll_pitch.h) and x, y, height and yaw from the graph
+// (section 5.2, graph/calibration.h), with a 6x6 covariance and, per parameter, whether it was
+// estimated and whether the data determine it.
+//
+// Why they compose: the tracker run at x = y = 0, z = 1, yaw = 0 with the estimated tilt measures
+// the planar motion of the camera's ground frame s (on the ground below the camera, yaw of the
+// camera) in units of the height. With T_vs = (x, y, yaw) on the ground and T_sc = (Ry(pitch)
+// Rx(roll) R0 | (0, 0, z)), T_vs T_sc = (Rz(yaw) Ry(pitch) Rx(roll) R0 | (x, y, z)) is exactly
+// conventions.md's T_vc, and the graph's m_r = T_vs S_z(m_s) T_vs^-1 estimates (x, y, z, yaw).
+// The two stages' errors are taken as independent (the cross-covariance is zero): the graph
+// sees the tilt only through the motions' scale, a second-order effect for small tilt errors.
+#pragma once
+#include <array>
+
+#include <Eigen/Core>
+
+#include "core/extrinsics.h"
+#include "graph/calibration.h"
+#include "track/roll_pitch.h"
+
+namespace planarvo::calib {
+
+inline constexpr std::array<const char*, 6> kExtrinsicsNames = {"x", "y", "z", "roll", "pitch", "yaw"};
+
+struct ExtrinsicsEstimate {
+  Extrinsics value;
+  // Order x, y, z, roll, pitch, yaw (metres, radians); rows and columns of parameters that were
+  // not estimated are zero.
+  Eigen::Matrix<double, 6, 6> covariance = Eigen::Matrix<double, 6, 6>::Zero();
+  std::array<bool, 6> estimated{};   // this run estimated it (else it was given or held)
+  std::array<bool, 6> observable{};  // estimated and determined by the data
+};
+
+// The graph's (x, y, scale, yaw) as x, y, z, yaw; its fixed scale (a height given by hand) as z,
+// not estimated. Roll and pitch as given, estimated when `roll_pitch_estimated`.
+ExtrinsicsEstimate compose_extrinsics(double roll, double pitch, const Eigen::Matrix2d& roll_pitch_covariance,
+                                      bool roll_pitch_estimated, const graph::CalibrationResult& graph);
+
+}  // namespace planarvo::calib

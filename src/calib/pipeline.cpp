@@ -1,0 +1,245 @@
+#include "calib/pipeline.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+#include <opencv2/core.hpp>
+
+#include "calib/motion_samples.h"
+#include "core/error.h"
+#include "io/dataset.h"
+
+namespace planarvo::calib {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+// The tracker's frame for stage 2 (eq. 14): the camera's tilt, at the robot's origin, one unit
+// above the ground, no yaw.
+Extrinsics camera_frame(double roll, double pitch) { return Extrinsics{0.0, 0.0, 1.0, roll, pitch, 0.0}; }
+
+struct HeldFrame {
+  cv::Mat gray;
+  double t = 0.0;
+  std::optional<SE2> odometry;
+  std::optional<int> direction;
+};
+
+}  // namespace
+
+const char* status_name(PipelineReport::Status s) {
+  switch (s) {
+    case PipelineReport::Status::Ok: return "ok";
+    case PipelineReport::Status::TooLittleTexture: return "too little texture";
+    case PipelineReport::Status::TooLittleMotion: return "too little motion";
+    case PipelineReport::Status::Unobservable: return "unobservable";
+    case PipelineReport::Status::Failed: return "failed";
+  }
+  return "?";
+}
+
+struct CameraCalibrator::Impl {
+  enum class Stage { RollPitch, Tracking, Stopped, Finished };
+
+  ocl::Runtime& rt;
+  CameraModel camera;
+  PipelineOptions opt;
+  Stage stage = Stage::RollPitch;
+  std::unique_ptr<track::RollPitchEstimator> roll_pitch;
+  std::vector<HeldFrame> held;
+  std::unique_ptr<track::Tracker> tracker;
+  MotionSampler sampler;
+  std::vector<double> frame_ms;
+  PipelineReport report;
+  Clock::time_point start = Clock::now();
+
+  static const PipelineOptions& validated(const PipelineOptions& o) {
+    if (!o.estimate_roll_pitch && !o.initial)
+      throw_invalid_argument("calibration: roll and pitch are not estimated, so initial extrinsics must give them");
+    if (o.graph.method == graph::CalibrationMethod::Nonholonomic && !o.graph.fix_scale)
+      throw_invalid_argument("calibration: the nonholonomic method needs the camera height (fix_scale, fixed_scale)");
+    if (o.max_buffered_frames < 2) throw_invalid_argument("calibration: max_buffered_frames must be at least 2");
+    return o;
+  }
+
+  static track::RollPitchOptions roll_pitch_options(const PipelineOptions& o) {
+    track::RollPitchOptions r = o.roll_pitch;
+    if (o.initial) {
+      r.initial_roll = o.initial->roll;
+      r.initial_pitch = o.initial->pitch;
+    }
+    return r;
+  }
+
+  Impl(ocl::Runtime& r, const CameraModel& c, const PipelineOptions& o) : rt(r), camera(c), opt(validated(o)) {
+    if (opt.estimate_roll_pitch) {
+      roll_pitch = std::make_unique<track::RollPitchEstimator>(rt, camera, roll_pitch_options(opt));
+    } else {
+      report.roll_pitch.status = track::RollPitchResult::Status::Ok;
+      report.roll_pitch.roll = opt.initial->roll;
+      report.roll_pitch.pitch = opt.initial->pitch;
+      start_tracking();
+    }
+  }
+
+  void start_tracking() {
+    tracker = std::make_unique<track::Tracker>(rt, camera, camera_frame(report.roll_pitch.roll, report.roll_pitch.pitch),
+                                               opt.tracker);
+    stage = Stage::Tracking;
+  }
+
+  void track(const uint8_t* gray, int width, int height, size_t stride, double t, const std::optional<SE2>& odometry,
+             const std::optional<int>& direction) {
+    const auto t0 = Clock::now();
+    const track::FrameResult r = tracker->track(gray, width, height, stride, t);
+    report.time.tracking += seconds_since(t0);
+    sampler.add(r, t, odometry, direction);
+    PipelineReport::Tracking& k = report.tracking;
+    ++k.frames;
+    k.engine_ms += r.ms;
+    frame_ms.push_back(r.ms);
+    k.keyframes += r.keyframe ? 1 : 0;
+    switch (r.status) {
+      case track::FrameResult::Status::First:
+      case track::FrameResult::Status::Ok: ++k.ok; break;
+      case track::FrameResult::Status::Degraded: ++k.degraded; break;
+      case track::FrameResult::Status::Lost: ++k.lost; break;
+    }
+  }
+
+  // Stage 1 ends: estimate, then track the frames held for it.
+  void end_roll_pitch() {
+    const auto t0 = Clock::now();
+    report.roll_pitch = roll_pitch->estimate();
+    roll_pitch.reset();  // its keyframe pyramids are no longer needed
+    report.time.roll_pitch += seconds_since(t0);
+    if (!report.roll_pitch.ok()) {
+      stage = Stage::Stopped;
+      report.status = report.roll_pitch.status == track::RollPitchResult::Status::TooLittleTexture
+                          ? PipelineReport::Status::TooLittleTexture
+                      : report.roll_pitch.status == track::RollPitchResult::Status::TooLittleMotion
+                          ? PipelineReport::Status::TooLittleMotion
+                          : PipelineReport::Status::Failed;
+      report.reason = "roll and pitch: " + report.roll_pitch.reason;
+      held.clear();
+      return;
+    }
+    start_tracking();
+    for (const HeldFrame& f : held) track(f.gray.data, f.gray.cols, f.gray.rows, f.gray.step, f.t, f.odometry, f.direction);
+    held.clear();
+  }
+
+  void add_frame(const uint8_t* gray, int width, int height, size_t stride, double t,
+                 const std::optional<SE2>& odometry, const std::optional<int>& direction) {
+    if (!gray) throw_invalid_argument("calibration: the frame is null");
+    if (width > 0 && stride < static_cast<size_t>(width))
+      throw_invalid_argument("calibration: the frame's stride is less than its width");
+    if (stage == Stage::Finished) throw_invalid_argument("calibration: frames added after finish()");
+    if (stage == Stage::Stopped) return;
+    if (stage == Stage::RollPitch) {
+      const auto t0 = Clock::now();
+      HeldFrame f;
+      if (width == camera.width && height == camera.height)
+        f.gray = cv::Mat(height, width, CV_8UC1, const_cast<uint8_t*>(gray), stride).clone();
+      else
+        f.gray = cv::Mat(height > 0 ? height : 1, width > 0 ? width : 1, CV_8UC1, cv::Scalar(0));  // tracked as lost
+      f.t = t;
+      f.odometry = odometry;
+      f.direction = direction;
+      held.push_back(std::move(f));
+      const bool complete = roll_pitch->add_frame(gray, width, height, stride, t);
+      report.time.roll_pitch += seconds_since(t0);
+      if (complete || static_cast<int>(held.size()) >= opt.max_buffered_frames) end_roll_pitch();
+      return;
+    }
+    track(gray, width, height, stride, t, odometry, direction);
+  }
+
+  // Stage 3 and the composition.
+  void calibrate_graph() {
+    const auto t0 = Clock::now();
+    graph::CalibrationOptions go = opt.graph;
+    if (opt.initial) go.initial = std::array<double, 4>{opt.initial->x, opt.initial->y, opt.initial->z, opt.initial->yaw};
+    std::vector<graph::MotionSample> samples = sampler.samples();
+    if (go.method == graph::CalibrationMethod::Odometry)
+      samples.erase(std::remove_if(samples.begin(), samples.end(), [](const graph::MotionSample& s) { return !s.odometry; }),
+                    samples.end());
+    report.samples = samples;
+    if (samples.size() < 3) {
+      report.status = PipelineReport::Status::Failed;
+      report.reason = "only " + std::to_string(samples.size()) + " frame intervals were tracked" +
+                      (go.method == graph::CalibrationMethod::Odometry ? " with odometry" : "") +
+                      ": nothing to calibrate x, y, height and yaw with";
+      return;
+    }
+    report.graph = graph::calibrate(samples, go);
+    report.time.graph = seconds_since(t0);
+    const track::RollPitchResult& rp = report.roll_pitch;
+    report.extrinsics = compose_extrinsics(rp.roll, rp.pitch, rp.covariance, opt.estimate_roll_pitch, report.graph);
+    if (report.graph.ok()) {
+      report.status = PipelineReport::Status::Ok;
+      report.reason.clear();
+    } else if (!report.graph.unobservable_reason.empty()) {
+      report.status = PipelineReport::Status::Unobservable;
+      report.reason = report.graph.unobservable_reason;
+    } else {
+      report.status = PipelineReport::Status::Failed;
+      report.reason = "the graph calibration did not converge: " + report.graph.summary.message;
+    }
+  }
+
+  PipelineReport finish() {
+    if (stage == Stage::Finished) throw_invalid_argument("calibration: finish() called twice");
+    if (stage == Stage::RollPitch) end_roll_pitch();
+    if (stage == Stage::Tracking) calibrate_graph();
+    stage = Stage::Finished;
+    if (!frame_ms.empty()) {
+      std::vector<double> ms = frame_ms;
+      std::nth_element(ms.begin(), ms.begin() + static_cast<long>(ms.size() / 2), ms.end());
+      report.tracking.median_ms = ms[ms.size() / 2];
+    }
+    report.time.total = seconds_since(start);
+    return std::move(report);
+  }
+};
+
+CameraCalibrator::CameraCalibrator(ocl::Runtime& runtime, const CameraModel& camera, const PipelineOptions& options)
+    : impl_(std::make_unique<Impl>(runtime, camera, options)) {}
+CameraCalibrator::~CameraCalibrator() = default;
+void CameraCalibrator::add_frame(const uint8_t* gray, int width, int height, size_t stride, double timestamp,
+                                 const std::optional<SE2>& odometry_pose, const std::optional<int>& direction) {
+  impl_->add_frame(gray, width, height, stride, timestamp, odometry_pose, direction);
+}
+PipelineReport CameraCalibrator::finish() { return impl_->finish(); }
+
+PipelineReport calibrate_dataset(ocl::Runtime& runtime, io::Dataset& ds, const PipelineOptions& options) {
+  const auto t0 = Clock::now();
+  if (options.graph.method == graph::CalibrationMethod::Odometry && !ds.has_odometry())
+    throw_invalid_input(ds.directory() + ": the odometry method needs wheel odometry (odometry.txt)");
+  if (options.graph.method == graph::CalibrationMethod::Nonholonomic && !ds.has_direction())
+    throw_invalid_input(ds.directory() +
+                        ": the nonholonomic method needs direction labels (direction.txt) for y and the branch");
+  CameraCalibrator calibrator(runtime, ds.camera(), options);
+  const int64_t n = ds.frame_count();
+  double decode = 0.0;
+  for (int64_t i = 0; i < n; ++i) {
+    const auto d0 = Clock::now();
+    const cv::Mat f = ds.frame(i);
+    decode += seconds_since(d0);
+    calibrator.add_frame(f.data, f.cols, f.rows, f.step, ds.timestamp(i), ds.odometry_at(i),
+                         ds.direction_for_interval(i));
+    if (options.progress && !options.progress(static_cast<double>(i + 1) / static_cast<double>(n), "tracking"))
+      throw Error(ErrorCode::Cancelled, "calibration cancelled");
+  }
+  if (options.progress && !options.progress(1.0, "graph calibration")) throw Error(ErrorCode::Cancelled, "calibration cancelled");
+  PipelineReport report = calibrator.finish();
+  report.time.decode = decode;
+  report.time.total = seconds_since(t0);
+  return report;
+}
+
+}  // namespace planarvo::calib

@@ -1,0 +1,260 @@
+// C API: the camera's calibration from images (src/calib/pipeline.h) and its first stage, roll and
+// pitch from images (src/track/roll_pitch.h).
+#include <cmath>
+#include <cstddef>
+#include <cstring>
+#include <memory>
+#include <string>
+
+#include "calib/pipeline.h"
+#include "capi/convert.h"
+#include "capi/graph_convert.h"
+#include "capi/handles.h"
+#include "capi/status.h"
+#include "capi/track_convert.h"
+#include "core/error.h"
+#include "track/roll_pitch.h"
+
+using planarvo::capi::guard;
+using planarvo::capi::require;
+
+struct planarvo_roll_pitch {
+  std::unique_ptr<planarvo::track::RollPitchEstimator> estimator;
+  cv::Mat grey;  // conversion buffer for colour and float frames
+};
+
+namespace {
+
+planarvo_calibration_status to_c(planarvo::track::RollPitchResult::Status s) {
+  using S = planarvo::track::RollPitchResult::Status;
+  switch (s) {
+    case S::Ok: return PLANARVO_CALIBRATION_OK;
+    case S::TooLittleTexture: return PLANARVO_CALIBRATION_TOO_LITTLE_TEXTURE;
+    case S::TooLittleMotion: return PLANARVO_CALIBRATION_TOO_LITTLE_MOTION;
+    case S::Failed: return PLANARVO_CALIBRATION_FAILED;
+  }
+  return PLANARVO_CALIBRATION_FAILED;
+}
+
+planarvo_calibration_status to_c(planarvo::calib::PipelineReport::Status s) {
+  using S = planarvo::calib::PipelineReport::Status;
+  switch (s) {
+    case S::Ok: return PLANARVO_CALIBRATION_OK;
+    case S::TooLittleTexture: return PLANARVO_CALIBRATION_TOO_LITTLE_TEXTURE;
+    case S::TooLittleMotion: return PLANARVO_CALIBRATION_TOO_LITTLE_MOTION;
+    case S::Unobservable: return PLANARVO_CALIBRATION_UNOBSERVABLE;
+    case S::Failed: return PLANARVO_CALIBRATION_FAILED;
+  }
+  return PLANARVO_CALIBRATION_FAILED;
+}
+
+constexpr size_t kRollPitchOptionsEnd = offsetof(planarvo_roll_pitch_options, search) + sizeof(int32_t);
+constexpr size_t kRollPitchResultEnd = offsetof(planarvo_roll_pitch_result, seconds) + sizeof(double);
+constexpr size_t kCameraOptionsEnd =
+    offsetof(planarvo_camera_calibration_options, progress_user_data) + sizeof(void*);
+constexpr size_t kCameraResultEnd = offsetof(planarvo_camera_calibration_result, seconds_total) + sizeof(double);
+
+planarvo::track::RollPitchOptions roll_pitch_options_from_c(const planarvo_roll_pitch_options* options) {
+  planarvo_roll_pitch_options o;
+  planarvo_roll_pitch_options_init(&o);
+  if (options) {
+    planarvo::capi::require_struct_size(options->struct_size, kRollPitchOptionsEnd, "planarvo_roll_pitch_options");
+    o = planarvo::capi::read_versioned(*options, o);
+  }
+  require(std::isfinite(o.initial_roll) && std::isfinite(o.initial_pitch),
+          "planarvo_roll_pitch_options.initial_roll and initial_pitch must be finite");
+  require(o.max_frames >= 0, "planarvo_roll_pitch_options.max_frames must be >= 0");
+  require(o.min_keyframes >= 2 && o.max_keyframes >= o.min_keyframes,
+          "planarvo_roll_pitch_options: need 2 <= min_keyframes <= max_keyframes");
+  require(o.keyframe_overlap > 0 && o.keyframe_overlap < 1, "planarvo_roll_pitch_options.keyframe_overlap must be in (0, 1)");
+  planarvo::track::RollPitchOptions r;
+  r.initial_roll = o.initial_roll;
+  r.initial_pitch = o.initial_pitch;
+  r.max_frames = o.max_frames;
+  r.min_keyframes = o.min_keyframes;
+  r.max_keyframes = o.max_keyframes;
+  r.keyframe_overlap = o.keyframe_overlap;
+  r.search = o.search != 0;
+  return r;
+}
+
+planarvo_roll_pitch_result roll_pitch_result_to_c(const planarvo::track::RollPitchResult& r) {
+  planarvo_roll_pitch_result out;
+  std::memset(&out, 0, sizeof out);
+  out.struct_size = sizeof out;
+  out.status = to_c(r.status);
+  planarvo::capi::copy_string(out.reason, sizeof out.reason, r.reason);
+  out.roll = r.roll;
+  out.pitch = r.pitch;
+  planarvo::capi::matrix_to_c<2>(r.covariance, out.covariance);
+  out.frames_used = r.frames_used;
+  out.keyframes = r.keyframes;
+  out.pairs = r.pairs;
+  out.seconds = (r.track_ms + r.align_ms) / 1000.0;
+  return out;
+}
+
+planarvo::CameraModel validated_camera(const planarvo_camera& camera, const char* where) {
+  const planarvo::CameraModel cam = planarvo::capi::to_cpp(camera);
+  try {
+    cam.validate(where);
+  } catch (const planarvo::Error& e) {
+    throw planarvo::Error(planarvo::ErrorCode::InvalidArgument, e.what());
+  }
+  return cam;
+}
+
+}  // namespace
+
+extern "C" {
+
+PLANARVO_API void planarvo_roll_pitch_options_init(planarvo_roll_pitch_options* o) {
+  if (!o) return;
+  std::memset(o, 0, sizeof *o);
+  const planarvo::track::RollPitchOptions d;
+  o->struct_size = sizeof *o;
+  o->initial_roll = d.initial_roll;
+  o->initial_pitch = d.initial_pitch;
+  o->max_frames = d.max_frames;
+  o->min_keyframes = d.min_keyframes;
+  o->max_keyframes = d.max_keyframes;
+  o->keyframe_overlap = d.keyframe_overlap;
+  o->search = d.search ? 1 : 0;
+}
+
+PLANARVO_API planarvo_status planarvo_roll_pitch_create(planarvo_context* context, const planarvo_camera* camera,
+                                                        const planarvo_roll_pitch_options* options,
+                                                        planarvo_roll_pitch** estimator) {
+  return guard([&] {
+    require(estimator != nullptr, "planarvo_roll_pitch_create: estimator is NULL");
+    *estimator = nullptr;
+    require(context != nullptr && camera != nullptr, "planarvo_roll_pitch_create: context and camera are required");
+    const planarvo::CameraModel cam = validated_camera(*camera, "planarvo_roll_pitch_create: camera");
+    auto h = std::make_unique<planarvo_roll_pitch>();
+    h->estimator = std::make_unique<planarvo::track::RollPitchEstimator>(*context->runtime, cam,
+                                                                         roll_pitch_options_from_c(options));
+    *estimator = h.release();
+  });
+}
+
+PLANARVO_API void planarvo_roll_pitch_destroy(planarvo_roll_pitch* estimator) { delete estimator; }
+
+PLANARVO_API planarvo_status planarvo_roll_pitch_add_frame(planarvo_roll_pitch* estimator,
+                                                           const planarvo_image* image, double timestamp,
+                                                           int32_t* complete) {
+  return guard([&] {
+    require(estimator != nullptr && image != nullptr, "planarvo_roll_pitch_add_frame: NULL argument");
+    require(image->data != nullptr && image->width > 0 && image->height > 0,
+            "planarvo_roll_pitch_add_frame: the image has no pixels");
+    require(image->format >= PLANARVO_GRAY8 && image->format <= PLANARVO_GRAY32F,
+            "planarvo_roll_pitch_add_frame: unknown pixel format");
+    size_t stride = 0;
+    const uint8_t* grey = planarvo::capi::grey_view(*image, estimator->grey, &stride);
+    require(stride >= static_cast<size_t>(image->width), "planarvo_roll_pitch_add_frame: stride is less than the row");
+    const bool done = estimator->estimator->add_frame(grey, image->width, image->height, stride, timestamp);
+    if (complete) *complete = done ? 1 : 0;
+  });
+}
+
+PLANARVO_API planarvo_status planarvo_roll_pitch_estimate(planarvo_roll_pitch* estimator,
+                                                          planarvo_roll_pitch_result* result) {
+  std::string reason;
+  const planarvo_status st = guard([&] {
+    require(estimator != nullptr && result != nullptr, "planarvo_roll_pitch_estimate: NULL argument");
+    planarvo::capi::require_struct_size(result->struct_size, kRollPitchResultEnd, "planarvo_roll_pitch_result");
+    const planarvo::track::RollPitchResult r = estimator->estimator->estimate();
+    planarvo::capi::write_versioned(roll_pitch_result_to_c(r), result);
+    reason = r.reason;
+  });
+  if (st == PLANARVO_OK && !reason.empty()) return planarvo::capi::fail(PLANARVO_ERROR_FAILED, reason);
+  return st;
+}
+
+PLANARVO_API void planarvo_camera_calibration_options_init(planarvo_camera_calibration_options* o) {
+  if (!o) return;
+  std::memset(o, 0, sizeof *o);
+  o->struct_size = sizeof *o;
+  o->method = PLANARVO_CALIBRATE_ODOMETRY;
+  o->height = 0.0;
+  o->roll_pitch_frames = 0;
+  o->estimate_roll_pitch = 1;
+}
+
+PLANARVO_API planarvo_status planarvo_calibrate_dataset(planarvo_context* context, planarvo_dataset* dataset,
+                                                        const planarvo_camera_calibration_options* options,
+                                                        planarvo_camera_calibration_result* result) {
+  std::string reason;
+  const planarvo_status st = guard([&] {
+    require(context != nullptr && dataset != nullptr && result != nullptr, "planarvo_calibrate_dataset: NULL argument");
+    planarvo::capi::require_struct_size(result->struct_size, kCameraResultEnd, "planarvo_camera_calibration_result");
+    planarvo_camera_calibration_options o;
+    planarvo_camera_calibration_options_init(&o);
+    if (options) {
+      planarvo::capi::require_struct_size(options->struct_size, kCameraOptionsEnd, "planarvo_camera_calibration_options");
+      o = planarvo::capi::read_versioned(*options, o);
+    }
+    require(o.method == PLANARVO_CALIBRATE_ODOMETRY || o.method == PLANARVO_CALIBRATE_NONHOLONOMIC,
+            "planarvo_camera_calibration_options.method is not a planarvo_calibration_method");
+    require(std::isfinite(o.height) && o.height >= 0, "planarvo_camera_calibration_options.height must be >= 0");
+    require(o.method == PLANARVO_CALIBRATE_ODOMETRY || o.height > 0,
+            "planarvo_camera_calibration_options.height: the nonholonomic method needs the camera height");
+    require(o.roll_pitch_frames >= 0, "planarvo_camera_calibration_options.roll_pitch_frames must be >= 0");
+    require(o.estimate_roll_pitch || o.has_initial,
+            "planarvo_camera_calibration_options: roll and pitch not estimated needs has_initial");
+    planarvo::calib::PipelineOptions po;
+    planarvo_calibration_options graph_read;
+    po.graph = planarvo::capi::calibration_options_from_c(o.graph, &graph_read);
+    po.graph.method = o.method == PLANARVO_CALIBRATE_ODOMETRY ? planarvo::graph::CalibrationMethod::Odometry
+                                                              : planarvo::graph::CalibrationMethod::Nonholonomic;
+    po.graph.fix_scale = o.height > 0;
+    po.graph.fixed_scale = o.height > 0 ? o.height : 1.0;
+    if (o.tracker) po.tracker = planarvo::capi::tracker_options_from_c(o.tracker);
+    po.roll_pitch.max_frames = o.roll_pitch_frames;
+    po.estimate_roll_pitch = o.estimate_roll_pitch != 0;
+    if (o.has_initial) {
+      require(o.initial.z > 0 && std::isfinite(o.initial.x + o.initial.y + o.initial.z + o.initial.roll +
+                                               o.initial.pitch + o.initial.yaw),
+              "planarvo_camera_calibration_options.initial must be finite with z > 0");
+      po.initial = planarvo::capi::to_cpp(o.initial);
+    }
+    if (o.progress) {
+      const planarvo_progress_fn fn = o.progress;
+      void* user = o.progress_user_data;
+      po.progress = [fn, user](double f, const char* stage) { return fn(user, f, stage) == 0; };
+    }
+    const planarvo::calib::PipelineReport r = planarvo::calib::calibrate_dataset(*context->runtime, *dataset->dataset, po);
+
+    planarvo_camera_calibration_result out;
+    std::memset(&out, 0, sizeof out);
+    out.struct_size = sizeof out;
+    out.status = to_c(r.status);
+    planarvo::capi::copy_string(out.reason, sizeof out.reason, r.reason);
+    out.extrinsics = planarvo::capi::to_c(r.extrinsics.value);
+    planarvo::capi::matrix_to_c<6>(r.extrinsics.covariance, out.covariance);
+    for (size_t i = 0; i < 6; ++i) {
+      out.estimated[i] = r.extrinsics.estimated[i];
+      out.observable[i] = r.extrinsics.observable[i];
+    }
+    out.roll_pitch = roll_pitch_result_to_c(r.roll_pitch);
+    out.graph = planarvo::capi::calibration_result_to_c(r.graph);
+    out.graph.struct_size = sizeof out.graph;
+    out.frames = r.tracking.frames;
+    out.frames_ok = r.tracking.ok;
+    out.frames_degraded = r.tracking.degraded;
+    out.frames_lost = r.tracking.lost;
+    out.samples = static_cast<int32_t>(r.samples.size());
+    out.tracking_median_ms = r.tracking.median_ms;
+    out.seconds_decode = r.time.decode;
+    out.seconds_roll_pitch = r.time.roll_pitch;
+    out.seconds_tracking = r.time.tracking;
+    out.seconds_graph = r.time.graph;
+    out.seconds_total = r.time.total;
+    planarvo::capi::write_versioned(out, result);
+    reason = r.reason;
+    if (!r.ok() && reason.empty()) reason = planarvo::calib::status_name(r.status);
+  });
+  if (st == PLANARVO_OK && !reason.empty()) return planarvo::capi::fail(PLANARVO_ERROR_FAILED, reason);
+  return st;
+}
+
+}  // extern "C"

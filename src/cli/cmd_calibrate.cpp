@@ -1,0 +1,116 @@
+// `planarvo calibrate DATASET`: the camera's extrinsics from a short drive (roll and pitch from
+// images, then x, y, height and yaw from the graph), through planarvo_calibrate_dataset.
+#include <cmath>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include "common.h"
+
+namespace planarvo::cli {
+namespace {
+
+constexpr double kDeg = M_PI / 180.0;
+
+const char* const kNames[6] = {"x", "y", "z", "roll", "pitch", "yaw"};
+
+void print_result(const planarvo_camera_calibration_result& r) {
+  std::printf("camera extrinsics (T_robot_camera; metres and radians in the file):\n");
+  const double v[6] = {r.extrinsics.x, r.extrinsics.y, r.extrinsics.z, r.extrinsics.roll, r.extrinsics.pitch,
+                       r.extrinsics.yaw};
+  for (int i = 0; i < 6; ++i) {
+    const bool angle = i >= 3;
+    const double k = angle ? 1 / kDeg : 1e3;
+    const char* unit = angle ? "deg" : "mm";
+    const double sd = std::sqrt(std::max(0.0, r.covariance[i * 7]));
+    if (!r.estimated[i]) {
+      std::printf("  %-5s %10.3f %-3s  (given, not estimated)\n", kNames[i], v[i] * k, unit);
+      continue;
+    }
+    std::printf("  %-5s %10.3f %-3s  +- %.3f%s\n", kNames[i], v[i] * k, unit, sd * k,
+                r.observable[i] ? "" : "  NOT DETERMINED");
+  }
+}
+
+}  // namespace
+
+int cmd_calibrate_dataset(const Args& args, const planarvo_calibration_options& graph) {
+  const std::string dir = args.positionals()[0];
+  planarvo_camera_calibration_options o;
+  planarvo_camera_calibration_options_init(&o);
+  const std::string method = args.get("method", "odometry");
+  o.method = graph.method;
+  o.graph = &graph;
+  if (args.has("fix-scale")) throw UsageError("--fix-scale is for metric sensors' motion pairs; give --height METRES");
+  if (args.has("initial")) throw UsageError("--initial is for motion pairs; give --initial-extrinsics FILE");
+  if (args.has("height")) {
+    o.height = args.get_double("height", 0);
+    if (!(o.height > 0)) throw UsageError("--height must be a positive number of metres");
+  } else if (o.method == PLANARVO_CALIBRATE_NONHOLONOMIC) {
+    throw UsageError("--method nonholonomic cannot estimate the camera height: give --height METRES");
+  }
+  if (args.has("frames")) {
+    const long long n = args.get_int("frames", 0);
+    if (n < 1) throw UsageError("--frames must be at least 1");
+    o.roll_pitch_frames = static_cast<int32_t>(n);
+  }
+  if (args.has("initial-extrinsics")) {
+    check(planarvo_extrinsics_load(args.get("initial-extrinsics").c_str(), &o.initial));
+    o.has_initial = 1;
+  }
+  const std::string out = args.get("output");
+  ContextPtr ctx = make_context(args);
+  Progress progress(!args.has("quiet"));
+  DatasetPtr ds = open_dataset(dir, args.get("video"), false, &progress);
+  planarvo_dataset_info info{};
+  info.struct_size = sizeof info;
+  check(planarvo_dataset_info_get(ds.get(), &info));
+  if (o.method == PLANARVO_CALIBRATE_ODOMETRY && !info.has_odometry)
+    throw UsageError(dir + " has no odometry.txt: the odometry method needs wheel odometry (or use --method "
+                           "nonholonomic with direction.txt and --height)");
+  if (o.method == PLANARVO_CALIBRATE_NONHOLONOMIC && !info.has_direction)
+    throw UsageError(dir + " has no direction.txt: the nonholonomic method needs the direction labels");
+  o.progress = &Progress::callback;
+  o.progress_user_data = &progress;
+  planarvo_camera_calibration_result r{};
+  r.struct_size = sizeof r;
+  const planarvo_status st = planarvo_calibrate_dataset(ctx.get(), ds.get(), &o, &r);
+  progress.finish();
+  if (st != PLANARVO_OK && st != PLANARVO_ERROR_FAILED) check(st);
+
+  std::printf("calibrated %s (%s) on %s\n", dir.c_str(), method.c_str(), device_name(ctx.get()).c_str());
+  if (r.roll_pitch.status == PLANARVO_CALIBRATION_OK && r.roll_pitch.keyframes > 0)
+    std::printf("roll and pitch: %d keyframes (%d pairs) from %d frames, %.2f s\n", r.roll_pitch.keyframes,
+                r.roll_pitch.pairs, r.roll_pitch.frames_used, r.seconds_roll_pitch);
+  if (r.frames > 0)
+    std::printf("tracking: %d frames, %d ok, %d degraded, %d lost; %d intervals; median %.2f ms per frame, %.2f s\n",
+                r.frames, r.frames_ok, r.frames_degraded, r.frames_lost, r.samples, r.tracking_median_ms,
+                r.seconds_tracking);
+  if (r.samples > 0)
+    std::printf("graph calibration: %d iterations over all solves, %d gross errors gated, variance factor %.3g, "
+                "%.3f s\n",
+                r.graph.total_iterations, r.graph.outliers, r.graph.variance_factor, r.seconds_graph);
+  std::printf("time: %.2f s in all (%.2f s reading images)\n", r.seconds_total, r.seconds_decode);
+  if (st == PLANARVO_OK || r.status == PLANARVO_CALIBRATION_UNOBSERVABLE) print_result(r);
+  if (st == PLANARVO_ERROR_FAILED) {
+    std::fprintf(stderr, "planarvo calibrate: %s\n", r.reason);
+    if (!out.empty()) std::fprintf(stderr, "planarvo calibrate: %s not written\n", out.c_str());
+    return kExitFailed;
+  }
+  if (!out.empty()) {
+    std::string estimated;
+    for (int i = 0; i < 6; ++i)
+      if (r.estimated[i]) estimated += std::string(estimated.empty() ? "" : ",") + kNames[i];
+    const std::string m = method == "odometry"
+                              ? "roll and pitch from images (sec. 5.1); x, y, z, yaw against wheel odometry (5.2.1)"
+                              : "roll and pitch from images (sec. 5.1); x, yaw nonholonomic, y from direction labels "
+                                "(5.2.2), z given";
+    const std::string notes = "planarvo calibrate " + dir;
+    check(planarvo_extrinsics_save(out.c_str(), &r.extrinsics, r.covariance, estimated.c_str(), m.c_str(),
+                                   notes.c_str()));
+    std::printf("wrote %s\n", out.c_str());
+  }
+  return kExitOk;
+}
+
+}  // namespace planarvo::cli
