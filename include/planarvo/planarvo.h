@@ -481,6 +481,11 @@ typedef struct planarvo_motion_pair {
 
 /* Zeroes *pair (no odometry, direction or covariances) and sets its struct_size. */
 PLANARVO_API void planarvo_motion_pair_init(planarvo_motion_pair* pair);
+/* Writes count motion pairs (elements pairs[0].struct_size bytes apart) as the CSV that
+ * planarvo_motion_pairs_load reads. Every pair must have the same columns (all with odometry or
+ * none, all with a direction label or none); covariances are not written. */
+PLANARVO_API planarvo_status planarvo_motion_pairs_save(const char* path, const planarvo_motion_pair* pairs,
+                                                        size_t count);
 
 /* Reads a motion-pair CSV (columns interval_s, [odo_dx, odo_dy, odo_dtheta,] sensor_dx, sensor_dy,
  * sensor_dtheta[, direction]; without a direction column the odometry's forward motion gives it).

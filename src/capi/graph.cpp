@@ -299,6 +299,24 @@ PLANARVO_API planarvo_status planarvo_motion_pairs_load(const char* path, planar
   });
 }
 
+PLANARVO_API planarvo_status planarvo_motion_pairs_save(const char* path, const planarvo_motion_pair* pairs,
+                                                        size_t count) {
+  return guard([&] {
+    require(path != nullptr && *path, "planarvo_motion_pairs_save: path is NULL or empty");
+    require(count == 0 || pairs != nullptr, "planarvo_motion_pairs_save: pairs is NULL");
+    std::vector<planarvo::io::MotionPair> out(count);
+    const size_t stride = count > 0 ? motion_pair_stride(pairs) : sizeof(planarvo_motion_pair);
+    for (size_t i = 0; i < count; ++i) {
+      const planarvo::graph::MotionSample s = read_pair(pairs, stride, i);
+      out[i].interval = s.interval;
+      out[i].sensor = s.sensor;
+      out[i].odometry = s.odometry;
+      out[i].direction = s.direction;
+    }
+    planarvo::io::write_motion_pairs(path, out);
+  });
+}
+
 PLANARVO_API void planarvo_motion_pair_init(planarvo_motion_pair* pair) {
   if (!pair) return;
   std::memset(pair, 0, sizeof *pair);

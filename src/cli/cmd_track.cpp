@@ -52,6 +52,11 @@ TrackRun track_dataset(planarvo_context* ctx, planarvo_dataset* ds, const planar
   std::vector<planarvo_se2> pose(n), motion(n), truth(n);
   std::vector<int32_t> valid(n, 0);
   bool all_truth = info.has_groundtruth != 0;
+  // Motion pairs: every tracked interval, with the data set's odometry and direction label when it
+  // has them (an interval the odometry or the labels do not cover is left out, so that every row
+  // has the same columns).
+  std::vector<planarvo_motion_pair> pairs;
+  planarvo_frame_data previous{};
   for (size_t i = 0; i < n; ++i) {
     planarvo_frame_data fd{};
     check(planarvo_dataset_frame_data(ds, static_cast<int64_t>(i), &fd));
@@ -73,6 +78,23 @@ TrackRun track_dataset(planarvo_context* ctx, planarvo_dataset* ds, const planar
     valid[i] = r.status == PLANARVO_TRACK_OK || r.status == PLANARVO_TRACK_DEGRADED;
     if (fd.has_groundtruth) truth[i] = fd.groundtruth;
     else all_truth = false;
+    if (!outputs.motions.empty() && i > 0 &&
+        (r.status == PLANARVO_TRACK_OK || r.status == PLANARVO_TRACK_DEGRADED) &&
+        (!info.has_odometry || (fd.has_odometry && previous.has_odometry)) &&
+        (!info.has_direction || fd.has_direction)) {
+      planarvo_motion_pair p;
+      planarvo_motion_pair_init(&p);
+      p.interval = fd.timestamp - previous.timestamp;
+      p.sensor = r.motion;
+      p.has_sensor_covariance = 1;
+      for (int k = 0; k < 9; ++k) p.sensor_covariance[k] = r.covariance[k];
+      p.has_odometry = info.has_odometry;
+      if (p.has_odometry) p.odometry = relative(previous.odometry, fd.odometry);
+      p.has_direction = info.has_direction;
+      p.direction = fd.direction;
+      if (p.interval > 0) pairs.push_back(p);
+    }
+    previous = fd;
     if (stats) {
       const double dt = i > 0 ? t[i] - t[i - 1] : 0;
       planarvo_frame_stats row{};
@@ -91,6 +113,7 @@ TrackRun track_dataset(planarvo_context* ctx, planarvo_dataset* ds, const planar
   }
   if (stats) check(planarvo_stats_writer_close(stats.release()));
   if (!outputs.trajectory.empty()) check(planarvo_write_tum(outputs.trajectory.c_str(), t.data(), pose.data(), n));
+  if (!outputs.motions.empty()) check(planarvo_motion_pairs_save(outputs.motions.c_str(), pairs.data(), pairs.size()));
   if (all_truth && n > 1) {
     std::vector<planarvo_se2> est(n - 1), tru(n - 1);
     std::vector<double> dt(n - 1);
@@ -135,6 +158,8 @@ int cmd_track(int argc, char** argv) {
       {"extrinsics", "FILE", "camera extrinsics YAML", "DATASET/extrinsics.yaml"},
       {"output", "FILE", "write the trajectory (TUM) to FILE (also -o)", ""},
       {"stats", "FILE", "write per-frame statistics (CSV) to FILE", ""},
+      {"motions-out", "FILE", "write the tracked frame-to-frame motions, with the data set's odometry and direction "
+                              "labels, as motion pairs (CSV) for calibrate --motions", ""},
       {"levels", "N", "pyramid levels", "4"},
       {"finest-level", "N", "finest pyramid level tracked (0 = full resolution)", "the coarsest at least 320 px wide"},
       {"max-iterations", "N", "cap on alignment steps per level", "per-level defaults"},
@@ -167,7 +192,7 @@ int cmd_track(int argc, char** argv) {
   ContextPtr ctx = make_context(args);
   Progress progress(!args.has("quiet"));
   DatasetPtr ds = open_dataset(dir, args.get("video"), false, &progress);
-  const TrackRun run = track_dataset(ctx.get(), ds.get(), e, o, {args.get("output"), args.get("stats")}, &progress);
+  const TrackRun run = track_dataset(ctx.get(), ds.get(), e, o, {args.get("output"), args.get("stats"), args.get("motions-out")}, &progress);
   progress.finish();
   std::printf("tracked %s on %s\n", dir.c_str(), device_name(ctx.get()).c_str());
   print_track_run(run);

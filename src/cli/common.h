@@ -65,6 +65,7 @@ struct TrackRun {
 };
 struct TrackOutputs {
   std::string trajectory, stats;  // "" for none
+  std::string motions;            // motion-pair CSV of the tracked intervals, "" for none
 };
 TrackRun track_dataset(planarvo_context* ctx, planarvo_dataset* ds, const planarvo_extrinsics& extrinsics,
                        const planarvo_tracker_options& options, const TrackOutputs& outputs, Progress* progress);

@@ -112,6 +112,23 @@ TEST(CalibrateDataset, OdometryMethodThroughTheCApiAndTheTool) {
   for (int i = 0; i < 36; ++i) EXPECT_NEAR(f.covariance(i / 6, i % 6), r.covariance[i], 1e-20) << i;
   EXPECT_EQ(f.estimated.size(), 6u);
 
+  // The other route: track at the camera's own frame (true tilt, x = y = 0, z = 1, yaw = 0), write
+  // the motions with --motions-out, calibrate from the CSV: x, y, height and yaw again.
+  io::ExtrinsicsFile virtual_frame;
+  virtual_frame.value = Extrinsics{0, 0, 1, t.roll, t.pitch, 0};
+  io::write_extrinsics_yaml((dir / "virtual.yaml").string(), virtual_frame);
+  const std::string pairs = (dir / "pairs.csv").string();
+  ASSERT_EQ(test::run_cli("track \"" + dir.path().string() + "\" --quiet --extrinsics \"" + (dir / "virtual.yaml").string() +
+                          "\" --motions-out \"" + pairs + "\"").exit_code, 0);
+  const std::string from_pairs = (dir / "from_pairs.yaml").string();
+  const test::CommandResult cp = test::run_cli("calibrate --motions \"" + pairs + "\" -o \"" + from_pairs + "\"");
+  ASSERT_EQ(cp.exit_code, 0) << cp.output;
+  const io::ExtrinsicsFile g = io::read_extrinsics_yaml(from_pairs);
+  EXPECT_LT(std::abs(g.value.x - t.x), 3e-3);
+  EXPECT_LT(std::abs(g.value.y - t.y), 3e-3);
+  EXPECT_LT(std::abs(g.value.z - t.z), 2e-3);
+  EXPECT_LT(std::abs(std::remainder(g.value.yaw - t.yaw, 2 * M_PI)), 0.3 * kDeg);
+
   // Bad usage: exit 2 and nothing written.
   std::filesystem::remove(out);
   EXPECT_EQ(test::run_cli("calibrate \"" + dir.path().string() + "\" --method nonholonomic -o \"" + out + "\"").exit_code, 2);
