@@ -542,6 +542,12 @@ typedef struct planarvo_calibration_options {
    * (no linear motion) when the odometry's forward speed is below this, else its sign. m/s,
    * default 1e-3; >= 0. */
   double still_speed;
+  /* Odometry method, pairs without an odometry covariance: non-zero fits the odometry's noise model
+   * to the calibration's own residuals (per component along travel, sideways and in heading: a
+   * constant, a part per metre and a part per radian) and solves again, so the covariance reflects
+   * the odometry's actual noise. Default 0 here; planarvo_calibrate_dataset uses 1 when its graph
+   * options are NULL. */
+  int32_t estimate_odometry_noise;
 } planarvo_calibration_options;
 
 typedef struct planarvo_calibration_result {

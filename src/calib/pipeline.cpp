@@ -31,6 +31,13 @@ struct HeldFrame {
 
 }  // namespace
 
+graph::CalibrationOptions PipelineOptions::default_graph_options() {
+  graph::CalibrationOptions o;
+  // The camera's motions are micrometre-precise, so the residuals measure the odometry's noise.
+  o.estimate_odometry_noise = true;
+  return o;
+}
+
 const char* status_name(PipelineReport::Status s) {
   switch (s) {
     case PipelineReport::Status::Ok: return "ok";

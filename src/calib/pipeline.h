@@ -43,8 +43,9 @@ struct PipelineOptions {
   // Stage 2: the tracker (its extrinsics come from stage 1).
   track::TrackerOptions tracker;
   // Stage 3: the method, the height when it is given (fix_scale, fixed_scale: the nonholonomic
-  // method needs it), the noise model and robustness.
-  graph::CalibrationOptions graph;
+  // method needs it), the noise model and robustness. The odometry's noise model is estimated
+  // from the drive (estimate_odometry_noise) unless turned off here.
+  graph::CalibrationOptions graph = default_graph_options();
   // A starting guess of the extrinsics: its roll and pitch start stage 1 and its x, y, z, yaw
   // start stage 3 (otherwise stage 1 starts looking straight down and stage 3 from its closed
   // form).
@@ -52,6 +53,8 @@ struct PipelineOptions {
   // Progress: fraction of the frames fed so far (calibrate_dataset; a stream's total is unknown)
   // and the stage; return false to cancel (Error(Cancelled)).
   std::function<bool(double fraction, const char* stage)> progress;
+
+  static graph::CalibrationOptions default_graph_options();
 };
 
 struct PipelineReport {

@@ -203,7 +203,7 @@ PLANARVO_API planarvo_status planarvo_calibrate_dataset(planarvo_context* contex
             "planarvo_camera_calibration_options: roll and pitch not estimated needs has_initial");
     planarvo::calib::PipelineOptions po;
     planarvo_calibration_options graph_read;
-    po.graph = planarvo::capi::calibration_options_from_c(o.graph, &graph_read);
+    if (o.graph) po.graph = planarvo::capi::calibration_options_from_c(o.graph, &graph_read);
     po.graph.method = o.method == PLANARVO_CALIBRATE_ODOMETRY ? planarvo::graph::CalibrationMethod::Odometry
                                                               : planarvo::graph::CalibrationMethod::Nonholonomic;
     po.graph.fix_scale = o.height > 0;

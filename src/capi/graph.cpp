@@ -192,6 +192,7 @@ planarvo::graph::CalibrationOptions calibration_options_from_c(const planarvo_ca
   co.loss_scale = o.loss_scale;
   co.gate_sigma = o.gate_sigma;
   co.still_speed = o.still_speed;
+  co.estimate_odometry_noise = o.estimate_odometry_noise != 0;
   return co;
 }
 
@@ -343,6 +344,7 @@ PLANARVO_API void planarvo_calibration_options_init(planarvo_calibration_options
   o->loss_scale = d.loss_scale;
   o->gate_sigma = d.gate_sigma;
   o->still_speed = d.still_speed;
+  o->estimate_odometry_noise = d.estimate_odometry_noise ? 1 : 0;
 }
 
 PLANARVO_API planarvo_status planarvo_calibrate(const planarvo_motion_pair* pairs, size_t count,

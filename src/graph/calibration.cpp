@@ -2,6 +2,7 @@
 // factors.h and solved by the sparse LM solver, with a closed-form start, a robust pass and
 // gating, and the covariance and observability of z.
 #include "graph/calibration.h"
+#include "graph/odometry_noise.h"
 
 #include <algorithm>
 #include <chrono>
@@ -420,17 +421,48 @@ CalibrationResult calibrate_odometry(Context& ctx) {
     solved = true;
   }
   bool kernel_on = o.loss != RobustLoss::None;
-  if (o.gate_sigma > 0.0) {
-    for (int round = 0; round < 5; ++round) {
-      sample_chi2(chi2, sample_of);
-      const int gated = gate(ctx, chi2, sample_of, kChi2Median3);
-      if (round > 0 && gated == 0) break;
-      solve_pass(nullptr);
-      kernel_on = false;
-      solved = true;
+  auto gated_least_squares = [&] {
+    if (o.gate_sigma > 0.0) {
+      for (int round = 0; round < 5; ++round) {
+        sample_chi2(chi2, sample_of);
+        const int gated = gate(ctx, chi2, sample_of, kChi2Median3);
+        if (round > 0 && gated == 0) break;
+        solve_pass(nullptr);
+        kernel_on = false;
+        solved = true;
+      }
+    }
+    if (!solved) solve_pass(nullptr);
+  };
+  gated_least_squares();
+  // The odometry's own noise model from the inliers' residuals (odometry_noise.h), twice: the
+  // second fit sees the estimate and the inliers of the first.
+  bool given = false;
+  for (const MotionSample& s : ctx.samples) given = given || s.odometry->has_covariance();
+  if (o.estimate_odometry_noise && !given) {
+    for (int round = 0; round < 2; ++round) {
+      const SE2 T(z[CI::kX], z[CI::kY], z[CI::kYaw]);
+      const double h = z[CI::kHeight];
+      std::vector<SE2> odometry;
+      std::vector<Eigen::Vector3d> residual;
+      for (size_t i = 0; i < n; ++i)
+        if (ctx.inlier[i]) {
+          const SE2& ms = ctx.samples[i].sensor.value;
+          const SE2 mapped = T * SE2(h * ms.x, h * ms.y, ms.theta) * T.inverse();
+          const SE2& mo = ctx.samples[i].odometry->value;
+          const SE2 e = mo.inverse() * mapped;
+          odometry.push_back(mo);
+          residual.emplace_back(e.x, e.y, e.theta);
+        }
+      r.odometry_noise = fit_odometry_noise(odometry, residual);
+      for (size_t i = 0; i < n; ++i) {
+        const SE2& mo = ctx.samples[i].odometry->value;
+        ctx.odo_cov[i] = component_covariance(Motion{mo, r.odometry_noise->covariance(mo)});
+      }
+      solved = false;
+      gated_least_squares();
     }
   }
-  if (!solved) solve_pass(nullptr);
 
   for (size_t i = 0; i < n; ++i)
     if (!ctx.inlier[i]) r.outlier_samples.push_back(static_cast<int>(i));

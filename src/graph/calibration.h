@@ -20,6 +20,7 @@
 
 #include "core/motion.h"
 #include "core/se2.h"
+#include "graph/odometry_noise.h"
 #include "graph/solver.h"
 
 namespace planarvo::graph {
@@ -59,6 +60,12 @@ struct CalibrationOptions {
   double sensor_sigma_theta = 1e-3;                                // rad
   double odometry_sigma_relative = 0.01, odometry_sigma_floor = 1e-4;  // m
   double odometry_sigma_theta = 2e-3;                                  // rad
+  // Odometry method, samples whose odometry carries no covariance: replace the model above by one
+  // fitted to the calibration's own residuals (graph/odometry_noise.h: per component, a constant,
+  // a part per travel and a part per turn, in the frame of the motion), then solve again. For a
+  // sensor much more precise than the odometry, such as the tracked camera; the result's
+  // covariance then reflects the odometry's actual noise rather than a guess.
+  bool estimate_odometry_noise = false;
   // Robustness against gross sensor errors (about 1% of scan matches fail on real data): a first
   // solve with the robust loss, then gating: a sample whose normalised squared residual exceeds
   // gate_sigma² (times the residuals' own robust variance factor where that exceeds 1, so that
@@ -113,6 +120,8 @@ struct CalibrationResult {
   // labels 0 pin y; the interval the ±1 labels leave otherwise, ±infinity where unbounded).
   std::array<int, 3> direction_counts{};
   std::optional<std::array<double, 2>> y_interval;
+  // The odometry noise model fitted when options.estimate_odometry_noise was used.
+  std::optional<OdometryNoiseModel> odometry_noise;
   SolverSummary summary;      // the final solve's
   int total_iterations = 0;   // LM iterations over all solves (initial, robust, gated)
   double total_time_s = 0.0;  // calibrate() as a whole
