@@ -9,6 +9,13 @@
 //     method=odometry|nonholonomic  (nonholonomic: the true height is given)  default odometry
 //     seconds=S (20) size=WxH (640x480) odometry_noise=REL (0.02) noise=GREY (1) gain=REL (0.05)
 //     seed=N (1) frames=N (roll/pitch frames; 0 = until the map is complete) keep=DIR (keep data sets)
+//
+//   bench_calibrate windows [key=value ...]   the paper's statistical form (its Tables 1-3, 5): one
+//     long drive (seconds=60), the calibration run on overlapping sub-trajectories of window=20 s
+//     every step=5 s, roll and pitch from frames=10 frames of each; mean +- std and the truth per
+//     parameter. texture=, config=, method= as above.
+#include <array>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -16,6 +23,7 @@
 #include <map>
 #include <sstream>
 #include <string>
+#include <optional>
 #include <vector>
 
 #include <unistd.h>
@@ -71,7 +79,10 @@ Extrinsics config(const std::string& name, uint64_t seed) {
 
 }  // namespace
 
+int windows(const std::map<std::string, std::string>& args);
+
 int main(int argc, char** argv) {
+  if (argc > 1 && std::string(argv[1]) == "windows") return windows(parse(argc - 1, argv + 1));
   const auto args = parse(argc, argv);
   const std::string shared = PLANARVO_SHARED_DIR;
   const auto textures = split(get(args, "textures", "asphalt_01.png,anti_skid_tiles.png"));
@@ -144,5 +155,85 @@ int main(int argc, char** argv) {
   for (int i = 0; i < 6; ++i)
     if (counted[i] > 0)
       std::printf("%-6s %9.4f %-3s %18.2f\n", names[i], worst[i], i < 3 ? "mm" : "deg", std::sqrt(nees[i] / counted[i]));
+  return 0;
+}
+
+int windows(const std::map<std::string, std::string>& args) {
+  const std::string shared = PLANARVO_SHARED_DIR;
+  const uint64_t seed = std::stoull(get(args, "seed", "1"));
+  const bool nonholonomic = get(args, "method", "odometry") == "nonholonomic";
+  sim::Options so;
+  so.texture = shared + "/data/textures/" + get(args, "texture", "asphalt_01.png");
+  so.extrinsics = config(get(args, "config", "1"), seed);
+  so.seconds = std::stod(get(args, "seconds", "60"));
+  so.seed = seed;
+  so.odometry_noise = std::stod(get(args, "odometry_noise", "0.02"));
+  const double window = std::stod(get(args, "window", "20")), step = std::stod(get(args, "step", "5"));
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / ("planarvo_bench_windows_" + std::to_string(::getpid()));
+  std::filesystem::remove_all(dir);
+  ocl::Runtime rt;
+  sim::simulate(rt, so, dir.string());
+  io::Dataset ds(dir.string());
+  const Extrinsics& t = so.extrinsics;
+  const double truth[6] = {t.x, t.y, t.z, t.roll, t.pitch, t.yaw};
+  const double scale[6] = {1e3, 1e3, 1e3, 1 / kDeg, 1 / kDeg, 1 / kDeg};
+  const char* names[6] = {"x mm", "y mm", "z mm", "roll deg", "pitch deg", "yaw deg"};
+  std::vector<std::array<double, 6>> values;
+  std::vector<std::array<double, 6>> sigmas;
+  int failed = 0;
+  std::printf("%-8s %8s %8s %8s %8s %8s %8s %8s  %s\n", "start s", names[0], names[1], names[2], names[3], names[4],
+              names[5], "time s", "status");
+  const double fps = so.fps;
+  for (double start = 0.0; start + window <= so.seconds + 1e-9; start += step) {
+    calib::PipelineOptions po;
+    if (nonholonomic) {
+      po.graph.method = graph::CalibrationMethod::Nonholonomic;
+      po.graph.fix_scale = true;
+      po.graph.fixed_scale = t.z;
+    }
+    po.roll_pitch.max_frames = std::stoi(get(args, "frames", "10"));
+    const auto t0 = std::chrono::steady_clock::now();
+    calib::CameraCalibrator cal(rt, ds.camera(), po);
+    const auto first = static_cast<int64_t>(std::llround(start * fps));
+    const auto last = std::min<int64_t>(ds.frame_count(), first + static_cast<int64_t>(std::llround(window * fps)));
+    for (int64_t i = first; i < last; ++i) {
+      const cv::Mat f = ds.frame(i);
+      cal.add_frame(f.data, f.cols, f.rows, f.step, ds.timestamp(i), ds.odometry_at(i),
+                    i > first ? ds.direction_for_interval(i) : std::nullopt);
+    }
+    const calib::PipelineReport r = cal.finish();
+    const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    const Extrinsics& e = r.extrinsics.value;
+    const std::array<double, 6> v = {e.x, e.y, e.z, e.roll, e.pitch, e.yaw};
+    std::printf("%-8.1f", start);
+    for (int k = 0; k < 6; ++k) std::printf(" %8.3f", v[static_cast<size_t>(k)] * scale[k]);
+    std::printf(" %8.2f  %s%s%s\n", secs, calib::status_name(r.status), r.reason.empty() ? "" : ": ", r.reason.c_str());
+    std::fflush(stdout);
+    if (!r.ok()) {
+      ++failed;
+      continue;
+    }
+    values.push_back(v);
+    std::array<double, 6> sd{};
+    for (int k = 0; k < 6; ++k) sd[static_cast<size_t>(k)] = std::sqrt(std::max(0.0, r.extrinsics.covariance(k, k)));
+    sigmas.push_back(sd);
+  }
+  std::filesystem::remove_all(dir);
+  std::printf("\n%zu windows of %.0f s every %.0f s over %.0f s, %d not ok; roll and pitch from %s frames each\n",
+              values.size(), window, step, so.seconds, failed, get(args, "frames", "10").c_str());
+  std::printf("%-10s %12s %12s %12s %14s\n", "param", "truth", "mean", "std", "mean sigma");
+  for (int k = 0; k < 6; ++k) {
+    double mean = 0, var = 0, ms = 0;
+    for (size_t i = 0; i < values.size(); ++i) {
+      mean += values[i][static_cast<size_t>(k)];
+      ms += sigmas[i][static_cast<size_t>(k)];
+    }
+    mean /= std::max<size_t>(1, values.size());
+    ms /= std::max<size_t>(1, values.size());
+    for (const auto& v : values) var += (v[static_cast<size_t>(k)] - mean) * (v[static_cast<size_t>(k)] - mean);
+    var /= std::max<size_t>(1, values.size() - 1);
+    std::printf("%-10s %12.3f %12.3f %12.3f %14.3f\n", names[k], truth[k] * scale[k], mean * scale[k],
+                std::sqrt(var) * scale[k], ms * scale[k]);
+  }
   return 0;
 }
