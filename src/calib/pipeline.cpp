@@ -222,6 +222,15 @@ void CameraCalibrator::add_frame(const uint8_t* gray, int width, int height, siz
   impl_->add_frame(gray, width, height, stride, timestamp, odometry_pose, direction);
 }
 PipelineReport CameraCalibrator::finish() { return impl_->finish(); }
+const char* CameraCalibrator::stage() const {
+  switch (impl_->stage) {
+    case Impl::Stage::RollPitch: return "roll and pitch";
+    case Impl::Stage::Tracking: return "tracking";
+    case Impl::Stage::Stopped: return "stopped";
+    case Impl::Stage::Finished: return "finished";
+  }
+  return "?";
+}
 
 PipelineReport calibrate_dataset(ocl::Runtime& runtime, io::Dataset& ds, const PipelineOptions& options) {
   const auto t0 = Clock::now();
@@ -239,7 +248,7 @@ PipelineReport calibrate_dataset(ocl::Runtime& runtime, io::Dataset& ds, const P
     decode += seconds_since(d0);
     calibrator.add_frame(f.data, f.cols, f.rows, f.step, ds.timestamp(i), ds.odometry_at(i),
                          ds.direction_for_interval(i));
-    if (options.progress && !options.progress(static_cast<double>(i + 1) / static_cast<double>(n), "tracking"))
+    if (options.progress && !options.progress(static_cast<double>(i + 1) / static_cast<double>(n), calibrator.stage()))
       throw Error(ErrorCode::Cancelled, "calibration cancelled");
   }
   if (options.progress && !options.progress(1.0, "graph calibration")) throw Error(ErrorCode::Cancelled, "calibration cancelled");

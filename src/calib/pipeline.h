@@ -108,6 +108,10 @@ class CameraCalibrator {
   // Runs what is left (stage 1 if its map is still open, stage 3) and returns the report. Once.
   PipelineReport finish();
 
+  // What the frames are going to now: "roll and pitch", "tracking", or "stopped" (stage 1 refused;
+  // later frames are not used).
+  const char* stage() const;
+
  private:
   struct Impl;
   std::unique_ptr<Impl> impl_;
