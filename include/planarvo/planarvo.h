@@ -677,6 +677,46 @@ PLANARVO_API planarvo_status planarvo_calibrate_dataset(planarvo_context* contex
                                                         const planarvo_camera_calibration_options* options,
                                                         planarvo_camera_calibration_result* result);
 
+/* The same calibration on a stream of frames (a camera, a bag): frames are fed one at a time with
+ * the robot's wheel-odometry pose at the frame's time (NULL when there is none) and the direction
+ * label of the interval ending at the frame (NULL when there is none); the frames that roll and
+ * pitch use are held until those are known, then tracked. */
+typedef struct planarvo_camera_calibrator planarvo_camera_calibrator;
+/* camera: the distorted camera the frames come from. options may be NULL. */
+PLANARVO_API planarvo_status planarvo_camera_calibrator_create(planarvo_context* context,
+                                                               const planarvo_camera* camera,
+                                                               const planarvo_camera_calibration_options* options,
+                                                               planarvo_camera_calibrator** calibrator);
+PLANARVO_API void planarvo_camera_calibrator_destroy(planarvo_camera_calibrator* calibrator);
+PLANARVO_API planarvo_status planarvo_camera_calibrator_add_frame(planarvo_camera_calibrator* calibrator,
+                                                                  const planarvo_image* image, double timestamp,
+                                                                  const planarvo_se2* odometry_pose,
+                                                                  const int32_t* direction);
+/* Runs what is left and fills result (once per calibrator); PLANARVO_ERROR_FAILED with the reason
+ * when the status is not OK, the result filled in either case. */
+PLANARVO_API planarvo_status planarvo_camera_calibrator_finish(planarvo_camera_calibrator* calibrator,
+                                                               planarvo_camera_calibration_result* result);
+
+/* The stages on their own. Motions from a data set: tracks every frame with the given extrinsics
+ * (for the graph calibration of a camera: x = y = 0, z = 1, yaw = 0 and its roll and pitch) and
+ * writes one motion pair per tracked interval (lost ones left out): the tracker's motion with its
+ * covariance as the sensor's, the data set's odometry and direction label where it has them.
+ * capacity must be at least the frame count - 1; *count receives the pairs written (each with
+ * struct_size = sizeof(planarvo_motion_pair)). options may be NULL. */
+PLANARVO_API planarvo_status planarvo_track_motions(planarvo_context* context, planarvo_dataset* dataset,
+                                                    const planarvo_extrinsics* extrinsics,
+                                                    const planarvo_tracker_options* options,
+                                                    planarvo_motion_pair* pairs, size_t capacity, size_t* count);
+/* Composition: roll and pitch (with their 2x2 covariance, row-major; NULL when they were given,
+ * not estimated) and a graph calibration's x, y, scale (the height) and yaw as the camera's
+ * extrinsics, their 6x6 covariance (order x y z roll pitch yaw, row-major; zero rows for what was
+ * not estimated) and, per parameter, whether it was estimated (any output may be NULL). */
+PLANARVO_API planarvo_status planarvo_compose_extrinsics(double roll, double pitch,
+                                                         const double* roll_pitch_covariance,
+                                                         const planarvo_calibration_result* graph,
+                                                         planarvo_extrinsics* extrinsics, double* covariance,
+                                                         int32_t* estimated);
+
 #ifdef __cplusplus
 }
 #endif

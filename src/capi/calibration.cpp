@@ -4,8 +4,10 @@
 #include <cstddef>
 #include <cstring>
 #include <memory>
+#include <optional>
 #include <string>
 
+#include "calib/motion_samples.h"
 #include "calib/pipeline.h"
 #include "capi/convert.h"
 #include "capi/graph_convert.h"
@@ -17,6 +19,12 @@
 
 using planarvo::capi::guard;
 using planarvo::capi::require;
+
+struct planarvo_camera_calibrator {
+  std::unique_ptr<planarvo::calib::CameraCalibrator> calibrator;
+  cv::Mat grey;
+  bool finished = false;
+};
 
 struct planarvo_roll_pitch {
   std::unique_ptr<planarvo::track::RollPitchEstimator> estimator;
@@ -104,6 +112,74 @@ planarvo::CameraModel validated_camera(const planarvo_camera& camera, const char
   return cam;
 }
 
+planarvo::calib::PipelineOptions pipeline_options_from_c(const planarvo_camera_calibration_options* options) {
+  planarvo_camera_calibration_options o;
+  planarvo_camera_calibration_options_init(&o);
+  if (options) {
+    planarvo::capi::require_struct_size(options->struct_size, kCameraOptionsEnd, "planarvo_camera_calibration_options");
+    o = planarvo::capi::read_versioned(*options, o);
+  }
+  require(o.method == PLANARVO_CALIBRATE_ODOMETRY || o.method == PLANARVO_CALIBRATE_NONHOLONOMIC,
+          "planarvo_camera_calibration_options.method is not a planarvo_calibration_method");
+  require(std::isfinite(o.height) && o.height >= 0, "planarvo_camera_calibration_options.height must be >= 0");
+  require(o.method == PLANARVO_CALIBRATE_ODOMETRY || o.height > 0,
+          "planarvo_camera_calibration_options.height: the nonholonomic method needs the camera height");
+  require(o.roll_pitch_frames >= 0, "planarvo_camera_calibration_options.roll_pitch_frames must be >= 0");
+  require(o.estimate_roll_pitch || o.has_initial,
+          "planarvo_camera_calibration_options: roll and pitch not estimated needs has_initial");
+  planarvo::calib::PipelineOptions po;
+  planarvo_calibration_options graph_read;
+  if (o.graph) po.graph = planarvo::capi::calibration_options_from_c(o.graph, &graph_read);
+  po.graph.method = o.method == PLANARVO_CALIBRATE_ODOMETRY ? planarvo::graph::CalibrationMethod::Odometry
+                                                            : planarvo::graph::CalibrationMethod::Nonholonomic;
+  po.graph.fix_scale = o.height > 0;
+  po.graph.fixed_scale = o.height > 0 ? o.height : 1.0;
+  if (o.tracker) po.tracker = planarvo::capi::tracker_options_from_c(o.tracker);
+  po.roll_pitch.max_frames = o.roll_pitch_frames;
+  po.estimate_roll_pitch = o.estimate_roll_pitch != 0;
+  if (o.has_initial) {
+    require(o.initial.z > 0 && std::isfinite(o.initial.x + o.initial.y + o.initial.z + o.initial.roll +
+                                             o.initial.pitch + o.initial.yaw),
+            "planarvo_camera_calibration_options.initial must be finite with z > 0");
+    po.initial = planarvo::capi::to_cpp(o.initial);
+  }
+  if (o.progress) {
+    const planarvo_progress_fn fn = o.progress;
+    void* user = o.progress_user_data;
+    po.progress = [fn, user](double f, const char* stage) { return fn(user, f, stage) == 0; };
+  }
+  return po;
+}
+
+planarvo_camera_calibration_result report_to_c(const planarvo::calib::PipelineReport& r) {
+  planarvo_camera_calibration_result out;
+  std::memset(&out, 0, sizeof out);
+  out.struct_size = sizeof out;
+  out.status = to_c(r.status);
+  planarvo::capi::copy_string(out.reason, sizeof out.reason, r.reason);
+  out.extrinsics = planarvo::capi::to_c(r.extrinsics.value);
+  planarvo::capi::matrix_to_c<6>(r.extrinsics.covariance, out.covariance);
+  for (size_t i = 0; i < 6; ++i) {
+    out.estimated[i] = r.extrinsics.estimated[i];
+    out.observable[i] = r.extrinsics.observable[i];
+  }
+  out.roll_pitch = roll_pitch_result_to_c(r.roll_pitch);
+  out.graph = planarvo::capi::calibration_result_to_c(r.graph);
+  out.graph.struct_size = sizeof out.graph;
+  out.frames = r.tracking.frames;
+  out.frames_ok = r.tracking.ok;
+  out.frames_degraded = r.tracking.degraded;
+  out.frames_lost = r.tracking.lost;
+  out.samples = static_cast<int32_t>(r.samples.size());
+  out.tracking_median_ms = r.tracking.median_ms;
+  out.seconds_decode = r.time.decode;
+  out.seconds_roll_pitch = r.time.roll_pitch;
+  out.seconds_tracking = r.time.tracking;
+  out.seconds_graph = r.time.graph;
+  out.seconds_total = r.time.total;
+  return out;
+}
+
 }  // namespace
 
 extern "C" {
@@ -187,74 +263,140 @@ PLANARVO_API planarvo_status planarvo_calibrate_dataset(planarvo_context* contex
   const planarvo_status st = guard([&] {
     require(context != nullptr && dataset != nullptr && result != nullptr, "planarvo_calibrate_dataset: NULL argument");
     planarvo::capi::require_struct_size(result->struct_size, kCameraResultEnd, "planarvo_camera_calibration_result");
-    planarvo_camera_calibration_options o;
-    planarvo_camera_calibration_options_init(&o);
-    if (options) {
-      planarvo::capi::require_struct_size(options->struct_size, kCameraOptionsEnd, "planarvo_camera_calibration_options");
-      o = planarvo::capi::read_versioned(*options, o);
-    }
-    require(o.method == PLANARVO_CALIBRATE_ODOMETRY || o.method == PLANARVO_CALIBRATE_NONHOLONOMIC,
-            "planarvo_camera_calibration_options.method is not a planarvo_calibration_method");
-    require(std::isfinite(o.height) && o.height >= 0, "planarvo_camera_calibration_options.height must be >= 0");
-    require(o.method == PLANARVO_CALIBRATE_ODOMETRY || o.height > 0,
-            "planarvo_camera_calibration_options.height: the nonholonomic method needs the camera height");
-    require(o.roll_pitch_frames >= 0, "planarvo_camera_calibration_options.roll_pitch_frames must be >= 0");
-    require(o.estimate_roll_pitch || o.has_initial,
-            "planarvo_camera_calibration_options: roll and pitch not estimated needs has_initial");
-    planarvo::calib::PipelineOptions po;
-    planarvo_calibration_options graph_read;
-    if (o.graph) po.graph = planarvo::capi::calibration_options_from_c(o.graph, &graph_read);
-    po.graph.method = o.method == PLANARVO_CALIBRATE_ODOMETRY ? planarvo::graph::CalibrationMethod::Odometry
-                                                              : planarvo::graph::CalibrationMethod::Nonholonomic;
-    po.graph.fix_scale = o.height > 0;
-    po.graph.fixed_scale = o.height > 0 ? o.height : 1.0;
-    if (o.tracker) po.tracker = planarvo::capi::tracker_options_from_c(o.tracker);
-    po.roll_pitch.max_frames = o.roll_pitch_frames;
-    po.estimate_roll_pitch = o.estimate_roll_pitch != 0;
-    if (o.has_initial) {
-      require(o.initial.z > 0 && std::isfinite(o.initial.x + o.initial.y + o.initial.z + o.initial.roll +
-                                               o.initial.pitch + o.initial.yaw),
-              "planarvo_camera_calibration_options.initial must be finite with z > 0");
-      po.initial = planarvo::capi::to_cpp(o.initial);
-    }
-    if (o.progress) {
-      const planarvo_progress_fn fn = o.progress;
-      void* user = o.progress_user_data;
-      po.progress = [fn, user](double f, const char* stage) { return fn(user, f, stage) == 0; };
-    }
+    const planarvo::calib::PipelineOptions po = pipeline_options_from_c(options);
     const planarvo::calib::PipelineReport r = planarvo::calib::calibrate_dataset(*context->runtime, *dataset->dataset, po);
 
-    planarvo_camera_calibration_result out;
-    std::memset(&out, 0, sizeof out);
-    out.struct_size = sizeof out;
-    out.status = to_c(r.status);
-    planarvo::capi::copy_string(out.reason, sizeof out.reason, r.reason);
-    out.extrinsics = planarvo::capi::to_c(r.extrinsics.value);
-    planarvo::capi::matrix_to_c<6>(r.extrinsics.covariance, out.covariance);
-    for (size_t i = 0; i < 6; ++i) {
-      out.estimated[i] = r.extrinsics.estimated[i];
-      out.observable[i] = r.extrinsics.observable[i];
-    }
-    out.roll_pitch = roll_pitch_result_to_c(r.roll_pitch);
-    out.graph = planarvo::capi::calibration_result_to_c(r.graph);
-    out.graph.struct_size = sizeof out.graph;
-    out.frames = r.tracking.frames;
-    out.frames_ok = r.tracking.ok;
-    out.frames_degraded = r.tracking.degraded;
-    out.frames_lost = r.tracking.lost;
-    out.samples = static_cast<int32_t>(r.samples.size());
-    out.tracking_median_ms = r.tracking.median_ms;
-    out.seconds_decode = r.time.decode;
-    out.seconds_roll_pitch = r.time.roll_pitch;
-    out.seconds_tracking = r.time.tracking;
-    out.seconds_graph = r.time.graph;
-    out.seconds_total = r.time.total;
+    const planarvo_camera_calibration_result out = report_to_c(r);
     planarvo::capi::write_versioned(out, result);
     reason = r.reason;
     if (!r.ok() && reason.empty()) reason = planarvo::calib::status_name(r.status);
   });
   if (st == PLANARVO_OK && !reason.empty()) return planarvo::capi::fail(PLANARVO_ERROR_FAILED, reason);
   return st;
+}
+
+PLANARVO_API planarvo_status planarvo_camera_calibrator_create(planarvo_context* context,
+                                                               const planarvo_camera* camera,
+                                                               const planarvo_camera_calibration_options* options,
+                                                               planarvo_camera_calibrator** calibrator) {
+  return guard([&] {
+    require(calibrator != nullptr, "planarvo_camera_calibrator_create: calibrator is NULL");
+    *calibrator = nullptr;
+    require(context != nullptr && camera != nullptr, "planarvo_camera_calibrator_create: context and camera are required");
+    const planarvo::CameraModel cam = validated_camera(*camera, "planarvo_camera_calibrator_create: camera");
+    auto h = std::make_unique<planarvo_camera_calibrator>();
+    h->calibrator = std::make_unique<planarvo::calib::CameraCalibrator>(*context->runtime, cam,
+                                                                        pipeline_options_from_c(options));
+    *calibrator = h.release();
+  });
+}
+
+PLANARVO_API void planarvo_camera_calibrator_destroy(planarvo_camera_calibrator* calibrator) { delete calibrator; }
+
+PLANARVO_API planarvo_status planarvo_camera_calibrator_add_frame(planarvo_camera_calibrator* calibrator,
+                                                                  const planarvo_image* image, double timestamp,
+                                                                  const planarvo_se2* odometry_pose,
+                                                                  const int32_t* direction) {
+  return guard([&] {
+    require(calibrator != nullptr && image != nullptr, "planarvo_camera_calibrator_add_frame: NULL argument");
+    require(!calibrator->finished, "planarvo_camera_calibrator_add_frame: the calibrator has finished");
+    require(image->data != nullptr && image->width > 0 && image->height > 0,
+            "planarvo_camera_calibrator_add_frame: the image has no pixels");
+    require(image->format >= PLANARVO_GRAY8 && image->format <= PLANARVO_GRAY32F,
+            "planarvo_camera_calibrator_add_frame: unknown pixel format");
+    require(std::isfinite(timestamp), "planarvo_camera_calibrator_add_frame: timestamp is not finite");
+    require(!direction || (*direction >= -1 && *direction <= 1),
+            "planarvo_camera_calibrator_add_frame: direction must be -1, 0 or 1");
+    require(!odometry_pose || std::isfinite(odometry_pose->x + odometry_pose->y + odometry_pose->theta),
+            "planarvo_camera_calibrator_add_frame: odometry_pose is not finite");
+    size_t stride = 0;
+    const uint8_t* grey = planarvo::capi::grey_view(*image, calibrator->grey, &stride);
+    std::optional<planarvo::SE2> odometry;
+    if (odometry_pose) odometry = planarvo::capi::to_cpp(*odometry_pose);
+    std::optional<int> label;
+    if (direction) label = *direction;
+    calibrator->calibrator->add_frame(grey, image->width, image->height, stride, timestamp, odometry, label);
+  });
+}
+
+PLANARVO_API planarvo_status planarvo_camera_calibrator_finish(planarvo_camera_calibrator* calibrator,
+                                                               planarvo_camera_calibration_result* result) {
+  std::string reason;
+  const planarvo_status st = guard([&] {
+    require(calibrator != nullptr && result != nullptr, "planarvo_camera_calibrator_finish: NULL argument");
+    planarvo::capi::require_struct_size(result->struct_size, kCameraResultEnd, "planarvo_camera_calibration_result");
+    require(!calibrator->finished, "planarvo_camera_calibrator_finish: called twice");
+    calibrator->finished = true;
+    const planarvo::calib::PipelineReport r = calibrator->calibrator->finish();
+    planarvo::capi::write_versioned(report_to_c(r), result);
+    reason = r.reason;
+    if (!r.ok() && reason.empty()) reason = planarvo::calib::status_name(r.status);
+  });
+  if (st == PLANARVO_OK && !reason.empty()) return planarvo::capi::fail(PLANARVO_ERROR_FAILED, reason);
+  return st;
+}
+
+PLANARVO_API planarvo_status planarvo_track_motions(planarvo_context* context, planarvo_dataset* dataset,
+                                                    const planarvo_extrinsics* extrinsics,
+                                                    const planarvo_tracker_options* options,
+                                                    planarvo_motion_pair* pairs, size_t capacity, size_t* count) {
+  return guard([&] {
+    require(context != nullptr && dataset != nullptr && extrinsics != nullptr && pairs != nullptr && count != nullptr,
+            "planarvo_track_motions: NULL argument");
+    *count = 0;
+    planarvo::io::Dataset& ds = *dataset->dataset;
+    const auto n = static_cast<size_t>(ds.frame_count());
+    if (capacity + 1 < n)
+      throw planarvo::capi::BufferTooSmall("planarvo_track_motions: " + std::to_string(n) + " frames need capacity " +
+                                           std::to_string(n - 1) + ", not " + std::to_string(capacity));
+    require(extrinsics->z > 0, "planarvo_track_motions: extrinsics.z (the camera height) must be positive");
+    planarvo::track::Tracker tracker(*context->runtime, ds.camera(), planarvo::capi::to_cpp(*extrinsics),
+                                     planarvo::capi::tracker_options_from_c(options));
+    planarvo::calib::MotionSampler sampler;
+    for (size_t i = 0; i < n; ++i) {
+      const auto k = static_cast<int64_t>(i);
+      const cv::Mat f = ds.frame(k);
+      const planarvo::track::FrameResult r = tracker.track(f.data, f.cols, f.rows, f.step, ds.timestamp(k));
+      sampler.add(r, ds.timestamp(k), ds.odometry_at(k), ds.direction_for_interval(k));
+    }
+    for (const planarvo::graph::MotionSample& s : sampler.samples()) {
+      planarvo_motion_pair p;
+      planarvo_motion_pair_init(&p);
+      p.interval = s.interval;
+      planarvo::capi::motion_to_c(s.sensor, &p.sensor, &p.has_sensor_covariance, p.sensor_covariance);
+      p.has_odometry = s.odometry.has_value();
+      if (s.odometry) planarvo::capi::motion_to_c(*s.odometry, &p.odometry, &p.has_odometry_covariance, p.odometry_covariance);
+      p.has_direction = s.direction.has_value();
+      if (s.direction) p.direction = *s.direction;
+      pairs[(*count)++] = p;
+    }
+  });
+}
+
+PLANARVO_API planarvo_status planarvo_compose_extrinsics(double roll, double pitch,
+                                                         const double* roll_pitch_covariance,
+                                                         const planarvo_calibration_result* graph,
+                                                         planarvo_extrinsics* extrinsics, double* covariance,
+                                                         int32_t* estimated) {
+  return guard([&] {
+    require(graph != nullptr, "planarvo_compose_extrinsics: graph is NULL");
+    require(std::isfinite(roll) && std::isfinite(pitch), "planarvo_compose_extrinsics: roll and pitch must be finite");
+    planarvo::graph::CalibrationResult g;
+    for (size_t i = 0; i < 4; ++i) {
+      g.value[i] = graph->value[i];
+      g.estimated[i] = graph->estimated[i] != 0;
+      g.observable[i] = graph->observable[i] != 0;
+    }
+    g.covariance = planarvo::capi::matrix_from_c<4>(graph->covariance);
+    const Eigen::Matrix2d rp = roll_pitch_covariance ? Eigen::Matrix2d(planarvo::capi::matrix_from_c<2>(roll_pitch_covariance))
+                                                     : Eigen::Matrix2d(Eigen::Matrix2d::Zero());
+    const planarvo::calib::ExtrinsicsEstimate e =
+        planarvo::calib::compose_extrinsics(roll, pitch, rp, roll_pitch_covariance != nullptr, g);
+    if (extrinsics) *extrinsics = planarvo::capi::to_c(e.value);
+    if (covariance) planarvo::capi::matrix_to_c<6>(e.covariance, covariance);
+    if (estimated)
+      for (size_t i = 0; i < 6; ++i) estimated[i] = e.estimated[i] ? 1 : 0;
+  });
 }
 
 }  // extern "C"

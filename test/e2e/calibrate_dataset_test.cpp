@@ -6,7 +6,9 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <memory>
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -200,6 +202,79 @@ TEST(CalibrateDataset, StandingStillIsTooLittleMotionExit1) {
   const std::string out = (dir / "calibrated.yaml").string();
   EXPECT_EQ(test::run_cli("calibrate \"" + dir.path().string() + "\" --quiet -o \"" + out + "\"").exit_code, 1);
   EXPECT_FALSE(std::filesystem::exists(out));
+}
+
+TEST(CalibrateDataset, StagesAndStreamThroughTheCApiEqualThePipeline) {
+  test::ScratchDir dir;
+  {
+    ocl::Runtime rt;
+    sim::simulate(rt, drive(6.0, sim::MotionProfile::Mixed, 15), dir.path().string());
+  }
+  planarvo_status st;
+  const planarvo_camera_calibration_result whole = calibrate_c(dir.path().string(), &st);
+  ASSERT_EQ(st, PLANARVO_OK) << planarvo_last_error();
+
+  planarvo_context* ctx = nullptr;
+  ASSERT_EQ(planarvo_context_create(nullptr, &ctx), PLANARVO_OK);
+  std::unique_ptr<planarvo_context, ContextDeleter> context(ctx);
+  planarvo_dataset* ds = nullptr;
+  ASSERT_EQ(planarvo_dataset_open(dir.path().string().c_str(), nullptr, &ds), PLANARVO_OK);
+  std::unique_ptr<planarvo_dataset, DatasetDeleter> dataset(ds);
+  planarvo_dataset_info info{};
+  info.struct_size = sizeof info;
+  ASSERT_EQ(planarvo_dataset_info_get(ds, &info), PLANARVO_OK);
+
+  // The stream: the same frames, odometry and labels, one at a time.
+  planarvo_camera_calibrator* cal = nullptr;
+  ASSERT_EQ(planarvo_camera_calibrator_create(ctx, &info.camera, nullptr, &cal), PLANARVO_OK) << planarvo_last_error();
+  for (int64_t i = 0; i < info.frame_count; ++i) {
+    planarvo_frame_data fd{};
+    ASSERT_EQ(planarvo_dataset_frame_data(ds, i, &fd), PLANARVO_OK);
+    planarvo_image img{};
+    ASSERT_EQ(planarvo_dataset_frame(ds, i, &img), PLANARVO_OK);
+    ASSERT_EQ(planarvo_camera_calibrator_add_frame(cal, &img, fd.timestamp, fd.has_odometry ? &fd.odometry : nullptr,
+                                                   fd.has_direction ? &fd.direction : nullptr),
+              PLANARVO_OK)
+        << planarvo_last_error();
+  }
+  planarvo_camera_calibration_result streamed{};
+  streamed.struct_size = sizeof streamed;
+  ASSERT_EQ(planarvo_camera_calibrator_finish(cal, &streamed), PLANARVO_OK) << planarvo_last_error();
+  EXPECT_EQ(planarvo_camera_calibrator_finish(cal, &streamed), PLANARVO_ERROR_INVALID_ARGUMENT);
+  planarvo_camera_calibrator_destroy(cal);
+  for (int i = 0; i < 36; ++i) EXPECT_EQ(streamed.covariance[i], whole.covariance[i]) << i;
+  EXPECT_EQ(streamed.extrinsics.x, whole.extrinsics.x);
+  EXPECT_EQ(streamed.extrinsics.yaw, whole.extrinsics.yaw);
+
+  // The stages by hand: motions tracked with the pipeline's roll and pitch, the graph calibration
+  // with the odometry's noise estimated, the composition.
+  const planarvo_extrinsics frame{0, 0, 1, whole.roll_pitch.roll, whole.roll_pitch.pitch, 0};
+  std::vector<planarvo_motion_pair> pairs(static_cast<size_t>(info.frame_count));
+  pairs[0].struct_size = sizeof(planarvo_motion_pair);
+  size_t n = 0;
+  EXPECT_EQ(planarvo_track_motions(ctx, ds, &frame, nullptr, pairs.data(), 3, &n), PLANARVO_ERROR_BUFFER_TOO_SMALL);
+  ASSERT_EQ(planarvo_track_motions(ctx, ds, &frame, nullptr, pairs.data(), pairs.size(), &n), PLANARVO_OK)
+      << planarvo_last_error();
+  EXPECT_EQ(static_cast<int>(n), whole.samples);
+  planarvo_calibration_options go;
+  planarvo_calibration_options_init(&go);
+  go.estimate_odometry_noise = 1;
+  planarvo_calibration_result g{};
+  g.struct_size = sizeof g;
+  ASSERT_EQ(planarvo_calibrate(pairs.data(), n, &go, &g), PLANARVO_OK) << planarvo_last_error();
+  planarvo_extrinsics e{};
+  double cov[36];
+  int32_t estimated[6];
+  ASSERT_EQ(planarvo_compose_extrinsics(whole.roll_pitch.roll, whole.roll_pitch.pitch, whole.roll_pitch.covariance, &g,
+                                        &e, cov, estimated),
+            PLANARVO_OK);
+  EXPECT_NEAR(e.x, whole.extrinsics.x, 1e-12);
+  EXPECT_NEAR(e.y, whole.extrinsics.y, 1e-12);
+  EXPECT_NEAR(e.z, whole.extrinsics.z, 1e-12);
+  EXPECT_NEAR(e.yaw, whole.extrinsics.yaw, 1e-12);
+  EXPECT_EQ(e.roll, whole.extrinsics.roll);
+  for (int i = 0; i < 36; ++i) EXPECT_NEAR(cov[i], whole.covariance[i], 1e-9 * std::abs(whole.covariance[i]) + 1e-20) << i;
+  for (int i = 0; i < 6; ++i) EXPECT_EQ(estimated[i], whole.estimated[i]) << i;
 }
 
 }  // namespace
