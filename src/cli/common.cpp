@@ -82,6 +82,8 @@ int Progress::callback(void* self, double fraction, const char* stage) {
   const int permille = static_cast<int>(fraction * 1000.0 + 0.5);
   const std::string s = stage ? stage : "";
   if (permille == p->last_permille_ && s == p->last_stage_) return 0;
+  // A new stage keeps the last one's bar on its own line and starts a bar of its own.
+  if (p->drawn_ && s != p->last_stage_) std::fprintf(stderr, "\n");
   p->last_permille_ = permille;
   p->last_stage_ = s;
   const int width = 30, filled = permille * width / 1000;
