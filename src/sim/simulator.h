@@ -38,6 +38,11 @@ enum class MotionProfile {
 // The paper's camera configuration 1: x 0.2441, y -0.0185, z 0.1787 m, roll 12.4, pitch 17.6,
 // yaw -9.2 degrees.
 Extrinsics default_extrinsics();
+// The paper's camera configurations 1, 2 and 3 (its Tables 1-3) as numbers in conventions.md's
+// convention (the paper states none; these are borrowed as numbers, not as the same mounts):
+// 1 = default_extrinsics(); 2 = (0.1917, -0.1078, 0.2164 m; 29.8, -4.6, 75.8 degrees);
+// 3 = (0.2226, 0.0806, 0.1469 m; -26.6, 4.7, -18.6 degrees). InvalidArgument for another k.
+Extrinsics paper_configuration(int k);
 // width x height pixels with a horizontal field of view of fov_deg measured on the distorted
 // image (the centres of the outermost pixel columns are fov_deg apart), mild barrel distortion
 // k1 = -0.12, k2 = 0.03, principal point a little off the image centre as real lenses have.

@@ -117,15 +117,15 @@ void require(bool ok, const std::string& what) {
 
 }  // namespace
 
-Extrinsics default_extrinsics() {
-  Extrinsics e;
-  e.x = 0.2441;
-  e.y = -0.0185;
-  e.z = 0.1787;
-  e.roll = 12.4 * kDeg;
-  e.pitch = 17.6 * kDeg;
-  e.yaw = -9.2 * kDeg;
-  return e;
+Extrinsics default_extrinsics() { return paper_configuration(1); }
+
+Extrinsics paper_configuration(int k) {
+  switch (k) {
+    case 1: return Extrinsics{0.2441, -0.0185, 0.1787, 12.4 * kDeg, 17.6 * kDeg, -9.2 * kDeg};
+    case 2: return Extrinsics{0.1917, -0.1078, 0.2164, 29.8 * kDeg, -4.6 * kDeg, 75.8 * kDeg};
+    case 3: return Extrinsics{0.2226, 0.0806, 0.1469, -26.6 * kDeg, 4.7 * kDeg, -18.6 * kDeg};
+    default: throw_invalid_argument("the paper's camera configurations are 1, 2 and 3, not " + std::to_string(k));
+  }
 }
 
 CameraModel default_camera(int width, int height, double fov_deg) {

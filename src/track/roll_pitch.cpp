@@ -115,13 +115,7 @@ struct RollPitchEstimator::Impl {
     pipeline.process(gray, width, height, stride, spare);
     const FrameResult r = tracker.track(spare, t);
     if (r.status == FrameResult::Status::First) {
-      keyframes.clear();
-      motions.clear();
-      keyframe_frames.clear();
-      keyframes.push_back(std::move(spare));
-      keyframe_frames.push_back(frames - 1);
-      spare = Pyramid();
-      since_keyframe = SE2();
+      start_map();
       return finish_frame(t0);
     }
     if (r.status == FrameResult::Status::Lost) {
@@ -151,6 +145,11 @@ struct RollPitchEstimator::Impl {
       return;
     }
     ++restarts;
+    start_map();
+  }
+
+  // The frame just fed (its pyramid in `spare`) becomes the map's first keyframe.
+  void start_map() {
     keyframes.clear();
     motions.clear();
     keyframe_frames.clear();

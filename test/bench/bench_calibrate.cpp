@@ -31,6 +31,7 @@
 #include "calib/pipeline.h"
 #include "io/dataset.h"
 #include "sim/simulator.h"
+#include "bench_args.h"
 #include "ocl/runtime.h"
 
 using namespace planarvo;
@@ -39,51 +40,25 @@ namespace {
 
 constexpr double kDeg = M_PI / 180.0;
 
-std::map<std::string, std::string> parse(int argc, char** argv) {
-  std::map<std::string, std::string> m;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    const auto eq = a.find('=');
-    if (eq == std::string::npos) {
-      std::fprintf(stderr, "bench_calibrate: arguments are key=value, not %s\n", a.c_str());
-      std::exit(2);
-    }
-    m[a.substr(0, eq)] = a.substr(eq + 1);
-  }
-  return m;
-}
-
-std::string get(const std::map<std::string, std::string>& m, const std::string& k, const std::string& d) {
-  const auto it = m.find(k);
-  return it == m.end() ? d : it->second;
-}
-
-std::vector<std::string> split(const std::string& s) {
-  std::vector<std::string> out;
-  std::stringstream ss(s);
-  std::string item;
-  while (std::getline(ss, item, ',')) out.push_back(item);
-  return out;
-}
+using bench::get;
+using bench::split;
 
 Extrinsics config(const std::string& name, uint64_t seed) {
-  if (name == "2") return {0.1917, -0.1078, 0.2164, 29.8 * kDeg, -4.6 * kDeg, 75.8 * kDeg};
-  if (name == "3") return {0.2226, 0.0806, 0.1469, -26.6 * kDeg, 4.7 * kDeg, -18.6 * kDeg};
   if (name[0] == 'r') {
     sim::Random r(sim::derive_seed(seed, 500 + std::stoull(name.substr(1))));
     return {r.uniform(-0.3, 0.3), r.uniform(-0.2, 0.2), r.uniform(0.12, 0.3),
             r.uniform(-25, 25) * kDeg, r.uniform(-25, 25) * kDeg, r.uniform(-180, 180) * kDeg};
   }
-  return {0.2441, -0.0185, 0.1787, 12.4 * kDeg, 17.6 * kDeg, -9.2 * kDeg};
+  return sim::paper_configuration(std::stoi(name));
 }
 
 }  // namespace
 
-int windows(const std::map<std::string, std::string>& args);
+int windows(const bench::Args& args);
 
 int main(int argc, char** argv) {
-  if (argc > 1 && std::string(argv[1]) == "windows") return windows(parse(argc - 1, argv + 1));
-  const auto args = parse(argc, argv);
+  if (argc > 1 && std::string(argv[1]) == "windows") return windows(bench::parse_args(argc - 1, argv + 1, "bench_calibrate windows"));
+  const auto args = bench::parse_args(argc, argv, "bench_calibrate");
   const std::string shared = PLANARVO_SHARED_DIR;
   const auto textures = split(get(args, "textures", "asphalt_01.png,anti_skid_tiles.png"));
   const auto configs = split(get(args, "configs", "1,2,3,r1,r2"));
@@ -158,7 +133,7 @@ int main(int argc, char** argv) {
   return 0;
 }
 
-int windows(const std::map<std::string, std::string>& args) {
+int windows(const bench::Args& args) {
   const std::string shared = PLANARVO_SHARED_DIR;
   const uint64_t seed = std::stoull(get(args, "seed", "1"));
   const bool nonholonomic = get(args, "method", "odometry") == "nonholonomic";

@@ -23,6 +23,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "sim/simulator.h"
+#include "bench_args.h"
 #include "ocl/runtime.h"
 #include "track/roll_pitch.h"
 
@@ -32,45 +33,13 @@ namespace {
 
 constexpr double kDeg = M_PI / 180.0;
 
-std::map<std::string, std::string> parse(int argc, char** argv) {
-  std::map<std::string, std::string> m;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    const auto eq = a.find('=');
-    if (eq == std::string::npos) {
-      std::fprintf(stderr, "bench_roll_pitch: arguments are key=value, not %s\n", a.c_str());
-      std::exit(2);
-    }
-    m[a.substr(0, eq)] = a.substr(eq + 1);
-  }
-  return m;
-}
-
-std::string get(const std::map<std::string, std::string>& m, const std::string& k, const std::string& d) {
-  const auto it = m.find(k);
-  return it == m.end() ? d : it->second;
-}
-
-std::vector<std::string> split(const std::string& s) {
-  std::vector<std::string> out;
-  std::stringstream ss(s);
-  std::string item;
-  while (std::getline(ss, item, ',')) out.push_back(item);
-  return out;
-}
-
-Extrinsics config(int k) {
-  switch (k) {
-    case 2: return {0.1917, -0.1078, 0.2164, 29.8 * kDeg, -4.6 * kDeg, 75.8 * kDeg};
-    case 3: return {0.2226, 0.0806, 0.1469, -26.6 * kDeg, 4.7 * kDeg, -18.6 * kDeg};
-    default: return {0.2441, -0.0185, 0.1787, 12.4 * kDeg, 17.6 * kDeg, -9.2 * kDeg};
-  }
-}
+using bench::get;
+using bench::split;
 
 }  // namespace
 
 int main(int argc, char** argv) {
-  const auto args = parse(argc, argv);
+  const auto args = bench::parse_args(argc, argv, "bench_roll_pitch");
   const std::string shared = PLANARVO_SHARED_DIR;
   std::vector<std::string> textures = split(get(args, "textures", "asphalt_01.png"));
   if (textures.size() == 1 && textures[0] == "all") {
@@ -111,7 +80,7 @@ int main(int argc, char** argv) {
                                    r.uniform(-30, 30) * kDeg, r.uniform(-30, 30) * kDeg, r.uniform(-180, 180) * kDeg};
         label = "rnd" + std::to_string(run);
       } else {
-        so.extrinsics = config(std::stoi(cfg));
+        so.extrinsics = sim::paper_configuration(std::stoi(cfg));
       }
       const sim::Trajectory traj = sim::generate_trajectory(so);
       const cv::Mat texture = cv::imread(so.texture, cv::IMREAD_GRAYSCALE);

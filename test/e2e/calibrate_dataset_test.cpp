@@ -36,7 +36,7 @@ sim::Options drive(double seconds, sim::MotionProfile motion, uint64_t seed) {
   sim::Options o;
   o.texture = test::texture("asphalt_01.png").string();
   o.camera = sim::default_camera(320, 240);
-  o.extrinsics = Extrinsics{0.2226, 0.0806, 0.1469, -26.6 * kDeg, 4.7 * kDeg, -18.6 * kDeg};  // configuration 3
+  o.extrinsics = sim::paper_configuration(3);
   o.seconds = seconds;
   o.seed = seed;
   o.motion = motion;

@@ -67,8 +67,8 @@ void expect_close(const RollPitchResult& r, const Extrinsics& truth, const char*
 TEST(RollPitch, ConvergesFromStraightDownForStrongTilts) {
   ocl::Runtime rt;
   // The paper's configurations 2 and 3 (about 30 degrees of roll) over two textures.
-  const Extrinsics config2{0.1917, -0.1078, 0.2164, 29.8 * kDeg, -4.6 * kDeg, 75.8 * kDeg};
-  const Extrinsics config3{0.2226, 0.0806, 0.1469, -26.6 * kDeg, 4.7 * kDeg, -18.6 * kDeg};
+  const Extrinsics config2 = sim::paper_configuration(2);
+  const Extrinsics config3 = sim::paper_configuration(3);
   expect_close(estimate(rt, drive(config2, sim::MotionProfile::Mixed, "asphalt_01.png", 3), {}), config2, "config 2");
   expect_close(estimate(rt, drive(config3, sim::MotionProfile::Mixed, "brick_floor.png", 4), {}), config3, "config 3");
 }
