@@ -9,6 +9,7 @@
 //     method=odometry|nonholonomic  (nonholonomic: the true height is given)  default odometry
 //     seconds=S (20) size=WxH (640x480) odometry_noise=REL (0.02) noise=GREY (1) gain=REL (0.05)
 //     seed=N (1) frames=N (roll/pitch frames; 0 = until the map is complete) keep=DIR (keep data sets)
+//     list=1 (print the configurations and stop)
 //
 //   bench_calibrate windows [key=value ...]   the paper's statistical form (its Tables 1-3, 5): one
 //     long drive (seconds=60), the calibration run on overlapping sub-trajectories of window=20 s
@@ -68,6 +69,12 @@ int main(int argc, char** argv) {
   const uint64_t seed = std::stoull(get(args, "seed", "1"));
 
   ocl::Runtime rt;
+  for (const std::string& cfg : configs) {
+    const Extrinsics e = config(cfg, seed);
+    std::printf("config %-3s x %.4f y %.4f z %.4f m, roll %.2f pitch %.2f yaw %.2f deg\n", cfg.c_str(), e.x, e.y, e.z,
+                e.roll / kDeg, e.pitch / kDeg, e.yaw / kDeg);
+  }
+  if (args.count("list")) return 0;
   std::printf("%-20s %-4s | %7s %7s %7s %7s %7s %7s | %6s %6s %6s %6s %6s %6s | %5s %5s %5s %5s %s\n", "texture", "cfg",
               "dx mm", "dy mm", "dz mm", "dr deg", "dp deg", "dyaw", "sx", "sy", "sz", "sr", "sp", "syaw", "rp s",
               "trk s", "dec s", "all s", "status");
