@@ -20,8 +20,8 @@ namespace {
 constexpr int kMinLevelSide = 8;
 constexpr double kMadToSigma = 1.4826;
 
-using Vector5d = Aligner::Vector5d;
-using Matrix52d = Aligner::Matrix52d;
+using Vector5d = JointStep::Vector5d;
+using Matrix52d = JointStep::Matrix52d;
 // At most 5x5, on the stack.
 using MatrixL = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 5, 5>;
 using MatrixL2 = Eigen::Matrix<double, Eigen::Dynamic, 2, 0, 5, 2>;
@@ -152,8 +152,9 @@ void Aligner::evaluate(const AlignmentPair& pair, const Extrinsics& e, int level
 // The damped Gauss-Newton step of the whole system: each pair's own block eliminated onto the
 // shared orientation (Schur complement), or on its own when nothing is shared. False when a
 // block is not positive definite at this damping.
-bool Aligner::solve(const std::vector<ReduceSums>& sums, double lambda, Step* step) const {
-  const int nl = local_size();
+bool solve_joint(const std::vector<ReduceSums>& sums, bool brightness, bool orientation, double lambda,
+                 JointStep* step) {
+  const int nl = brightness ? 5 : 3;
   step->local.resize(sums.size());
   step->X.resize(sums.size());
   step->x.resize(sums.size());
@@ -163,13 +164,13 @@ bool Aligner::solve(const std::vector<ReduceSums>& sums, double lambda, Step* st
   std::vector<Matrix52d>& X = step->X;
   std::vector<Vector5d>& x = step->x;
   for (size_t p = 0; p < sums.size(); ++p) {
-    PairBlock b = pair_block(sums[p], nl, with_orientation_);
+    PairBlock b = pair_block(sums[p], nl, orientation);
     damp(&b.A_ll, nl, lambda);
     const Eigen::LDLT<MatrixL> ldlt(MatrixL(b.A_ll.topLeftCorner(nl, nl)));
     if (ldlt.info() != Eigen::Success || !(ldlt.vectorD().minCoeff() > 0.0)) return false;
     x[p].setZero();
     x[p].head(nl) = ldlt.solve(VectorL(b.g_l.head(nl)));
-    if (!with_orientation_) {
+    if (!orientation) {
       step->local[p] = -x[p];
       if (!step->local[p].allFinite()) return false;
       continue;
@@ -180,7 +181,7 @@ bool Aligner::solve(const std::vector<ReduceSums>& sums, double lambda, Step* st
     S += b.A_ss - b.A_ls.topRows(nl).transpose() * X[p].topRows(nl);
     r += b.g_s - b.A_ls.topRows(nl).transpose() * x[p].head(nl);
   }
-  if (!with_orientation_) return true;
+  if (!orientation) return true;
   const Eigen::LDLT<Eigen::Matrix2d> ldlt(S);
   if (ldlt.info() != Eigen::Success || !(ldlt.vectorD().minCoeff() > 0.0)) return false;
   step->orientation = -ldlt.solve(r);
@@ -192,8 +193,8 @@ bool Aligner::solve(const std::vector<ReduceSums>& sums, double lambda, Step* st
   return true;
 }
 
-Eigen::Matrix2d Aligner::orientation_information(const std::vector<ReduceSums>& sums) const {
-  const int nl = local_size();
+Eigen::Matrix2d joint_orientation_information(const std::vector<ReduceSums>& sums, bool brightness) {
+  const int nl = brightness ? 5 : 3;
   Eigen::Matrix2d S = Eigen::Matrix2d::Zero();
   for (const ReduceSums& s : sums) {
     const PairBlock b = pair_block(s, nl, true);
@@ -259,11 +260,11 @@ AlignmentReport Aligner::align(std::vector<AlignmentPair>& pairs, Extrinsics* ex
     double lambda = 0.0;
     int steps = 0;
     const int max_steps = std::max(1, options_.max_iterations[L]);
-    Step& step = step_;
+    JointStep& step = step_;
     std::vector<AlignmentPair>& cand = cand_;
     cand = pairs;
     while (steps < max_steps) {
-      if (!solve(cur_, lambda, &step)) {
+      if (!solve_joint(cur_, options_.estimate_brightness, with_orientation_, lambda, &step)) {
         if (lambda >= 1e8) break;
         lambda = lambda == 0.0 ? options_.lambda_min : lambda * options_.lambda_up;
         continue;
@@ -321,7 +322,7 @@ AlignmentReport Aligner::align(std::vector<AlignmentPair>& pairs, Extrinsics* ex
     report.total_wrr += s.wrr;
     report.total_valid += s.valid;
   }
-  if (with_orientation_) report.orientation_information = orientation_information(cur_);
+  if (with_orientation_) report.orientation_information = joint_orientation_information(cur_, options_.estimate_brightness);
   report.ok = true;
   *extrinsics = ext;
   return report;

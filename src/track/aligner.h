@@ -109,6 +109,26 @@ extern const char* const kAlignFewValid;       // "too few valid pixels"
 extern const char* const kAlignNoLiveTexture;  // "no texture in the live frame"
 extern const char* const kAlignDiverged;       // "diverged"
 
+// A damped Gauss-Newton step of the joint system over image pairs: per pair its local block
+// (motion, then brightness a, b when `brightness`) and, with `orientation`, the shared tilt.
+struct JointStep {
+  using Vector5d = Eigen::Matrix<double, 5, 1>;
+  using Matrix52d = Eigen::Matrix<double, 5, 2>;
+  std::vector<Vector5d> local;  // per pair: motion (3), then a, b (zero without brightness)
+  Eigen::Vector2d orientation = Eigen::Vector2d::Zero();
+  std::vector<Matrix52d> X;     // scratch: per pair A_ll^-1 A_ls
+  std::vector<Vector5d> x;      // scratch: per pair A_ll^-1 g_l
+};
+
+// Solves (H + lambda diag(H) + ridge) delta = -g for the system whose pair blocks are the passes'
+// sums (ReduceLayout's order: motion, tilt when NPARAM is 5, brightness) by eliminating each
+// pair's block onto the tilt (Schur complement) and back-substituting. False when a block is not
+// positive definite at this damping.
+bool solve_joint(const std::vector<ReduceSums>& sums, bool brightness, bool orientation, double lambda,
+                 JointStep* step);
+// The tilt's information with every pair's block marginalised (undamped Schur complement).
+Eigen::Matrix2d joint_orientation_information(const std::vector<ReduceSums>& sums, bool brightness);
+
 class Aligner {
  public:
   // K: the camera matrix of level 0 (undistorted pinhole). with_orientation: the pairs share the
@@ -135,20 +155,8 @@ class Aligner {
   bool with_orientation() const { return with_orientation_; }
   const AlignerOptions& options() const { return options_; }
 
-  using Vector5d = Eigen::Matrix<double, 5, 1>;
-  using Matrix52d = Eigen::Matrix<double, 5, 2>;
-
  private:
-  // A step of the whole system, and the solve's scratch (kept, so a frame allocates nothing).
-  struct Step {
-    std::vector<Vector5d> local;  // per pair: motion (3), then a, b
-    Eigen::Vector2d orientation = Eigen::Vector2d::Zero();
-    std::vector<Matrix52d> X;     // per pair: A_ll^-1 A_ls
-    std::vector<Vector5d> x;      // per pair: A_ll^-1 g_l
-  };
   void evaluate(const AlignmentPair& pair, const Extrinsics& e, int level, bool stats, ReduceSums* out);
-  bool solve(const std::vector<ReduceSums>& sums, double lambda, Step* step) const;
-  Eigen::Matrix2d orientation_information(const std::vector<ReduceSums>& sums) const;
 
   ocl::Runtime& runtime_;
   Eigen::Matrix3d K_;
@@ -158,7 +166,7 @@ class Aligner {
   std::vector<ReduceSums> cur_, next_;
   std::vector<AlignmentPair> cand_;
   std::vector<double> measured_;
-  Step step_;
+  JointStep step_;
 };
 
 }  // namespace planarvo::track
