@@ -243,7 +243,8 @@ int cmd_demo(int argc, char** argv) {
   if (args.has("help")) {
     std::printf("usage: planarvo demo [options]\n\n"
                 "The main job on a built-in default: simulates a short drive over a real ground texture,\n"
-                "reads it back and runs the engine on it, and prints its accuracy against ground truth.\n\n%s",
+                "reads it back, tracks it, calibrates the camera from the images and the odometry, and prints\n"
+                "the accuracy of both against ground truth.\n\n%s",
                 format_options(specs).c_str());
     return kExitOk;
   }
@@ -306,6 +307,35 @@ int cmd_demo(int argc, char** argv) {
                 a.endpoint_error * 1e3, 100 * a.endpoint_drift, a.endpoint_heading / kDeg, a.rms_translation * 1e3);
     std::printf("   visual odometry velocity slopes: linear %.4f, angular %.4f; gross errors (> 1 mm): %d\n",
                 a.slope_linear, a.slope_angular, a.gross_errors);
+  }
+
+  // 5. The camera's calibration from the images and the wheel odometry alone.
+  t0 = std::chrono::steady_clock::now();
+  planarvo_camera_calibration_options co;
+  planarvo_camera_calibration_options_init(&co);
+  co.progress = &Progress::callback;
+  co.progress_user_data = &progress;
+  planarvo_camera_calibration_result cr{};
+  cr.struct_size = sizeof cr;
+  const planarvo_status cs = planarvo_calibrate_dataset(ctx.get(), ds.get(), &co, &cr);
+  progress.finish();
+  if (cs != PLANARVO_OK && cs != PLANARVO_ERROR_FAILED) check(cs);
+  std::printf("\n5. calibrated the camera from the images and the wheel odometry in %.1f s (planarvo calibrate):\n",
+              seconds_since(t0));
+  if (cs == PLANARVO_ERROR_FAILED) {
+    std::printf("   not determined: %s\n", cr.reason);
+  } else {
+    const planarvo_extrinsics& t = info.extrinsics_gt;
+    const planarvo_extrinsics& e = cr.extrinsics;
+    const double est[6] = {e.x, e.y, e.z, e.roll, e.pitch, e.yaw}, tru[6] = {t.x, t.y, t.z, t.roll, t.pitch, t.yaw};
+    const char* names[6] = {"x", "y", "z", "roll", "pitch", "yaw"};
+    std::printf("   %-6s %12s %12s %10s %10s\n", "", "estimated", "true", "error", "sigma");
+    for (int i = 0; i < 6; ++i) {
+      const double k = i < 3 ? 1e3 : 1 / kDeg;
+      std::printf("   %-6s %8.3f %-3s %8.3f %-3s %10.3f %10.3f\n", names[i], est[i] * k, i < 3 ? "mm" : "deg",
+                  tru[i] * k, i < 3 ? "mm" : "deg", std::remainder(est[i] - tru[i], 2 * M_PI) * k,
+                  std::sqrt(std::max(0.0, cr.covariance[i * 7])) * k);
+    }
   }
   std::printf("\nLook at the frames in %s/images; `planarvo info %s` describes the data set.\n", out.c_str(),
               out.c_str());

@@ -289,7 +289,7 @@ AlignmentReport Aligner::align(std::vector<AlignmentPair>& pairs, Extrinsics* ex
       // A step below the convergence threshold, or a small last one, is applied without the
       // passes that would check it.
       if (step_px < options_.convergence_px || (steps == max_steps && step_px < 0.5)) {
-        pairs.swap(cand);
+        std::copy(cand.begin(), cand.end(), pairs.begin());  // elements, not buffers: callers keep references
         ext = cand_ext;
         break;
       }
@@ -301,7 +301,7 @@ AlignmentReport Aligner::align(std::vector<AlignmentPair>& pairs, Extrinsics* ex
         valid = valid && next_[p].valid >= options_.min_valid_fraction * R.width * R.height;
       }
       if (valid && mean_cost(next_) <= mean_cost(cur_)) {
-        pairs.swap(cand);
+        std::copy(cand.begin(), cand.end(), pairs.begin());  // elements, not buffers: callers keep references
         ext = cand_ext;
         cur_.swap(next_);
         lambda = lambda / options_.lambda_down < options_.lambda_min ? 0.0 : lambda / options_.lambda_down;

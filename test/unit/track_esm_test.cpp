@@ -12,6 +12,7 @@
 #include "image/undistort.h"
 #include "ocl/runtime.h"
 #include "sim/simulator.h"
+#include "track/aligner.h"
 #include "track/tracker.h"
 #include "track/warp_model.h"
 #include "unit/track_test_pyramid.h"
@@ -75,6 +76,36 @@ TEST_F(TrackEsm, RecoversASmallMotionOnNoiseFreeRenders) {
       EXPECT_LT(et, finest == 0 ? 0.02e-3 : 0.01e-3);
       EXPECT_LT(er, (finest == 0 ? 0.001 : 0.003) * kDeg);
     }
+  }
+}
+
+TEST_F(TrackEsm, TheTrackerReportsTheAlignersResult) {
+  // The aligner updates the caller's pairs in place (their storage stays, so references taken
+  // before the call see the result), and the tracker's motion is exactly what the aligner finds
+  // from the same start: a tracker that read a stale state reported a step-old estimate.
+  make_scene("asphalt_01.png", 320, 240);
+  const SE2 a(0.1, 0.2, 0.3);
+  TrackerOptions opt;
+  Aligner aligner(rt_, scene_.options.camera.K(), opt, false);
+  for (const SE2& m : {SE2(0.006, -0.002, 0.02), SE2(0.012, 0.003, -0.01), SE2(-0.004, 0.0, 0.04),
+                       SE2(0.002, 0.001, 0.0), SE2(0.02, -0.004, 0.03)}) {
+    const Pyramid ref = pyramid_at(a, 4), live = pyramid_at(a * m, 4);
+    Tracker tr(rt_, scene_.options.camera, scene_.options.extrinsics, opt);
+    ASSERT_EQ(tr.track(ref, 0.0).status, FrameResult::Status::First);
+    const FrameResult r = tr.track(live, 1.0 / 30);
+    ASSERT_EQ(r.status, FrameResult::Status::Ok) << r.reason;
+
+    std::vector<AlignmentPair> pairs(1);
+    pairs[0].reference = &ref;
+    pairs[0].live = &live;
+    const AlignmentPair* storage = pairs.data();
+    Extrinsics e = scene_.options.extrinsics;
+    const AlignmentReport rep = aligner.align(pairs, &e, aligner.levels(ref, live));
+    ASSERT_TRUE(rep.ok);
+    EXPECT_EQ(pairs.data(), storage);
+    EXPECT_EQ(r.motion.x, pairs[0].motion.x) << m.x;
+    EXPECT_EQ(r.motion.y, pairs[0].motion.y) << m.x;
+    EXPECT_EQ(r.motion.theta, pairs[0].motion.theta) << m.x;
   }
 }
 
