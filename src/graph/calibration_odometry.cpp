@@ -61,12 +61,10 @@ OdometryGraph build_odometry_graph(const Context& ctx, const std::vector<SE2>& p
   return og;
 }
 
-}  // namespace
-
-CalibrationResult calibrate_odometry(Context& ctx) {
+// The start: the given initial value, else the closed form (calibration_init.h); the scale at
+// fixed_scale when it is fixed.
+Vector4 odometry_start(const Context& ctx) {
   const CalibrationOptions& o = ctx.options;
-  const size_t n = ctx.samples.size();
-  CalibrationResult& r = ctx.result;
   Vector4 z;
   if (o.initial) {
     z = Vector4((*o.initial)[0], (*o.initial)[1], (*o.initial)[2], (*o.initial)[3]);
@@ -78,109 +76,157 @@ CalibrationResult calibrate_odometry(Context& ctx) {
     if (!z.allFinite()) z = Vector4(0.0, 0.0, o.fix_scale ? o.fixed_scale : 1.0, 0.0);
   }
   if (o.fix_scale) z[CI::kHeight] = o.fixed_scale;
-  std::vector<SE2> poses = {SE2()};
-  for (const MotionSample& s : ctx.samples) poses.push_back(poses.back() * s.odometry->value);
+  return z;
+}
 
-  OdometryGraph og;
-  auto solve_pass = [&](RobustKernelPtr kernel) {
-    og = build_odometry_graph(ctx, poses, z, kernel);
-    ctx.record(solve(og.graph, pass_options(o, kernel != nullptr)));
-    z = og.graph.vector(og.z);
-    for (size_t i = 0; i < poses.size(); ++i) poses[i] = og.graph.pose(og.poses[i]);
-  };
+// The passes of the odometry method. Each builds the graph anew (a gated sample loses its sensor
+// factor) from the estimate and the poses of the pass before.
+class OdometryPasses {
+ public:
+  explicit OdometryPasses(Context& ctx);
+  // Plain least squares first from a given start, then the robust loss.
+  void robust_pass();
+  // Gating and plain least squares on the inliers, while the gate drops more.
+  void gated_least_squares();
+  // The odometry's noise model from the residuals, and the gated passes again with it.
+  void refit_odometry_noise();
+  // The variance factor, the covariance and the observability of the final fit.
+  CalibrationResult finish();
+
+ private:
+  void solve_pass(RobustKernelPtr kernel);
   // Per inlier sample: the sensor and odometry factors' χ² together (3 dof once the two poses
   // are fitted).
-  auto sample_chi2 = [&](std::vector<double>& chi2, std::vector<int>& sample_of) {
-    chi2.clear();
-    sample_of.clear();
-    for (size_t i = 0; i < n; ++i)
-      if (og.sensor_factor[i] >= 0) {
-        chi2.push_back(factor_chi2(og.graph, og.sensor_factor[i]) +
-                       factor_chi2(og.graph, og.odometry_factor[i]));
-        sample_of.push_back(static_cast<int>(i));
-      }
-  };
-  std::vector<double> chi2;
-  std::vector<int> sample_of;
-  bool solved = false;
-  if (o.initial) {  // a far start: plain least squares first, so that the loss does not
-    solve_pass(nullptr);  // take the good samples for outliers
-    solved = true;
-  } else {
-    og = build_odometry_graph(ctx, poses, z, nullptr);
-  }
-  double k0 = 1.0;
-  if (o.loss != RobustLoss::None) {
-    sample_chi2(chi2, sample_of);
-    k0 = std::max(1.0, median(chi2) / kChi2Median3);  // the loss in the data's own sigmas
-    solve_pass(make_kernel(o.loss, o.loss_scale * std::sqrt(k0)));
-    solved = true;
-  }
-  bool kernel_on = o.loss != RobustLoss::None;
-  auto gated_least_squares = [&] {
-    if (o.gate_sigma > 0.0) {
-      for (int round = 0; round < 5; ++round) {
-        sample_chi2(chi2, sample_of);
-        const int gated = gate(ctx, chi2, sample_of, kChi2Median3);
-        if (round > 0 && gated == 0) break;
-        solve_pass(nullptr);
-        kernel_on = false;
-        solved = true;
-      }
-    }
-    if (!solved) solve_pass(nullptr);
-  };
-  gated_least_squares();
-  // The odometry's own noise model from the inliers' residuals (odometry_noise.h), twice: the
-  // second fit sees the estimate and the inliers of the first.
-  bool given = false;
-  for (const MotionSample& s : ctx.samples) given = given || s.odometry->has_covariance();
-  if (o.estimate_odometry_noise && !given) {
-    for (int round = 0; round < 2; ++round) {
-      const SE2 T(z[CI::kX], z[CI::kY], z[CI::kYaw]);
-      const double h = z[CI::kHeight];
-      std::vector<SE2> odometry;
-      std::vector<Eigen::Vector3d> residual;
-      for (size_t i = 0; i < n; ++i)
-        if (ctx.inlier[i]) {
-          const SE2& ms = ctx.samples[i].sensor.value;
-          const SE2 mapped = T * SE2(h * ms.x, h * ms.y, ms.theta) * T.inverse();
-          const SE2& mo = ctx.samples[i].odometry->value;
-          const SE2 e = mo.inverse() * mapped;
-          odometry.push_back(mo);
-          residual.emplace_back(e.x, e.y, e.theta);
-        }
-      r.odometry_noise = fit_odometry_noise(odometry, residual);
-      for (size_t i = 0; i < n; ++i) {
-        const SE2& mo = ctx.samples[i].odometry->value;
-        ctx.odo_cov[i] = component_covariance(Motion{mo, r.odometry_noise->covariance(mo)});
-      }
-      solved = false;
-      gated_least_squares();
-    }
-  }
+  void sample_chi2();
 
-  for (size_t i = 0; i < n; ++i)
-    if (!ctx.inlier[i]) r.outlier_samples.push_back(static_cast<int>(i));
+  Context& ctx_;
+  const CalibrationOptions& o_;
+  const size_t n_;
+  Vector4 z_;
+  std::vector<SE2> poses_;
+  OdometryGraph og_;
+  std::vector<double> chi2_;
+  std::vector<int> sample_of_;
+  bool solved_ = false;     // a pass has solved since the inliers last changed
+  bool kernel_on_ = false;  // the last pass had the robust loss
+};
+
+OdometryPasses::OdometryPasses(Context& ctx)
+    : ctx_(ctx), o_(ctx.options), n_(ctx.samples.size()), z_(odometry_start(ctx)), poses_{SE2()} {
+  for (const MotionSample& s : ctx.samples) poses_.push_back(poses_.back() * s.odometry->value);
+}
+
+void OdometryPasses::solve_pass(RobustKernelPtr kernel) {
+  og_ = build_odometry_graph(ctx_, poses_, z_, kernel);
+  ctx_.record(solve(og_.graph, pass_options(o_, kernel != nullptr)));
+  z_ = og_.graph.vector(og_.z);
+  for (size_t i = 0; i < poses_.size(); ++i) poses_[i] = og_.graph.pose(og_.poses[i]);
+}
+
+void OdometryPasses::sample_chi2() {
+  chi2_.clear();
+  sample_of_.clear();
+  for (size_t i = 0; i < n_; ++i)
+    if (og_.sensor_factor[i] >= 0) {
+      chi2_.push_back(factor_chi2(og_.graph, og_.sensor_factor[i]) +
+                      factor_chi2(og_.graph, og_.odometry_factor[i]));
+      sample_of_.push_back(static_cast<int>(i));
+    }
+}
+
+void OdometryPasses::robust_pass() {
+  if (o_.initial) {  // a far start: plain least squares first, so that the loss does not
+    solve_pass(nullptr);  // take the good samples for outliers
+    solved_ = true;
+  } else {
+    og_ = build_odometry_graph(ctx_, poses_, z_, nullptr);
+  }
+  if (o_.loss != RobustLoss::None) {
+    sample_chi2();
+    const double k0 = std::max(1.0, median(chi2_) / kChi2Median3);  // the loss in the data's own sigmas
+    solve_pass(make_kernel(o_.loss, o_.loss_scale * std::sqrt(k0)));
+    solved_ = true;
+    kernel_on_ = true;
+  }
+}
+
+void OdometryPasses::gated_least_squares() {
+  if (o_.gate_sigma > 0.0) {
+    for (int round = 0; round < 5; ++round) {
+      sample_chi2();
+      const int gated = gate(ctx_, chi2_, sample_of_, kChi2Median3);
+      if (round > 0 && gated == 0) break;
+      solve_pass(nullptr);
+      kernel_on_ = false;
+      solved_ = true;
+    }
+  }
+  if (!solved_) solve_pass(nullptr);
+}
+
+// Where the samples' odometry carries no covariance of its own (odometry_noise.h): fitted twice,
+// the second fit sees the estimate and the inliers of the first.
+void OdometryPasses::refit_odometry_noise() {
+  bool given = false;
+  for (const MotionSample& s : ctx_.samples) given = given || s.odometry->has_covariance();
+  if (!o_.estimate_odometry_noise || given) return;
+  for (int round = 0; round < 2; ++round) {
+    const SE2 T(z_[CI::kX], z_[CI::kY], z_[CI::kYaw]);
+    const double h = z_[CI::kHeight];
+    std::vector<SE2> odometry;
+    std::vector<Eigen::Vector3d> residual;
+    for (size_t i = 0; i < n_; ++i)
+      if (ctx_.inlier[i]) {
+        const SE2& ms = ctx_.samples[i].sensor.value;
+        const SE2 mapped = T * SE2(h * ms.x, h * ms.y, ms.theta) * T.inverse();
+        const SE2& mo = ctx_.samples[i].odometry->value;
+        const SE2 e = mo.inverse() * mapped;
+        odometry.push_back(mo);
+        residual.emplace_back(e.x, e.y, e.theta);
+      }
+    ctx_.result.odometry_noise = fit_odometry_noise(odometry, residual);
+    for (size_t i = 0; i < n_; ++i) {
+      const SE2& mo = ctx_.samples[i].odometry->value;
+      ctx_.odo_cov[i] = component_covariance(Motion{mo, ctx_.result.odometry_noise->covariance(mo)});
+    }
+    solved_ = false;
+    gated_least_squares();
+  }
+}
+
+CalibrationResult OdometryPasses::finish() {
+  CalibrationResult& r = ctx_.result;
+  for (size_t i = 0; i < n_; ++i)
+    if (!ctx_.inlier[i]) r.outlier_samples.push_back(static_cast<int>(i));
   r.outliers = static_cast<int>(r.outlier_samples.size());
-  const int free_z = o.fix_scale ? 3 : 4;
-  const int dof = 3 * (static_cast<int>(n) - r.outliers) - free_z;
-  sample_chi2(chi2, sample_of);
-  const double fit = kernel_on ? median(chi2) / kChi2Median3
-                               : (dof > 0 ? og.graph.chi2() / dof : 1.0);
+  const int free_z = o_.fix_scale ? 3 : 4;
+  const int dof = 3 * (static_cast<int>(n_) - r.outliers) - free_z;
+  sample_chi2();
+  const double fit = kernel_on_ ? median(chi2_) / kChi2Median3
+                                : (dof > 0 ? og_.graph.chi2() / dof : 1.0);
   r.variance_factor = std::max(1.0, fit);
-  for (int k = 0; k < 4; ++k) r.value[static_cast<size_t>(k)] = z[k];
-  r.value[CI::kYaw] = wrap_angle(z[CI::kYaw]);
-  r.estimated = {true, true, !o.fix_scale, true};
-  const Observability obs = covariance_of_z(og.graph, og.z, r.variance_factor, r);
+  for (int k = 0; k < 4; ++k) r.value[static_cast<size_t>(k)] = z_[k];
+  r.value[CI::kYaw] = wrap_angle(z_[CI::kYaw]);
+  r.estimated = {true, true, !o_.fix_scale, true};
+  const Observability obs = covariance_of_z(og_.graph, og_.z, r.variance_factor, r);
   std::vector<int> params = {CI::kX, CI::kY};
-  if (!o.fix_scale) params.push_back(CI::kHeight);
+  if (!o_.fix_scale) params.push_back(CI::kHeight);
   params.push_back(CI::kYaw);
   std::vector<std::string> reasons;
-  judge(ctx, obs, params, {CI::kX, CI::kY}, reasons);
+  judge(ctx_, obs, params, {CI::kX, CI::kY}, reasons);
   for (size_t k = 0; k < reasons.size(); ++k)
     r.unobservable_reason += (k ? "; " : "") + reasons[k];
   return r;
+}
+
+}  // namespace
+
+CalibrationResult calibrate_odometry(Context& ctx) {
+  OdometryPasses passes(ctx);
+  passes.robust_pass();
+  passes.gated_least_squares();
+  passes.refit_odometry_noise();
+  return passes.finish();
 }
 
 }  // namespace planarvo::graph::calibration_detail
