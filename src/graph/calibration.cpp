@@ -103,6 +103,21 @@ std::vector<const double*> value_pointers(const FactorGraph& g, int f) {
   return p;
 }
 
+// Gates the samples whose normalised squared residual is beyond gate_sigma² times the robust
+// variance factor where that exceeds 1; returns how many were newly gated.
+int gate(Context& ctx, const SampleResiduals& residuals, double chi2_median) {
+  const std::vector<double>& chi2 = residuals.chi2;
+  const double k = median(chi2) / chi2_median;
+  const double threshold = sq(ctx.options.gate_sigma) * std::max(k, 1.0);
+  int gated = 0;
+  for (size_t j = 0; j < chi2.size(); ++j)
+    if (chi2[j] > threshold) {
+      ctx.inlier[static_cast<size_t>(residuals.sample[j])] = 0;
+      ++gated;
+    }
+  return gated;
+}
+
 double sigma_limit(const CalibrationOptions& o, int k) {
   return k == CI::kYaw ? o.max_sigma_angle : k == CI::kHeight ? o.max_sigma_scale : o.max_sigma_position;
 }
@@ -173,17 +188,17 @@ std::vector<SE2> Context::inlier_sensor_motions(std::vector<double>* sigma_t,
   return m;
 }
 
-int gate(Context& ctx, const std::vector<double>& chi2, const std::vector<int>& sample_of,
-         double chi2_median) {
-  const double k = median(chi2) / chi2_median;
-  const double threshold = sq(ctx.options.gate_sigma) * std::max(k, 1.0);
-  int gated = 0;
-  for (size_t j = 0; j < chi2.size(); ++j)
-    if (chi2[j] > threshold) {
-      ctx.inlier[static_cast<size_t>(sample_of[j])] = 0;
-      ++gated;
-    }
-  return gated;
+int gated_passes(Context& ctx, double chi2_median, const std::function<SampleResiduals()>& residuals,
+                 const std::function<void()>& solve_least_squares) {
+  if (ctx.options.gate_sigma <= 0.0) return 0;
+  int solves = 0;
+  for (int round = 0; round < 5; ++round) {
+    const int gated = gate(ctx, residuals(), chi2_median);
+    if (round > 0 && gated == 0) break;
+    solve_least_squares();
+    ++solves;
+  }
+  return solves;
 }
 
 Observability covariance_of_z(const FactorGraph& g, VariableId z, double f, CalibrationResult& r) {
@@ -288,6 +303,17 @@ void judge(Context& ctx, const Observability& obs, const std::vector<int>& param
   }
   for (int k : params)
     if (bad[static_cast<size_t>(k)]) r.observable[static_cast<size_t>(k)] = false;
+}
+
+void finish_result(Context& ctx, const Vector4& z, const std::vector<std::string>& reasons) {
+  CalibrationResult& r = ctx.result;
+  for (size_t i = 0; i < ctx.samples.size(); ++i)
+    if (!ctx.inlier[i]) r.outlier_samples.push_back(static_cast<int>(i));
+  r.outliers = static_cast<int>(r.outlier_samples.size());
+  for (int k = 0; k < 4; ++k) r.value[static_cast<size_t>(k)] = z[k];
+  r.value[CI::kYaw] = wrap_angle(z[CI::kYaw]);
+  for (size_t k = 0; k < reasons.size(); ++k)
+    r.unobservable_reason += (k ? "; " : "") + reasons[k];
 }
 
 }  // namespace calibration_detail

@@ -3,6 +3,7 @@
 // gating, and the covariance and observability of z. Internal to src/graph.
 #pragma once
 #include <array>
+#include <functional>
 #include <limits>
 #include <string>
 #include <vector>
@@ -53,11 +54,18 @@ struct Context {
                                          std::vector<double>* sigma_theta) const;
 };
 
-// Gates the samples whose normalised squared residual (chi2, with median chi2_median for its
-// degrees of freedom) is beyond gate_sigma² times the robust variance factor where that exceeds
-// 1; returns how many were newly gated.
-int gate(Context& ctx, const std::vector<double>& chi2, const std::vector<int>& sample_of,
-         double chi2_median);
+// The normalised squared residuals of the inlier samples of a graph, one per sample.
+struct SampleResiduals {
+  std::vector<double> chi2;
+  std::vector<int> sample;  // the sample of each
+};
+
+// Gating (calibration.h, "Robustness"): at most 5 rounds that gate the samples on their
+// residuals (`residuals`, with median chi2_median for their degrees of freedom) and solve the
+// inliers by plain least squares (`solve_least_squares`), while the gate drops more; the first
+// round always solves. Returns the number of solves, 0 without gating (gate_sigma 0).
+int gated_passes(Context& ctx, double chi2_median, const std::function<SampleResiduals()>& residuals,
+                 const std::function<void()>& solve_least_squares);
 
 struct Observability {
   std::array<bool, 4> null_space{};
@@ -71,6 +79,9 @@ Observability covariance_of_z(const FactorGraph& g, VariableId z, double f, Cali
 // unobservable for this method.
 void judge(Context& ctx, const Observability& obs, const std::vector<int>& params,
            const std::vector<int>& straight_params, std::vector<std::string>& reasons);
+
+// The result's last fields: the gated samples, the value (yaw wrapped) and the reasons joined.
+void finish_result(Context& ctx, const Vector4& z, const std::vector<std::string>& reasons);
 
 // The two methods (calibration_odometry.cpp, calibration_nonholonomic.cpp).
 CalibrationResult calibrate_odometry(Context& ctx);

@@ -170,7 +170,7 @@ class NonholonomicPasses {
 
  private:
   void solve_pass(RobustKernelPtr kernel);
-  void sample_chi2();
+  SampleResiduals sample_chi2() const;
   void flip();
 
   Context& ctx_;
@@ -178,8 +178,6 @@ class NonholonomicPasses {
   const Labels& labels_;
   Vector4 z_;
   NonholonomicGraph ng_;
-  std::vector<double> chi2_;
-  std::vector<int> sample_of_;
   bool kernel_on_ = false;  // the last pass had the robust loss
 };
 
@@ -189,14 +187,14 @@ void NonholonomicPasses::solve_pass(RobustKernelPtr kernel) {
   z_ = ng_.graph.vector(ng_.z);
 }
 
-void NonholonomicPasses::sample_chi2() {
-  chi2_.clear();
-  sample_of_.clear();
+SampleResiduals NonholonomicPasses::sample_chi2() const {
+  SampleResiduals s;
   for (size_t i = 0; i < ctx_.samples.size(); ++i)
     if (ng_.factor_of[i] >= 0) {
-      chi2_.push_back(factor_chi2(ng_.graph, ng_.factor_of[i]));
-      sample_of_.push_back(static_cast<int>(i));
+      s.chi2.push_back(factor_chi2(ng_.graph, ng_.factor_of[i]));
+      s.sample.push_back(static_cast<int>(i));
     }
+  return s;
 }
 
 void NonholonomicPasses::flip() {
@@ -209,20 +207,13 @@ void NonholonomicPasses::solve_x_yaw() {
   else ng_ = build_nonholonomic_graph(ctx_, z_, nullptr);
   double k0 = 1.0;
   if (o_.loss != RobustLoss::None) {
-    sample_chi2();
-    k0 = std::max(1.0, median(chi2_) / kChi2Median1);
+    k0 = std::max(1.0, median(sample_chi2().chi2) / kChi2Median1);
     solve_pass(make_kernel(o_.loss, o_.loss_scale * std::sqrt(k0)));
     kernel_on_ = true;
   }
-  if (o_.gate_sigma > 0.0) {
-    for (int round = 0; round < 5; ++round) {
-      sample_chi2();
-      const int gated = gate(ctx_, chi2_, sample_of_, kChi2Median1);
-      if (round > 0 && gated == 0) break;
-      solve_pass(nullptr);
-      kernel_on_ = false;
-    }
-  }
+  if (gated_passes(ctx_, kChi2Median1, [this] { return sample_chi2(); },
+                   [this] { solve_pass(nullptr); }) > 0)
+    kernel_on_ = false;
   // The information depends on z: once more with it taken at the solution.
   solve_pass(kernel_on_ ? make_kernel(o_.loss, o_.loss_scale * std::sqrt(k0)) : nullptr);
 }
@@ -249,11 +240,11 @@ void NonholonomicPasses::choose_branch(std::vector<std::string>& reasons) {
 
 void NonholonomicPasses::covariance(std::vector<std::string>& reasons) {
   CalibrationResult& r = ctx_.result;
-  sample_chi2();
-  const int dof = static_cast<int>(chi2_.size()) - 2;
+  const std::vector<double> chi2 = sample_chi2().chi2;
+  const int dof = static_cast<int>(chi2.size()) - 2;
   double sum = 0.0;
-  for (double c : chi2_) sum += c;
-  r.variance_factor = std::max(1.0, kernel_on_ ? median(chi2_) / kChi2Median1 : (dof > 0 ? sum / dof : 1.0));
+  for (double c : chi2) sum += c;
+  r.variance_factor = std::max(1.0, kernel_on_ ? median(chi2) / kChi2Median1 : (dof > 0 ? sum / dof : 1.0));
   r.estimated = {true, false, false, true};
   const Observability obs = covariance_of_z(ng_.graph, ng_.z, r.variance_factor, r);
   judge(ctx_, obs, {CI::kX, CI::kYaw}, {CI::kX}, reasons);
@@ -417,13 +408,7 @@ CalibrationResult calibrate_nonholonomic(Context& ctx) {
   passes.covariance(reasons);
   Vector4 z = passes.z();
   if (have_labels) estimate_y(ctx, labels, z, reasons);
-  for (size_t i = 0; i < ctx.samples.size(); ++i)
-    if (!ctx.inlier[i]) r.outlier_samples.push_back(static_cast<int>(i));
-  r.outliers = static_cast<int>(r.outlier_samples.size());
-  for (int k = 0; k < 4; ++k) r.value[static_cast<size_t>(k)] = z[k];
-  r.value[CI::kYaw] = wrap_angle(z[CI::kYaw]);
-  for (size_t k = 0; k < reasons.size(); ++k)
-    r.unobservable_reason += (k ? "; " : "") + reasons[k];
+  finish_result(ctx, z, reasons);
   return r;
 }
 

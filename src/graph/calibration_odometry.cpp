@@ -97,7 +97,7 @@ class OdometryPasses {
   void solve_pass(RobustKernelPtr kernel);
   // Per inlier sample: the sensor and odometry factors' χ² together (3 dof once the two poses
   // are fitted).
-  void sample_chi2();
+  SampleResiduals sample_chi2() const;
 
   Context& ctx_;
   const CalibrationOptions& o_;
@@ -105,8 +105,6 @@ class OdometryPasses {
   Vector4 z_;
   std::vector<SE2> poses_;
   OdometryGraph og_;
-  std::vector<double> chi2_;
-  std::vector<int> sample_of_;
   bool solved_ = false;     // a pass has solved since the inliers last changed
   bool kernel_on_ = false;  // the last pass had the robust loss
 };
@@ -123,15 +121,15 @@ void OdometryPasses::solve_pass(RobustKernelPtr kernel) {
   for (size_t i = 0; i < poses_.size(); ++i) poses_[i] = og_.graph.pose(og_.poses[i]);
 }
 
-void OdometryPasses::sample_chi2() {
-  chi2_.clear();
-  sample_of_.clear();
+SampleResiduals OdometryPasses::sample_chi2() const {
+  SampleResiduals s;
   for (size_t i = 0; i < n_; ++i)
     if (og_.sensor_factor[i] >= 0) {
-      chi2_.push_back(factor_chi2(og_.graph, og_.sensor_factor[i]) +
-                      factor_chi2(og_.graph, og_.odometry_factor[i]));
-      sample_of_.push_back(static_cast<int>(i));
+      s.chi2.push_back(factor_chi2(og_.graph, og_.sensor_factor[i]) +
+                       factor_chi2(og_.graph, og_.odometry_factor[i]));
+      s.sample.push_back(static_cast<int>(i));
     }
+  return s;
 }
 
 void OdometryPasses::robust_pass() {
@@ -142,8 +140,7 @@ void OdometryPasses::robust_pass() {
     og_ = build_odometry_graph(ctx_, poses_, z_, nullptr);
   }
   if (o_.loss != RobustLoss::None) {
-    sample_chi2();
-    const double k0 = std::max(1.0, median(chi2_) / kChi2Median3);  // the loss in the data's own sigmas
+    const double k0 = std::max(1.0, median(sample_chi2().chi2) / kChi2Median3);  // the loss in the data's own sigmas
     solve_pass(make_kernel(o_.loss, o_.loss_scale * std::sqrt(k0)));
     solved_ = true;
     kernel_on_ = true;
@@ -151,15 +148,10 @@ void OdometryPasses::robust_pass() {
 }
 
 void OdometryPasses::gated_least_squares() {
-  if (o_.gate_sigma > 0.0) {
-    for (int round = 0; round < 5; ++round) {
-      sample_chi2();
-      const int gated = gate(ctx_, chi2_, sample_of_, kChi2Median3);
-      if (round > 0 && gated == 0) break;
-      solve_pass(nullptr);
-      kernel_on_ = false;
-      solved_ = true;
-    }
+  if (gated_passes(ctx_, kChi2Median3, [this] { return sample_chi2(); },
+                   [this] { solve_pass(nullptr); }) > 0) {
+    kernel_on_ = false;
+    solved_ = true;
   }
   if (!solved_) solve_pass(nullptr);
 }
@@ -196,17 +188,12 @@ void OdometryPasses::refit_odometry_noise() {
 
 CalibrationResult OdometryPasses::finish() {
   CalibrationResult& r = ctx_.result;
-  for (size_t i = 0; i < n_; ++i)
-    if (!ctx_.inlier[i]) r.outlier_samples.push_back(static_cast<int>(i));
-  r.outliers = static_cast<int>(r.outlier_samples.size());
+  const int inliers = static_cast<int>(std::count(ctx_.inlier.begin(), ctx_.inlier.end(), 1));
   const int free_z = o_.fix_scale ? 3 : 4;
-  const int dof = 3 * (static_cast<int>(n_) - r.outliers) - free_z;
-  sample_chi2();
-  const double fit = kernel_on_ ? median(chi2_) / kChi2Median3
+  const int dof = 3 * inliers - free_z;
+  const double fit = kernel_on_ ? median(sample_chi2().chi2) / kChi2Median3
                                 : (dof > 0 ? og_.graph.chi2() / dof : 1.0);
   r.variance_factor = std::max(1.0, fit);
-  for (int k = 0; k < 4; ++k) r.value[static_cast<size_t>(k)] = z_[k];
-  r.value[CI::kYaw] = wrap_angle(z_[CI::kYaw]);
   r.estimated = {true, true, !o_.fix_scale, true};
   const Observability obs = covariance_of_z(og_.graph, og_.z, r.variance_factor, r);
   std::vector<int> params = {CI::kX, CI::kY};
@@ -214,8 +201,7 @@ CalibrationResult OdometryPasses::finish() {
   params.push_back(CI::kYaw);
   std::vector<std::string> reasons;
   judge(ctx_, obs, params, {CI::kX, CI::kY}, reasons);
-  for (size_t k = 0; k < reasons.size(); ++k)
-    r.unobservable_reason += (k ? "; " : "") + reasons[k];
+  finish_result(ctx_, z_, reasons);
   return r;
 }
 
