@@ -191,15 +191,11 @@ TrajectoryShape classify_trajectory(const std::vector<SE2>& sensor,
 
 namespace {
 
-bool active(const PriorTerm& t, double r) {
-  return t.label == 0 || (t.label > 0 ? r < 0.0 : r > 0.0);
-}
-
 double slope(const std::vector<PriorTerm>& terms, double y) {
   double d = 0.0;
   for (const PriorTerm& t : terms) {
     const double r = t.alpha + t.beta * y;
-    if (active(t, r)) d += 2.0 * t.weight * t.beta * r;
+    if (prior_term_active(t, r)) d += 2.0 * t.weight * t.beta * r;
   }
   return d;
 }
@@ -221,7 +217,7 @@ double direction_prior_cost(const std::vector<PriorTerm>& terms, double y) {
   double c = 0.0;
   for (const PriorTerm& t : terms) {
     const double r = t.alpha + t.beta * y;
-    if (active(t, r)) c += t.weight * r * r;
+    if (prior_term_active(t, r)) c += t.weight * r * r;
   }
   return c;
 }

@@ -55,6 +55,11 @@ struct PriorTerm {
   double alpha = 0.0, beta = 0.0, weight = 0.0;
   int label = 0;
 };
+// Whether a term's residual r = α + β y counts: always for label 0, for +1 where negative, for
+// −1 where positive.
+inline bool prior_term_active(const PriorTerm& t, double r) {
+  return t.label == 0 || (t.label > 0 ? r < 0.0 : r > 0.0);
+}
 double direction_prior_cost(const std::vector<PriorTerm>& terms, double y);
 // The minimising set [argmin_lo, argmin_hi] of C (one point when labels 0 or contradicting
 // labels pin y; the interval the ±1 labels leave otherwise), its midpoint as the estimate, and
