@@ -176,6 +176,7 @@ struct Tracker::Impl {
     const MatrixJ inv = ldlt.solve(I);
     res->covariance = s2 * inv.topLeftCorner(3, 3);
     if (!res->covariance.allFinite()) res->covariance = lost_covariance();
+    res->alignment_covariance = res->covariance;
 
     const ReduceSums& st = report.finest_stats[0];
     const double var_ref = st.valid > 0 ? st.iref2 / st.valid - std::pow(st.iref / st.valid, 2) : 0.0;
@@ -293,7 +294,7 @@ struct Tracker::Impl {
       res.status = Status::Lost;
       res.reason = why;
       res.motion = predicted;
-      res.covariance = lost_covariance();
+      res.covariance = res.alignment_covariance = lost_covariance();
       pose = pose * predicted;
       if (can_be_keyframe) {
         make_keyframe(live);

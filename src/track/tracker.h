@@ -77,6 +77,10 @@ struct FrameResult {
   // Pixels are treated as independent, so it is optimistic as an absolute (README.md).
   // Large (1 m^2, 1 rad^2 on the diagonal) when Lost or First.
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Identity();
+  // Covariance of this frame's own alignment with the keyframe: the right perturbation of its
+  // pose in the keyframe's robot frame (the estimate T_kf^-1 T_k), same units. The motion's
+  // covariance above is this one when the previous frame is the keyframe.
+  Eigen::Matrix3d alignment_covariance = Eigen::Matrix3d::Identity();
   std::array<int, kMaxLevels> iterations{};  // fused passes per level
   std::array<double, kMaxLevels> level_ms{};  // wall time per level (passes and solves), ms
   int levels_used = 0;
