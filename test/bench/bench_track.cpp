@@ -8,6 +8,9 @@
 //        huber, overlap, maxit=l0,l1,.., textures=a.png,b.png or textures=all,
 //        config=1|2|3 (the paper's camera configurations), perturb=1 (the tracker gets extrinsics
 //        off by +10,-10,+10 mm and +2.5,-2.5,+2.5 deg); see main())
+//   bench_track nees [key=value...]         NEES of the covariances (alignment and frame-to-frame
+//       motion) and the lag-1 correlation of the errors per texture x configuration x size x
+//       finest level (seconds, seed, textures, configs=1,2,3, sizes=640x480,320x240, finest=0,1)
 //   bench_track ecc [w h] [pairs] [levels]   OpenCV's findTransformECC (homography) against the
 //       tracker on the same frame pairs, ECC's homography reduced to planar motion (see bench_ecc)
 #include <algorithm>
@@ -15,6 +18,7 @@
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -283,6 +287,192 @@ int bench_accuracy(const std::vector<std::string>& textures, double seconds, int
   return 0;
 }
 
+// NEES of the tracker's covariances against the simulator's truth. Per frame tracked `ok`:
+// the alignment (the live pose in the keyframe's robot frame, T_kf^-1 T_k, reconstructed from
+// the reported motions since the last keyframe; FrameResult::alignment_covariance) and the
+// reported frame-to-frame motion (FrameResult::covariance); the error is the right
+// perturbation xi = log(estimate^-1 truth), NEES = xi^T C^-1 xi (3 on average when C is right).
+// Lag-1 correlation: of consecutive frames' errors, each component normalised by its standard
+// deviation, averaged over x, y, theta (motion: all consecutive pairs; alignment: consecutive
+// frames against the same keyframe).
+struct NeesStats {
+  std::vector<double> align, motion, motion_kf;  // motion_kf: frames whose previous frame is the keyframe
+  std::vector<Eigen::Vector3d> zm_prev, zm_cur, za_prev, za_cur;
+  int frames = 0, ok = 0, keyframes = 0;
+
+  static double mean(const std::vector<double>& v) {
+    double s = 0;
+    for (double x : v) s += x;
+    return v.empty() ? 0.0 : s / static_cast<double>(v.size());
+  }
+  static double corr(const std::vector<Eigen::Vector3d>& a, const std::vector<Eigen::Vector3d>& b) {
+    if (a.size() < 3) return 0.0;
+    double c = 0;
+    for (int i = 0; i < 3; ++i) {
+      double sab = 0, saa = 0, sbb = 0, ma = 0, mb = 0;
+      for (size_t k = 0; k < a.size(); ++k) { ma += a[k](i); mb += b[k](i); }
+      ma /= static_cast<double>(a.size());
+      mb /= static_cast<double>(a.size());
+      for (size_t k = 0; k < a.size(); ++k) {
+        sab += (a[k](i) - ma) * (b[k](i) - mb);
+        saa += (a[k](i) - ma) * (a[k](i) - ma);
+        sbb += (b[k](i) - mb) * (b[k](i) - mb);
+      }
+      c += sab / std::sqrt(saa * sbb) / 3.0;
+    }
+    return c;
+  }
+};
+
+double nees(const Eigen::Vector3d& xi, const Eigen::Matrix3d& C) { return xi.dot(C.ldlt().solve(xi)); }
+
+Eigen::Vector3d normalised(const Eigen::Vector3d& xi, const Eigen::Matrix3d& C) {
+  return {xi(0) / std::sqrt(C(0, 0)), xi(1) / std::sqrt(C(1, 1)), xi(2) / std::sqrt(C(2, 2))};
+}
+
+// One tracker's bookkeeping over a sequence.
+struct NeesRun {
+  track::Tracker tracker;
+  NeesStats st;
+  SE2 kf_truth, est_rel;  // the keyframe's true pose; the previous frame's estimate relative to it
+  bool prev_ok = false, prev_kf = true;
+  Eigen::Vector3d prev_zm, prev_za;
+
+  int since_kf = 0;
+  FILE* csv = nullptr;  // per-frame rows (BENCH_NEES_CSV)
+  std::string tag;
+
+  NeesRun(ocl::Runtime& rt, const sim::Options& so, const track::TrackerOptions& o) : tracker(rt, so.camera, so.extrinsics, o) {}
+
+  void frame(const cv::Mat& img, double t, const SE2& truth_prev, const SE2& truth) {
+    const track::FrameResult r = tracker.track(img.data, img.cols, img.rows, img.step, t);
+    ++st.frames;
+    if (r.status == track::FrameResult::Status::First) {
+      kf_truth = truth;
+      est_rel = SE2();
+      prev_ok = false;
+      prev_kf = true;
+      since_kf = 0;
+      ++st.keyframes;
+      return;
+    }
+    const SE2 est_align = est_rel * r.motion;
+    const bool ok = r.status == track::FrameResult::Status::Ok;
+    if (ok) {
+      ++st.ok;
+      const Eigen::Vector3d xa = (est_align.inverse() * (kf_truth.inverse() * truth)).log();
+      const Eigen::Vector3d xm = (r.motion.inverse() * (truth_prev.inverse() * truth)).log();
+      st.align.push_back(nees(xa, r.alignment_covariance));
+      st.motion.push_back(nees(xm, r.covariance));
+      if (csv) {
+        const Eigen::Matrix3d& A = r.alignment_covariance;
+        const Eigen::Matrix3d& M = r.covariance;
+        std::fprintf(csv, "%s,%d,%d,%.4f,%.4f,%d", tag.c_str(), st.frames - 1, since_kf + 1, r.overlap, r.sigma,
+                     r.iterations[static_cast<size_t>(std::max(0, tracker.options().finest_level))]);
+        for (int i = 0; i < 3; ++i) std::fprintf(csv, ",%.6e", xa(i));
+        for (int i = 0; i < 3; ++i)
+          for (int j = i; j < 3; ++j) std::fprintf(csv, ",%.6e", A(i, j));
+        for (int i = 0; i < 3; ++i) std::fprintf(csv, ",%.6e", xm(i));
+        for (int i = 0; i < 3; ++i)
+          for (int j = i; j < 3; ++j) std::fprintf(csv, ",%.6e", M(i, j));
+        const SE2 m = r.motion;
+        std::fprintf(csv, ",%.6e,%.6e,%.6e,%d\n", m.x, m.y, m.theta, r.keyframe ? 1 : 0);
+      }
+      if (prev_kf) st.motion_kf.push_back(st.motion.back());
+      const Eigen::Vector3d za = normalised(xa, r.alignment_covariance), zm = normalised(xm, r.covariance);
+      if (prev_ok) {
+        st.zm_prev.push_back(prev_zm);
+        st.zm_cur.push_back(zm);
+        if (!prev_kf) {
+          st.za_prev.push_back(prev_za);
+          st.za_cur.push_back(za);
+        }
+      }
+      prev_za = za;
+      prev_zm = zm;
+    }
+    prev_ok = ok;
+    if (r.keyframe) {
+      ++st.keyframes;
+      kf_truth = truth;
+      est_rel = SE2();
+      prev_kf = true;
+      since_kf = 0;
+    } else {
+      est_rel = est_align;
+      prev_kf = false;
+      ++since_kf;
+    }
+  }
+};
+
+int bench_nees(const std::vector<std::string>& textures, const std::vector<int>& configs,
+               const std::vector<std::array<int, 2>>& sizes, const std::vector<int>& finests, double seconds,
+               uint64_t seed, double noise, const track::TrackerOptions& base) {
+  ocl::Runtime rt;
+  std::printf("device: %s\n", rt.device_info().device_name.c_str());
+  std::printf("%.0f s at 30 Hz per sequence (seed %llu), mixed motion up to 0.8 m/s and 1.5 rad/s, noise %g grey "
+              "level, gain drift 5%%, lens distortion, camera-frame API; tracker: convergence %g px\n", seconds,
+              static_cast<unsigned long long>(seed), noise, base.convergence_px);
+  std::printf("NEES: mean over the frames tracked ok of xi^T C^-1 xi (3 when C is right); align: the pose in the "
+              "keyframe's frame; motion: the reported frame-to-frame motion (motion|kf: those right after a "
+              "keyframe); lag1: correlation of consecutive errors, per component, mean of x, y, theta\n");
+  std::printf("%-22s %3s %9s %6s %6s %4s %4s %8s %8s %9s %9s %9s\n", "texture", "cfg", "size", "finest", "frames",
+              "ok", "kf", "nees_al", "nees_mo", "nees_mokf", "lag1_mo", "lag1_al");
+  FILE* csv = std::getenv("BENCH_NEES_CSV") ? std::fopen(std::getenv("BENCH_NEES_CSV"), "w") : nullptr;
+  if (csv)
+    std::fprintf(csv, "texture,config,width,finest,frame,since_kf,overlap,sigma,passes,ea_x,ea_y,ea_t,A_xx,A_xy,A_xt,"
+                      "A_yy,A_yt,A_tt,em_x,em_y,em_t,M_xx,M_xy,M_xt,M_yy,M_yt,M_tt,m_x,m_y,m_t,keyframe\n");
+  std::vector<double> all_motion, all_align;
+  for (const auto& wh : sizes)
+    for (int config : configs)
+      for (const std::string& tex : textures) {
+        sim::Options so = sequence_options(tex, seconds, wh[0], wh[1], seed);
+        so.extrinsics = paper_configuration(config);
+        so.pixel_noise = noise;
+        const sim::Trajectory traj = sim::generate_trajectory(so);
+        const std::vector<sim::Exposure> exposure = sim::exposure_series(so, traj.t);
+        sim::Renderer renderer(rt, cv::imread(so.texture, cv::IMREAD_GRAYSCALE), so);
+        std::vector<std::unique_ptr<NeesRun>> runs;
+        for (int f : finests) {
+          track::TrackerOptions o = base;
+          o.finest_level = f;
+          runs.push_back(std::make_unique<NeesRun>(rt, so, o));
+          runs.back()->csv = csv;
+          runs.back()->tag = tex + "," + std::to_string(config) + "," + std::to_string(wh[0]) + "," + std::to_string(f);
+        }
+        for (size_t k = 0; k < traj.t.size(); ++k) {
+          const cv::Mat img = sim::apply_camera(renderer.render_float(traj.pose[k]), exposure[k], so.pixel_noise,
+                                                sim::derive_seed(so.seed, 1000 + k));
+          for (auto& run : runs) run->frame(img, traj.t[k], traj.pose[k == 0 ? 0 : k - 1], traj.pose[k]);
+        }
+        for (size_t i = 0; i < runs.size(); ++i) {
+          const NeesStats& st = runs[i]->st;
+          char size[16];
+          std::snprintf(size, sizeof size, "%dx%d", wh[0], wh[1]);
+          std::printf("%-22s %3d %9s %6d %6d %4d %4d %8.2f %8.2f %9.2f %9.2f %9.2f\n", tex.c_str(), config, size,
+                      finests[i], st.frames, st.ok, st.keyframes, NeesStats::mean(st.align), NeesStats::mean(st.motion),
+                      NeesStats::mean(st.motion_kf), NeesStats::corr(st.zm_prev, st.zm_cur),
+                      NeesStats::corr(st.za_prev, st.za_cur));
+          all_motion.push_back(NeesStats::mean(st.motion));
+          all_align.push_back(NeesStats::mean(st.align));
+        }
+        std::fflush(stdout);
+      }
+  if (csv) std::fclose(csv);
+  auto summary = [](const char* what, const std::vector<double>& v) {
+    if (v.empty()) return;
+    int inside = 0;
+    for (double x : v) inside += x >= 2.0 && x <= 4.0;
+    std::printf("%s: mean NEES per sequence from %.2f to %.2f (mean %.2f), %d of %zu within [2, 4]\n", what,
+                *std::min_element(v.begin(), v.end()), *std::max_element(v.begin(), v.end()), NeesStats::mean(v),
+                inside, v.size());
+  };
+  summary("frame-to-frame motion", all_motion);
+  summary("alignment", all_align);
+  return 0;
+}
+
 // Speed: frames rendered once into memory, then tracked repeatedly with each configuration,
 // the configurations interleaved so that load from other processes spreads over all of them.
 int bench_speed(int width, int height, double seconds, int rounds) {
@@ -538,6 +728,25 @@ int bench_ecc(int width, int height, int pairs, int levels, int stride) {
   return 0;
 }
 
+std::vector<std::string> split(const std::string& x) {
+  std::vector<std::string> out;
+  size_t p = 0;
+  while (p <= x.size()) {
+    const size_t c = x.find(',', p);
+    out.push_back(x.substr(p, c == std::string::npos ? std::string::npos : c - p));
+    if (c == std::string::npos) break;
+    p = c + 1;
+  }
+  return out;
+}
+
+std::vector<std::string> all_textures() {
+  return {"aerial_asphalt_01.png", "aerial_ground_rock.png", "anti_skid_tiles.png", "anti_slip_concrete.png",
+          "asphalt_01.png", "asphalt_02.png", "black_painted_planks.png", "blue_floor_tiles_01.png",
+          "brick_floor.png", "brown_mud_rocks_01.png", "brushed_concrete.png", "skimage_brick.png",
+          "skimage_grass.png", "skimage_gravel.png"};
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -570,17 +779,6 @@ int main(int argc, char** argv) {
       const std::string a = argv[i];
       const size_t eq = a.find('=');
       const std::string k = a.substr(0, eq), v = eq == std::string::npos ? "" : a.substr(eq + 1);
-      auto list = [&](const std::string& x) {
-        std::vector<std::string> out;
-        size_t p = 0;
-        while (p <= x.size()) {
-          const size_t c = x.find(',', p);
-          out.push_back(x.substr(p, c == std::string::npos ? std::string::npos : c - p));
-          if (c == std::string::npos) break;
-          p = c + 1;
-        }
-        return out;
-      };
       if (k == "seconds") seconds = std::atof(v.c_str());
       else if (k == "w") w = std::atoi(v.c_str());
       else if (k == "h") h = std::atoi(v.c_str());
@@ -599,25 +797,72 @@ int main(int argc, char** argv) {
       else if (k == "huber") topt.huber_factor = std::atof(v.c_str());
       else if (k == "overlap") topt.keyframe_overlap = std::atof(v.c_str());
       else if (k == "maxit") {
-        const auto it = list(v);
+        const auto it = split(v);
         for (size_t l = 0; l < it.size() && l < topt.max_iterations.size(); ++l) topt.max_iterations[l] = std::atoi(it[l].c_str());
-      } else if (k == "textures") tex = list(v);
+      } else if (k == "textures") tex = split(v);
       else {
         std::fprintf(stderr, "unknown option %s\n", a.c_str());
         return 2;
       }
     }
-    if (tex.size() == 1 && tex[0] == "all")
-      tex = {"aerial_asphalt_01.png", "aerial_ground_rock.png", "anti_skid_tiles.png", "anti_slip_concrete.png",
-             "asphalt_01.png", "asphalt_02.png", "black_painted_planks.png", "blue_floor_tiles_01.png",
-             "brick_floor.png", "brown_mud_rocks_01.png", "brushed_concrete.png", "skimage_brick.png",
-             "skimage_grass.png", "skimage_gravel.png"};
+    if (tex.size() == 1 && tex[0] == "all") tex = all_textures();
     if (config < 1 || config > 3) {
       std::fprintf(stderr, "config must be 1, 2 or 3\n");
       return 2;
     }
     return bench_accuracy(tex, seconds, w, h, seed, motion, topt, std::getenv("BENCH_VERBOSE") != nullptr, config,
                           perturb);
+  }
+  if (mode == "nees") {
+    // bench_track nees [key=value ...]: seconds=5 textures=a.png,b.png|all configs=1,2,3
+    //   sizes=640x480,320x240 finest=0,1 seed=1 (every texture x configuration x size, each
+    //   sequence rendered once and tracked once per finest level)
+    double seconds = 5.0, noise = 1.0;
+    uint64_t seed = 1;
+    std::vector<std::string> tex = {"asphalt_01.png", "anti_skid_tiles.png", "brick_floor.png",
+                                    "aerial_ground_rock.png"};
+    std::vector<int> configs = {1, 2, 3}, finests = {0, 1};
+    std::vector<std::array<int, 2>> sizes = {{640, 480}, {320, 240}};
+    track::TrackerOptions topt;
+    for (int i = 2; i < argc; ++i) {
+      const std::string a = argv[i];
+      const size_t eq = a.find('=');
+      const std::string k = a.substr(0, eq), v = eq == std::string::npos ? "" : a.substr(eq + 1);
+      if (k == "seconds") seconds = std::atof(v.c_str());
+      else if (k == "seed") seed = std::strtoull(v.c_str(), nullptr, 10);
+      else if (k == "noise") noise = std::atof(v.c_str());
+      else if (k == "conv") topt.convergence_px = std::atof(v.c_str());
+      else if (k == "huber") topt.huber_factor = std::atof(v.c_str());
+      else if (k == "brightness") topt.estimate_brightness = std::atoi(v.c_str()) != 0;
+      else if (k == "maxit") {
+        const auto it = split(v);
+        for (size_t l = 0; l < it.size() && l < topt.max_iterations.size(); ++l) topt.max_iterations[l] = std::atoi(it[l].c_str());
+      } else if (k == "textures") tex = v == "all" ? all_textures() : split(v);
+      else if (k == "configs" || k == "finest") {
+        std::vector<int>& out = k == "configs" ? configs : finests;
+        out.clear();
+        for (const std::string& x : split(v)) out.push_back(std::atoi(x.c_str()));
+      } else if (k == "sizes") {
+        sizes.clear();
+        for (const std::string& x : split(v)) {
+          int w = 0, h = 0;
+          if (std::sscanf(x.c_str(), "%dx%d", &w, &h) != 2 || w < 16 || h < 16) {
+            std::fprintf(stderr, "bad size %s (WxH)\n", x.c_str());
+            return 2;
+          }
+          sizes.push_back({w, h});
+        }
+      } else {
+        std::fprintf(stderr, "unknown option %s\n", a.c_str());
+        return 2;
+      }
+    }
+    for (int c : configs)
+      if (c < 1 || c > 3) {
+        std::fprintf(stderr, "configs must be 1, 2 or 3\n");
+        return 2;
+      }
+    return bench_nees(tex, configs, sizes, finests, seconds, seed, noise, topt);
   }
   if (mode == "ecc") {
     // bench_track ecc [w h] [pairs] [levels] [stride]
@@ -626,6 +871,6 @@ int main(int argc, char** argv) {
                      argc > 6 ? std::atoi(argv[6]) : 1);
   }
   std::fprintf(stderr, "usage: bench_track kernel [w h [wx wy pix hist fast [rounds]]] | speed [w h [seconds [rounds]]]"
-                       " | accuracy [key=value...] | ecc [w h [pairs [levels [stride]]]]\n");
+                       " | accuracy [key=value...] | nees [key=value...] | ecc [w h [pairs [levels [stride]]]]\n");
   return 2;
 }
