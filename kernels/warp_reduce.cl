@@ -26,7 +26,7 @@
 // (group_id(0) + num_groups(0) * group_id(1)).
 //
 // Build options (-D): NPARAM (3), WG_X (16), WG_Y (1), PIX (8), STATS (0: 1 adds the
-// statistics below and a histogram of HIST_BINS (16) bins of |r|),
+// statistics below, a histogram of HIST_BINS (16) bins of |r| and J^T J over the inliers),
 // DEBUG_OUTPUT (off: when defined, a last argument receives per reference pixel
 // (r, weight, valid, rho); not for the fast path).
 #ifndef NPARAM
@@ -73,7 +73,8 @@
 #define OUT_GREF (OUT_COST + 9)      // sum of |grad I_r(p)|^2 over valid pairs
 #define OUT_HVALID (OUT_COST + 10)   // valid pixels in the histogram's subsample
 #define OUT_HIST (OUT_COST + 11)     // HIST_BINS: counts of |r| < 0.25 * 2^(j / 2) in it
-#define NOUT (OUT_HIST + HIST_BINS)
+#define OUT_JTJ_IN (OUT_HIST + HIST_BINS)  // NH: upper triangle of J^T J over the inliers (|r| <= k)
+#define NOUT (OUT_JTJ_IN + NH)
 #else
 #define NOUT (OUT_COST + 5)
 #endif
@@ -198,6 +199,18 @@ void warp_reduce(__global const float4* ref, const int ref_stride, const int ref
     acc[OUT_IREF2] += ic * ic;
     acc[OUT_GLIVE] += m * (lGu * lGu + lGv * lGv);
     acc[OUT_GREF] += m * (rGu * rGu + rGv * rGv);
+    // The Huber cost's own Hessian (psi' = 1 inside k, 0 beyond) for the covariance: J^T J
+    // over the inliers, unweighted.
+    {
+      const float win = inlier ? m : 0.0f;
+      int oi = OUT_JTJ_IN;
+#pragma unroll
+      for (int i = 0; i < NJ; ++i) {
+        const float wj = win * J[i];
+#pragma unroll
+        for (int j = i; j < NJ; ++j) acc[oi++] += wj * J[j];
+      }
+    }
     // The histogram of |r| for the robust scale: a subsample (each work-item's first pixel)
     // is plenty for a median and saves most of its cost.
     if (k == 0) {

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <sstream>
 
+#include <Eigen/Cholesky>
+
 #include "core/error.h"
 #include "ocl/runtime.h"
 
@@ -11,10 +13,65 @@ namespace planarvo::track {
 
 double ReduceLayout::hist_threshold(int j) { return 0.25 * std::pow(2.0, 0.5 * j); }
 
+namespace {
+
+// The score clusters: whole work-groups, merge_x side by side and merge_y rows of them.
+struct ClusterGrid {
+  size_t span = 1, wg_y = 1;        // pixels of one work-group along x, y
+  size_t groups_x = 0, groups_y = 0;
+  size_t merge_x = 1, merge_y = 1;  // work-groups per cluster along x, y
+  size_t clusters_x = 0, clusters_y = 0;
+
+  ClusterGrid(int width, int height, int wg_x, int wg_y_, int pix, int cluster_width, int cluster_height) {
+    span = static_cast<size_t>(wg_x) * static_cast<size_t>(pix);
+    wg_y = static_cast<size_t>(wg_y_);
+    groups_x = (static_cast<size_t>(width) + span - 1) / span;
+    groups_y = (static_cast<size_t>(height) + wg_y - 1) / wg_y;
+    merge_x = std::max<size_t>(1, (static_cast<size_t>(std::max(0, cluster_width)) + span / 2) / span);
+    merge_y = std::max<size_t>(1, (static_cast<size_t>(std::max(0, cluster_height)) + wg_y / 2) / wg_y);
+    clusters_x = (groups_x + merge_x - 1) / merge_x;
+    clusters_y = (groups_y + merge_y - 1) / merge_y;
+  }
+  size_t clusters() const { return clusters_x * clusters_y; }
+  size_t of_group(size_t gx, size_t gy) const { return (gy / merge_y) * clusters_x + gx / merge_x; }
+  size_t of_pixel(int x, int y) const { return of_group(static_cast<size_t>(x) / span, static_cast<size_t>(y) / wg_y); }
+};
+
+// Per cluster: J^T W r (nj), the upper triangle of J^T W J (nh, ReduceLayout's order), valid.
+size_t cluster_stride(const ReduceLayout& L) { return static_cast<size_t>(L.nj() + L.nh() + 1); }
+
+// score_outer and clusters from the per-cluster sums (ReduceSums::score_outer).
+void finish_score_outer(const ReduceLayout& L, const std::vector<double>& acc, ReduceSums* out) {
+  const int nj = L.nj();
+  VectorJ delta = VectorJ::Zero(nj);
+  const Eigen::LDLT<MatrixJ> ldlt(out->JtWJ);
+  if (ldlt.info() == Eigen::Success) delta = -ldlt.solve(out->JtWr);
+  if (!delta.allFinite()) delta.setZero();
+  out->score_outer = MatrixJ::Zero(nj, nj);
+  out->clusters = 0;
+  const size_t stride = cluster_stride(L);
+  VectorJ sc(nj);
+  for (size_t c = 0; c + stride <= acc.size(); c += stride) {
+    const double* a = &acc[c];
+    if (!(a[stride - 1] > 0)) continue;
+    for (int i = 0; i < nj; ++i) {
+      double v = a[i];
+      for (int j = 0; j < nj; ++j) v += a[nj + L.jtj(std::min(i, j), std::max(i, j))] * delta(j);
+      sc(i) = v;
+    }
+    out->score_outer.noalias() += sc * sc.transpose();
+    out->clusters += 1;
+  }
+}
+
+}  // namespace
+
 void ReduceSums::assign(const ReduceLayout& L, const double* row) {
   const int n = L.nj();
   JtWJ.resize(n, n);
   JtWr.resize(n);
+  score_outer = MatrixJ::Zero(n, n);
+  clusters = 0;
   for (int i = 0; i < n; ++i) {
     for (int j = i; j < n; ++j) JtWJ(i, j) = JtWJ(j, i) = row[L.jtj(i, j)];
     JtWr(i) = row[L.jtr(i)];
@@ -28,6 +85,7 @@ void ReduceSums::assign(const ReduceLayout& L, const double* row) {
   rr = iref = iref2 = glive = gref = hist_valid = 0.0;
   hist_bins = L.stats ? L.hist_bins : 0;
   hist.fill(0.0);
+  JtJ_inlier.resize(0, 0);
   if (!L.stats) return;
   rr = row[L.rr()];
   iref = row[L.iref()];
@@ -36,6 +94,9 @@ void ReduceSums::assign(const ReduceLayout& L, const double* row) {
   gref = row[L.gref()];
   hist_valid = row[L.hvalid()];
   for (int j = 0; j < L.hist_bins; ++j) hist[static_cast<size_t>(j)] = row[L.hist(j)];
+  JtJ_inlier.resize(n, n);
+  for (int i = 0; i < n; ++i)
+    for (int j = i; j < n; ++j) JtJ_inlier(i, j) = JtJ_inlier(j, i) = row[L.jtj_inlier(i, j)];
 }
 
 double ReduceSums::median_abs_residual() const {
@@ -58,7 +119,22 @@ double ReduceSums::median_abs_residual() const {
 ReduceSums warp_reduce_reference(const LevelView& ref, const LevelView& live,
                                  const WarpInputs& in, const ReduceLayout& L, int wg_x,
                                  int pixels_per_item) {
-  const int span = wg_x * pixels_per_item;
+  WarpReduceOptions o;
+  o.wg_x = wg_x;
+  o.wg_y = 1;
+  o.pixels_per_item = pixels_per_item;
+  return warp_reduce_reference(ref, live, in, L, o);
+}
+
+ReduceSums warp_reduce_reference(const LevelView& ref, const LevelView& live,
+                                 const WarpInputs& in, const ReduceLayout& L,
+                                 const WarpReduceOptions& o) {
+  const int wg_x = o.wg_x;
+  const int span = wg_x * o.pixels_per_item;
+  const ClusterGrid grid(ref.width, ref.height, o.wg_x, o.wg_y, o.pixels_per_item, o.cluster_width,
+                         o.cluster_height);
+  const size_t cstride = cluster_stride(L);
+  std::vector<double> cl(grid.clusters() * cstride, 0.0);
   if (in.nparam != L.nparam) throw_invalid_argument("warp_reduce_reference: nparam mismatch");
   const int nj = L.nj();
   std::vector<double> row(static_cast<size_t>(L.count()), 0.0);
@@ -118,11 +194,16 @@ ReduceSums warp_reduce_reference(const LevelView& ref, const LevelView& live,
       const bool inlier = ar <= k;
       const double w = inlier ? 1.0 : k / ar;
       const double rho = inlier ? 0.5 * r * r : k * (ar - 0.5 * k);
+      double* c = &cl[grid.of_pixel(x, y) * cstride];
       for (int i = 0; i < nj; ++i) {
-        for (int j = i; j < nj; ++j)
+        for (int j = i; j < nj; ++j) {
           row[static_cast<size_t>(L.jtj(i, j))] += w * J[static_cast<size_t>(i)] * J[static_cast<size_t>(j)];
+          c[nj + L.jtj(i, j)] += w * J[static_cast<size_t>(i)] * J[static_cast<size_t>(j)];
+        }
         row[static_cast<size_t>(L.jtr(i))] += w * J[static_cast<size_t>(i)] * r;
+        c[i] += w * J[static_cast<size_t>(i)] * r;
       }
+      c[cstride - 1] += 1.0;
       row[static_cast<size_t>(L.cost())] += rho;
       row[static_cast<size_t>(L.wrr())] += w * r * r;
       row[static_cast<size_t>(L.valid())] += 1.0;
@@ -134,6 +215,10 @@ ReduceSums warp_reduce_reference(const LevelView& ref, const LevelView& live,
       row[static_cast<size_t>(L.iref2())] += ic * ic;
       row[static_cast<size_t>(L.glive())] += Ls[1] * Ls[1] + Ls[2] * Ls[2];
       row[static_cast<size_t>(L.gref())] += static_cast<double>(R[1]) * R[1] + static_cast<double>(R[2]) * R[2];
+      if (inlier)
+        for (int i = 0; i < nj; ++i)
+          for (int j = i; j < nj; ++j)
+            row[static_cast<size_t>(L.jtj_inlier(i, j))] += J[static_cast<size_t>(i)] * J[static_cast<size_t>(j)];
       if (x % span >= wg_x) continue;
       row[static_cast<size_t>(L.hvalid())] += 1.0;
       for (int j = 0; j < L.hist_bins; ++j)
@@ -142,6 +227,7 @@ ReduceSums warp_reduce_reference(const LevelView& ref, const LevelView& live,
   }
   ReduceSums out;
   out.assign(L, row.data());
+  finish_score_outer(L, cl, &out);
   return out;
 }
 
@@ -230,6 +316,22 @@ void WarpReduce::run(const cl::Buffer& ref, int ref_w, int ref_h, const cl::Buff
   for (size_t g = 0; g < groups; ++g, p += c)
     for (size_t o = 0; o < c; ++o) row_[o] += static_cast<double>(p[o]);
   out->assign(layout_, row_.data());
+
+  // The score clusters from the same rows (a few additions per work-group).
+  const ClusterGrid grid(ref_w, ref_h, options_.wg_x, options_.wg_y, options_.pixels_per_item,
+                         options_.cluster_width, options_.cluster_height);
+  const int nj = layout_.nj(), nh = layout_.nh();
+  const size_t cstride = cluster_stride(layout_);
+  clusters_.assign(grid.clusters() * cstride, 0.0);
+  p = partials_host_.data();
+  for (size_t gy = 0; gy < groups_y; ++gy)
+    for (size_t gx = 0; gx < groups_x; ++gx, p += c) {
+      double* cs = &clusters_[grid.of_group(gx, gy) * cstride];
+      for (int i = 0; i < nj; ++i) cs[i] += static_cast<double>(p[layout_.jtr(i)]);
+      for (int i = 0; i < nh; ++i) cs[nj + i] += static_cast<double>(p[layout_.jtj(0, 0) + i]);
+      cs[cstride - 1] += static_cast<double>(p[layout_.valid()]);
+    }
+  finish_score_outer(layout_, clusters_, out);
 }
 
 }  // namespace planarvo::track

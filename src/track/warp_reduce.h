@@ -45,7 +45,9 @@ struct ReduceLayout {
   int gref() const { return cost() + 9; }
   int hvalid() const { return cost() + 10; }  // valid pixels in the histogram's subsample
   int hist(int j) const { return cost() + 11 + j; }
-  int count() const { return stats ? hist(0) + hist_bins : cost() + 5; }
+  // Upper triangle of J^T J over the inliers (|r| <= k, unweighted), row by row; i <= j.
+  int jtj_inlier(int i, int j) const { return hist(0) + hist_bins + jtj(i, j); }
+  int count() const { return stats ? hist(0) + hist_bins + nh() : cost() + 5; }
   // Histogram bin j counts |r| < hist_threshold(j) = 0.25 * 2^(j / 2) grey levels.
   static double hist_threshold(int j);
 };
@@ -62,6 +64,16 @@ struct ReduceSums {
   double valid = 0;  // pixels with a valid reference and a valid live sample
   double inlier = 0; // of those, |r| <= k
   double ref = 0;    // pixels with a valid reference
+  // Cluster-robust outer product of the scores (nj x nj), for a covariance that does not take
+  // neighbouring pixels' residuals as independent: the valid pixels are grouped into clusters
+  // of about WarpReduceOptions::cluster_width x cluster_height pixels (whole work-groups), each
+  // cluster's score s_c = sum of J w r over its pixels is extrapolated to the Gauss-Newton
+  // solution of this pass's own sums (s_c + (J^T W J)_c delta, delta = -(J^T W J)^-1 J^T W r, all
+  // nj parameters; the extrapolated scores sum to zero), and score_outer = sum_c s_c s_c^T over
+  // the `clusters` clusters with valid pixels. Filled by WarpReduce::run and the reference,
+  // not by assign().
+  MatrixJ score_outer;
+  double clusters = 0;
   // The STATS variant's (zero otherwise):
   bool has_stats = false;
   double rr = 0;                // sum of r^2
@@ -71,6 +83,9 @@ struct ReduceSums {
   // Over a subsample of the valid pixels (each work-item's first pixel), hist_valid of them:
   double hist_valid = 0;
   std::array<double, kMaxHistBins> hist{};  // counts of |r| < ReduceLayout::hist_threshold(j)
+  // J^T J over the inliers (|r| <= k), unweighted: the Huber cost's own Hessian (psi' is 1
+  // inside the threshold and 0 beyond), where J^T W J is the reweighted one.
+  MatrixJ JtJ_inlier;
 
   // Fills the fields from the summed row (layout.count() values).
   void assign(const ReduceLayout& layout, const double* row);
@@ -95,15 +110,20 @@ struct LevelView {
   int width = 0, height = 0, stride = 0;
 };
 
+struct WarpReduceOptions;
+
 // The plain C++ reference of the kernel: the same per-pixel formulas, the warp in float in the
 // kernel's order (so validity decisions match), everything after it in double, accumulated in
 // double. Returns the sums for the layout's nparam, stats and hist_bins; the histogram's
 // subsample is the pixels whose column c satisfies (c mod (wg_x * pix)) < wg_x, as the
-// kernel's work distribution makes it.
-
+// kernel's work distribution makes it; the score clusters are those of WarpReduce::run with
+// the options' work-group shape and cluster size (the first form: wg_y = 1, default clusters).
 ReduceSums warp_reduce_reference(const LevelView& ref, const LevelView& live,
                                  const WarpInputs& in, const ReduceLayout& layout, int wg_x = 16,
                                  int pixels_per_item = 8);
+ReduceSums warp_reduce_reference(const LevelView& ref, const LevelView& live,
+                                 const WarpInputs& in, const ReduceLayout& layout,
+                                 const WarpReduceOptions& options);
 
 struct WarpReduceOptions {
   int wg_x = 16, wg_y = 1;   // work-group shape (WG_X x WG_Y must be a power of two)
@@ -112,6 +132,10 @@ struct WarpReduceOptions {
   int hist_bins = 16;        // and a histogram of |r| for the robust scale (with stats only)
   bool fast_math = false;    // -cl-fast-relaxed-math (no faster on PoCL: src/track/README.md)
   bool debug_output = false; // per-pixel (r, weight, valid, rho) into a debug buffer
+  // The clusters of ReduceSums::score_outer, pixels: whole work-groups, as many side by side
+  // as come nearest cluster_width and as many rows of them as come nearest cluster_height
+  // (128 x 16 with the default work-group; measured in src/track/README.md, "Covariance").
+  int cluster_width = 128, cluster_height = 16;
 };
 
 // The pass on the device. Builds its program once; run() allocates nothing once the partials
@@ -142,6 +166,7 @@ class WarpReduce {
   std::vector<float> params_host_;
   std::vector<float> partials_host_;
   std::vector<double> row_;
+  std::vector<double> clusters_;  // per score cluster: J^T W r, J^T W J, valid
 };
 
 }  // namespace planarvo::track

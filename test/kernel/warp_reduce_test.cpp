@@ -3,7 +3,10 @@
 // derivative matrices, random brightness and Huber thresholds; sizes that are not multiples of
 // the work-group's span; several work-group shapes, pixels per work-item, parameter counts and
 // histogram sizes. The partials are poisoned first: every row must be written, nothing after.
+// Also the host's per-cluster score outer products (ReduceSums::score_outer) against the
+// reference's, and the inlier J^T J of the STATS variant.
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <random>
 #include <string>
@@ -176,6 +179,35 @@ void expect_sums_match(const ReduceSums& k, const ReduceSums& r, int nj, double 
   EXPECT_NEAR(k.hist_valid, r.hist_valid, flips);
   for (int j = 0; j < r.hist_bins; ++j)
     EXPECT_NEAR(k.hist[static_cast<size_t>(j)], r.hist[static_cast<size_t>(j)], flips + 1) << "bin " << j;
+  // J^T J over the inliers: like J^T W J, and a pixel may flip between inlier and outlier.
+  ASSERT_EQ(k.JtJ_inlier.rows(), nj);
+  for (int i = 0; i < nj; ++i)
+    for (int j = i; j < nj; ++j) {
+      const double scale = std::sqrt(r.JtJ_inlier(i, i) * r.JtJ_inlier(j, j));
+      EXPECT_NEAR(k.JtJ_inlier(i, j), r.JtJ_inlier(i, j), (rel + 5 * (per_pixel + 1.0 / std::max(1.0, r.inlier))) * scale + 1e-6)
+          << "JtJ_inlier(" << i << "," << j << ")";
+    }
+}
+
+// The cluster-robust score outer products of the host class (from the kernel's rows) and of the
+// reference (per pixel): the same clusters, the same extrapolation. Each entry within 1e-3 of
+// sqrt(M_ii M_jj) (observed 2e-6..2e-5 with 4-24 clusters, 4e-4 with 2). With one cluster the
+// extrapolated score is zero up to rounding (it is the whole pass's, which the extrapolation
+// cancels): only finite there.
+void expect_score_outer_match(const ReduceSums& k, const ReduceSums& r, int nj) {
+  ASSERT_EQ(k.clusters, r.clusters);
+  ASSERT_GT(r.clusters, 0.0);
+  ASSERT_EQ(k.score_outer.rows(), nj);
+  EXPECT_TRUE(k.score_outer.allFinite());
+  if (r.clusters < 2) return;
+  double worst = 0.0;
+  for (int i = 0; i < nj; ++i)
+    for (int j = i; j < nj; ++j) {
+      const double scale = std::sqrt(r.score_outer(i, i) * r.score_outer(j, j));
+      EXPECT_NEAR(k.score_outer(i, j), r.score_outer(i, j), 1e-3 * scale) << "score_outer(" << i << "," << j << ")";
+      worst = std::max(worst, std::abs(k.score_outer(i, j) - r.score_outer(i, j)) / scale);
+    }
+  std::printf("score_outer: %.0f clusters, largest difference %.2g of sqrt(M_ii M_jj)\n", r.clusters, worst);
 }
 
 class WarpReduceKernel : public ::testing::Test {
@@ -196,6 +228,8 @@ TEST_F(WarpReduceKernel, MatchesReferenceOnRandomLevels) {
   variants.push_back({5, o});
   o.wg_x = 8; o.wg_y = 1; o.pixels_per_item = 8; o.hist_bins = 16; o.stats = false;
   variants.push_back({1, o});
+  o.stats = true; o.cluster_width = 200; o.cluster_height = 5;  // 3 x 5 work-groups per score cluster
+  variants.push_back({3, o});
   const int sizes[][4] = {{97, 61, 101, 67}, {160, 120, 160, 120}, {33, 7, 40, 9}};
   for (const Variant& v : variants) {
     for (const auto& s : sizes) {
@@ -209,7 +243,7 @@ TEST_F(WarpReduceKernel, MatchesReferenceOnRandomLevels) {
       L.stats = v.options.stats;
       L.hist_bins = v.options.stats ? v.options.hist_bins : 0;
       const ReduceSums r = warp_reduce_reference({ref.data(), rw, rh, rw}, {live.data(), lw, lh, lw}, in, L,
-                                                  v.options.wg_x, v.options.pixels_per_item);
+                                                  v.options);
       ASSERT_GT(r.valid, 0.3 * rw * rh) << "the random warp should keep most pixels inside";
 
       int unwritten = 0, touched = 0;
@@ -229,12 +263,14 @@ TEST_F(WarpReduceKernel, MatchesReferenceOnRandomLevels) {
       EXPECT_EQ(c.cost, k.cost);
       EXPECT_EQ(c.JtWJ, k.JtWJ);
       EXPECT_EQ(c.JtWr, k.JtWr);
+      expect_score_outer_match(c, r, L.nj());
       // Deterministic: a second run is bit-identical.
       ReduceSums c2;
       wr.run(bref, rw, rh, blive, lw, lh, in, &c2);
       EXPECT_EQ(c2.JtWJ, c.JtWJ);
       EXPECT_EQ(c2.JtWr, c.JtWr);
       EXPECT_EQ(c2.cost, c.cost);
+      EXPECT_EQ(c2.score_outer, c.score_outer);
     }
   }
 }
@@ -260,6 +296,10 @@ TEST_F(WarpReduceKernel, IdentityWarpOfALevelOnItselfHasZeroResidual) {
   EXPECT_EQ(s.rr, 0.0);
   EXPECT_EQ(s.inlier, s.valid);
   EXPECT_EQ(s.glive, s.gref);
+  // Every pixel an inlier of weight 1: the inlier J^T J is J^T W J; no residual, no score.
+  EXPECT_EQ(s.JtJ_inlier, s.JtWJ);
+  EXPECT_EQ(s.score_outer.norm(), 0.0);
+  EXPECT_GT(s.clusters, 0.0);
   // A pixel is valid when it and its right, lower and lower-right neighbours are valid and
   // inside: count that directly.
   int expected = 0, refs = 0;
