@@ -28,6 +28,14 @@ struct Estimate {
 
 Eigen::Matrix3d lost_covariance() { return Eigen::Matrix3d::Identity(); }
 
+// The adjoint of an SE(2) element on se(2) = (vx, vy, omega): T exp(xi) T^-1 = exp(Ad_T xi).
+Eigen::Matrix3d adjoint(const SE2& T) {
+  const double c = std::cos(T.theta), s = std::sin(T.theta);
+  Eigen::Matrix3d A;
+  A << c, -s, T.y, s, c, -T.x, 0, 0, 1;
+  return A;
+}
+
 // Reasons (compared by address).
 constexpr const char* kNoTexture = "no texture";
 constexpr const char* kMismatch = "images do not match";
@@ -84,6 +92,8 @@ struct Tracker::Impl {
   bool keyframe_is_slot = false;
   SE2 pose;             // accumulated robot pose
   Estimate prev;        // the previous frame relative to the keyframe
+  // Covariance of prev.T (zero when the previous frame is the keyframe).
+  Eigen::Matrix3d prev_covariance = Eigen::Matrix3d::Zero();
   Eigen::Vector3d velocity = Eigen::Vector3d::Zero();  // se(2) per second
   double last_t = 0.0, nominal_dt = 0.0, since_good = 0.0;
   bool has_t = false;
@@ -100,6 +110,7 @@ struct Tracker::Impl {
     has_keyframe = false;
     pose = SE2();
     prev = Estimate();
+    prev_covariance.setZero();
     velocity.setZero();
     has_t = false;
     nominal_dt = 0.0;
@@ -157,7 +168,38 @@ struct Tracker::Impl {
            !(std::sqrt(cov(2, 2)) <= opt.max_heading_std);
   }
 
-  // Fills covariance, cost, inliers, overlap and the status from the finest level's sums.
+  // The alignment's covariance from the finest level's sums (TrackerOptions::
+  // covariance_step_fraction, README.md "Covariance"): s is the last pass at the estimate, st
+  // the STATS pass that opened the level (the same pass when the level took one). n = 3 or 5
+  // parameters, brightness marginalised by taking the motion block.
+  Eigen::Matrix3d alignment_covariance(const ReduceSums& s, const ReduceSums& st, int n, double floor_s2) const {
+    const MatrixJ A = s.JtWJ.topLeftCorner(n, n);
+    const Eigen::LDLT<MatrixJ> ldlt(A);
+    // Bread: the Huber cost's Hessian, J^T J over the inliers (J^T W J also counts the pixels
+    // beyond the threshold, with weight k / |r|, and would understate the spread).
+    const ReduceSums& hs = s.has_stats ? s : st;
+    MatrixJ B = hs.JtJ_inlier.rows() >= n ? MatrixJ(hs.JtJ_inlier.topLeftCorner(n, n)) : A;
+    Eigen::LDLT<MatrixJ> bread(B);
+    if (bread.info() != Eigen::Success || !(bread.vectorD().minCoeff() > 0.0)) bread.compute(A);
+    const MatrixJ Binv = bread.solve(MatrixJ::Identity(n, n));
+    // Meat: the scores' outer product over clusters of neighbouring pixels, scaled by
+    // G / (G - n) for the n parameters fitted from the same G clusters; with too few clusters,
+    // the independent-pixel sigma^2 J^T W J. At least the floor's worth of independent noise.
+    const double dof = std::max(1.0, s.valid - n);
+    MatrixJ M = s.clusters > 2.0 * n ? MatrixJ(s.score_outer.topLeftCorner(n, n) * (s.clusters / (s.clusters - n)))
+                                     : MatrixJ(std::max(s.wrr / dof, floor_s2) * A);
+    M += std::max(0.0, floor_s2 - s.wrr / dof) * A;
+    Eigen::Matrix3d C = (Binv * M * Binv.transpose()).topLeftCorner(3, 3);
+    C = 0.5 * (C + C.transpose());
+    // The last step, applied unchecked (or left over): the estimate is off by a fraction of it.
+    const VectorJ step = -ldlt.solve(VectorJ(s.JtWr.head(n)));
+    const Eigen::Vector3d d = opt.covariance_step_fraction * step.head(3);
+    if (d.allFinite()) C += d * d.transpose();
+    return C;
+  }
+
+  // Fills the alignment's covariance, cost, inliers, overlap and the status from the finest
+  // level's sums.
   void finish(FrameResult* res, const Estimate& e) {
     const ReduceSums& s = report.finest[0];
     res->final_cost = s.valid > 0 ? s.cost / s.valid : HUGE_VAL;
@@ -167,16 +209,21 @@ struct Tracker::Impl {
     res->bias = e.b;
     const int n = opt.estimate_brightness ? 5 : 3;
     const double dof = std::max(1.0, s.valid - n);
-    // Floored at min_sigma: noise-free synthetic images would otherwise claim zero variance.
-    const double s2 = std::max(s.wrr / dof, opt.min_sigma * opt.min_sigma);
     res->sigma = report.finest_sigma[0];
+    // The independent-pixel covariance sigma^2 (J^T W J)^-1 (sigma^2 at least min_sigma^2, so
+    // noise-free synthetic frames do not claim zero variance) judges how well the texture
+    // constrains the motion (the thresholds below were measured with it).
+    const double floor_s2 = opt.min_sigma * opt.min_sigma;
+    const double s2 = std::max(s.wrr / dof, floor_s2);
     MatrixJ A = s.JtWJ.topLeftCorner(n, n);
     Eigen::LDLT<MatrixJ> ldlt(A);
     MatrixJ I = MatrixJ::Identity(n, n);
     const MatrixJ inv = ldlt.solve(I);
-    res->covariance = s2 * inv.topLeftCorner(3, 3);
-    if (!res->covariance.allFinite()) res->covariance = lost_covariance();
-    res->alignment_covariance = res->covariance;
+    Eigen::Matrix3d independent = s2 * inv.topLeftCorner(3, 3);
+    if (!independent.allFinite()) independent = lost_covariance();
+    res->alignment_covariance = alignment_covariance(s, report.finest_stats[0], n, floor_s2);
+    if (!res->alignment_covariance.allFinite()) res->alignment_covariance = lost_covariance();
+    res->covariance = res->alignment_covariance;
 
     const ReduceSums& st = report.finest_stats[0];
     const double var_ref = st.valid > 0 ? st.iref2 / st.valid - std::pow(st.iref / st.valid, 2) : 0.0;
@@ -193,7 +240,7 @@ struct Tracker::Impl {
     } else if (res->inlier_fraction < opt.min_inlier_fraction) {
       res->status = Status::Degraded;
       res->reason = "few inliers";
-    } else if (weakly_constrained(res->covariance)) {
+    } else if (weakly_constrained(independent)) {
       res->status = Status::Degraded;
       res->reason = kWeak;
     } else {
@@ -227,6 +274,7 @@ struct Tracker::Impl {
     }
     has_keyframe = true;
     prev = Estimate();
+    prev_covariance.setZero();
   }
 
   FrameResult track_gray(const uint8_t* gray, int width, int height, size_t stride, double t) {
@@ -300,7 +348,9 @@ struct Tracker::Impl {
         make_keyframe(live);
         res.keyframe = true;
       } else {
+        // The next motion is from this predicted pose: as uncertain as this one.
         prev.T = prev.T * predicted;
+        prev_covariance = lost_covariance();
       }
       if (since_good > opt.max_gap_seconds) velocity.setZero();
       return done(res);
@@ -360,8 +410,12 @@ struct Tracker::Impl {
       res.reason = time_problem;
     }
 
-    // Frame-to-frame motion from the keyframe-relative estimates.
+    // Frame-to-frame motion from the keyframe-relative estimates, and its covariance: with
+    // prev.T = P exp(xi_p) and est.T = E exp(xi_e), the motion is m exp(xi_e - Ad(m^-1) xi_p).
     res.motion = prev.T.inverse() * est.T;
+    const Eigen::Matrix3d ad = adjoint(res.motion.inverse());
+    res.covariance = res.alignment_covariance + ad * prev_covariance * ad.transpose();
+    if (!res.covariance.allFinite()) res.covariance = lost_covariance();
     pose = pose * res.motion;
     if (dt > 0.0) velocity = res.motion.log() / dt;
     since_good = 0.0;
@@ -370,6 +424,7 @@ struct Tracker::Impl {
       res.keyframe = true;
     } else {
       prev = est;
+      prev_covariance = res.alignment_covariance;
     }
     return done(res);
   }

@@ -55,6 +55,14 @@ struct TrackerOptions : AlignerOptions {
   double max_position_std = 1e-4;  // metres
   double max_std_ratio = 10.0;
   double max_heading_std = 1e-3;   // radians
+  // Covariance (src/track/README.md, "Covariance"). The alignment's is the M-estimator's
+  // sandwich H^-1 M H^-1 (H: J^T J over the Huber inliers, M: the scores' outer product over
+  // clusters of neighbouring pixels, ReduceSums::score_outer) plus (f delta)(f delta)^T, delta
+  // the finest level's last Gauss-Newton step, f = covariance_step_fraction: that step is
+  // applied without a pass to check it, and the estimate is then measured to be off the
+  // converged one by 0.2-0.9 of it (Huber reweighting shortens the steps). 0.5 measured (mean
+  // NEES of the frame-to-frame motion ~3 on the simulator); 0 leaves the sandwich alone.
+  double covariance_step_fraction = 0.5;
 
   static WarpReduceOptions default_kernel_options();
 };
@@ -71,15 +79,21 @@ struct FrameResult {
   // Frame-to-frame motion: this frame's robot pose in the previous frame's robot frame
   // (T_{k-1}^-1 T_k, conventions.md), metres and radians.
   SE2 motion;
-  // Covariance of the right perturbation xi of the motion (motion = m̂ exp(xi)) from this frame's
-  // alignment: sigma^2 (J^T W J)^-1 of the finest level, brightness marginalised, sigma^2 the
-  // weighted residual variance (at least min_sigma^2); (x, y) in metres, theta in radians.
-  // Pixels are treated as independent, so it is optimistic as an absolute (README.md).
-  // Large (1 m^2, 1 rad^2 on the diagonal) when Lost or First.
+  // Covariance of the right perturbation xi of the motion (motion = m̂ exp(xi)), (x, y) in
+  // metres, theta in radians: this frame's alignment covariance plus the previous frame's
+  // carried through the adjoint, C_k + Ad(m̂^-1) C_{k-1} Ad(m̂^-1)^T, the motion being
+  // (T_kf^-1 T_{k-1})^-1 (T_kf^-1 T_k) (just C_k when the previous frame is the keyframe).
+  // Calibrated against the simulator's truth: mean NEES of the motions 2-4 (README.md,
+  // "Covariance"). Consecutive motions share the middle frame's alignment error, so their
+  // errors are negatively correlated (about -0.4); the sum of a run of motions is better
+  // known than the sum of their covariances says. Large (1 m^2, 1 rad^2 on the diagonal) when
+  // Lost or First, and for the first frame after a Lost one that did not become the keyframe.
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Identity();
   // Covariance of this frame's own alignment with the keyframe: the right perturbation of its
-  // pose in the keyframe's robot frame (the estimate T_kf^-1 T_k), same units. The motion's
-  // covariance above is this one when the previous frame is the keyframe.
+  // pose in the keyframe's robot frame (the estimate T_kf^-1 T_k), same units; brightness
+  // marginalised (TrackerOptions::covariance_step_fraction says how it is made). Frames
+  // aligned with the same keyframe share that keyframe's own part of the error (correlation
+  // 0.2-0.7 between consecutive frames), which is in this covariance and cancels in the motion.
   Eigen::Matrix3d alignment_covariance = Eigen::Matrix3d::Identity();
   std::array<int, kMaxLevels> iterations{};  // fused passes per level
   std::array<double, kMaxLevels> level_ms{};  // wall time per level (passes and solves), ms
