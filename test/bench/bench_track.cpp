@@ -10,7 +10,9 @@
 //        off by +10,-10,+10 mm and +2.5,-2.5,+2.5 deg); see main())
 //   bench_track nees [key=value...]         NEES of the covariances (alignment and frame-to-frame
 //       motion) and the lag-1 correlation of the errors per texture x configuration x size x
-//       finest level (seconds, seed, textures, configs=1,2,3, sizes=640x480,320x240, finest=0,1)
+//       finest level (seconds=5, seed=1, textures=..|all, configs=1,2,3, sizes=640x480,320x240,
+//       finest=0,1; noise=1 grey level; tracker: conv, huber, brightness=0|1, maxit=l0,l1,..);
+//       BENCH_NEES_CSV=file also writes one row per frame tracked ok
 //   bench_track ecc [w h] [pairs] [levels]   OpenCV's findTransformECC (homography) against the
 //       tracker on the same frame pairs, ECC's homography reduced to planar motion (see bench_ecc)
 #include <algorithm>
@@ -233,8 +235,7 @@ SequenceReport run_sequence(ocl::Runtime& rt, const sim::Options& so, const trac
       std_head.push_back(std::sqrt(r.covariance(2, 2)));
       const Eigen::Vector2d ev = Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(r.covariance.topLeftCorner<2, 2>()).eigenvalues();
       rep.aniso_max = std::max(rep.aniso_max, std::sqrt(ev(1) / ev(0)));
-      // Normalised error of the frames tracked directly against the keyframe's own frame
-      // (the previous frame was the keyframe), where the covariance is that of the motion.
+      // Normalised error of the motion with its covariance (`bench_track nees` has more).
       const Eigen::Vector3d xi = (r.motion.inverse() * t).log();
       nees += xi.dot(r.covariance.ldlt().solve(xi));
       ++nees_n;
