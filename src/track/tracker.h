@@ -42,8 +42,9 @@ struct TrackerOptions : AlignerOptions {
   // dominates): above lost_residual_ratio Lost, above degraded_residual_ratio Degraded.
   // Inlier fraction below min_inlier_fraction: Degraded (with k = 2 sigma of this frame's own
   // residuals, Gaussian residuals give 0.95; a heavy tail of unexplained pixels, fewer).
-  // |a| > max_log_gain: Lost. Degraded when the covariance's position standard deviation
-  // (larger axis) exceeds max_position_std, its axes differ by more than max_std_ratio (texture
+  // |a| > max_log_gain: Lost. Degraded when the independent-pixel covariance's (sigma^2
+  // (J^T W J)^-1, with which these were measured; not the reported one) position standard
+  // deviation (larger axis) exceeds max_position_std, its axes differ by more than max_std_ratio (texture
   // that constrains the motion in one direction only, e.g. stripes: 21; the shared textures:
   // 1.9-3.5), or the heading's exceeds max_heading_std (typical: 2-10 um, 1e-5 rad).
   double max_gap_factor = 2.5;
@@ -61,7 +62,7 @@ struct TrackerOptions : AlignerOptions {
   // the finest level's last Gauss-Newton step, f = covariance_step_fraction: that step is
   // applied without a pass to check it, and the estimate is then measured to be off the
   // converged one by 0.2-0.9 of it (Huber reweighting shortens the steps). 0.5 measured (mean
-  // NEES of the frame-to-frame motion ~3 on the simulator); 0 leaves the sandwich alone.
+  // NEES of the frame-to-frame motion 2.9 on the simulator); 0 leaves the sandwich alone.
   double covariance_step_fraction = 0.5;
 
   static WarpReduceOptions default_kernel_options();
@@ -83,8 +84,8 @@ struct FrameResult {
   // metres, theta in radians: this frame's alignment covariance plus the previous frame's
   // carried through the adjoint, C_k + Ad(m̂^-1) C_{k-1} Ad(m̂^-1)^T, the motion being
   // (T_kf^-1 T_{k-1})^-1 (T_kf^-1 T_k) (just C_k when the previous frame is the keyframe).
-  // Calibrated against the simulator's truth: mean NEES of the motions 2-4 (README.md,
-  // "Covariance"). Consecutive motions share the middle frame's alignment error, so their
+  // Calibrated against the simulator's truth: mean NEES of the motions 2.9 (1.1-5.3 per 5-s
+  // sequence; README.md, "Covariance (simulator)"). Consecutive motions share the middle frame's alignment error, so their
   // errors are negatively correlated (about -0.4); the sum of a run of motions is better
   // known than the sum of their covariances says. Large (1 m^2, 1 rad^2 on the diagonal) when
   // Lost or First, and for the first frame after a Lost one that did not become the keyframe.
