@@ -54,6 +54,10 @@ CameraModel validated(const CameraModel& c, const Extrinsics& e, const TrackerOp
   if (o.levels < 1 || o.levels > kMaxLevels)
     throw_invalid_argument("TrackerOptions::levels must be 1.." + std::to_string(kMaxLevels));
   if (!(e.z > 0.0)) throw_invalid_argument("Tracker: the camera height z must be positive");
+  if (!(o.covariance_step_fraction >= 0.0))
+    throw_invalid_argument("the tracker's covariance step fraction must be 0 or more");
+  if (!(o.consecutive_alignment_correlation >= 0.0 && o.consecutive_alignment_correlation <= 0.5))
+    throw_invalid_argument("the tracker's consecutive alignment correlation must be within [0, 0.5]");
   c.validate("Tracker camera");
   return c;
 }
@@ -92,7 +96,8 @@ struct Tracker::Impl {
   bool keyframe_is_slot = false;
   SE2 pose;             // accumulated robot pose
   Estimate prev;        // the previous frame relative to the keyframe
-  // Covariance of prev.T (zero when the previous frame is the keyframe).
+  // Covariance of prev.T less the part the next frame shares with it ((1 - 2 rho) C; zero when
+  // the previous frame is the keyframe, lost_covariance() after a Lost frame).
   Eigen::Matrix3d prev_covariance = Eigen::Matrix3d::Zero();
   Eigen::Vector3d velocity = Eigen::Vector3d::Zero();  // se(2) per second
   double last_t = 0.0, nominal_dt = 0.0, since_good = 0.0;
@@ -182,11 +187,13 @@ struct Tracker::Impl {
     Eigen::LDLT<MatrixJ> bread(B);
     if (bread.info() != Eigen::Success || !(bread.vectorD().minCoeff() > 0.0)) bread.compute(A);
     const MatrixJ Binv = bread.solve(MatrixJ::Identity(n, n));
-    // Meat: the scores' outer product over clusters of neighbouring pixels, scaled by
-    // G / (G - n) for the n parameters fitted from the same G clusters; with too few clusters,
-    // the independent-pixel sigma^2 J^T W J. At least the floor's worth of independent noise.
+    // Meat: the scores' outer product over G clusters of neighbouring pixels, scaled by
+    // G / (G - 1): the scores are taken at the fitted solution, which removes one cluster's worth
+    // of their spread along any direction (E = (1 - 1/G) of the true one for alike clusters).
+    // With too few clusters, the independent-pixel sigma^2 J^T W J. At least the floor's worth
+    // of independent noise.
     const double dof = std::max(1.0, s.valid - n);
-    MatrixJ M = s.clusters > 2.0 * n ? MatrixJ(s.score_outer.topLeftCorner(n, n) * (s.clusters / (s.clusters - n)))
+    MatrixJ M = s.clusters > 2.0 * n ? MatrixJ(s.score_outer.topLeftCorner(n, n) * (s.clusters / (s.clusters - 1.0)))
                                      : MatrixJ(std::max(s.wrr / dof, floor_s2) * A);
     M += std::max(0.0, floor_s2 - s.wrr / dof) * A;
     Eigen::Matrix3d C = (Binv * M * Binv.transpose()).topLeftCorner(3, 3);
@@ -411,7 +418,8 @@ struct Tracker::Impl {
     }
 
     // Frame-to-frame motion from the keyframe-relative estimates, and its covariance: with
-    // prev.T = P exp(xi_p) and est.T = E exp(xi_e), the motion is m exp(xi_e - Ad(m^-1) xi_p).
+    // prev.T = P exp(xi_p) and est.T = E exp(xi_e), the motion is m exp(xi_e - Ad(m^-1) xi_p);
+    // prev_covariance already holds xi_p's covariance less the part shared with xi_e.
     res.motion = prev.T.inverse() * est.T;
     const Eigen::Matrix3d ad = adjoint(res.motion.inverse());
     res.covariance = res.alignment_covariance + ad * prev_covariance * ad.transpose();
@@ -424,7 +432,7 @@ struct Tracker::Impl {
       res.keyframe = true;
     } else {
       prev = est;
-      prev_covariance = res.alignment_covariance;
+      prev_covariance = (1.0 - 2.0 * opt.consecutive_alignment_correlation) * res.alignment_covariance;
     }
     return done(res);
   }

@@ -57,13 +57,18 @@ struct TrackerOptions : AlignerOptions {
   double max_std_ratio = 10.0;
   double max_heading_std = 1e-3;   // radians
   // Covariance (src/track/README.md, "Covariance"). The alignment's is the M-estimator's
-  // sandwich H^-1 M H^-1 (H: J^T J over the Huber inliers, M: the scores' outer product over
+  // sandwich B^-1 M B^-1 (B: J^T J over the Huber inliers, M: the scores' outer product over
   // clusters of neighbouring pixels, ReduceSums::score_outer) plus (f delta)(f delta)^T, delta
   // the finest level's last Gauss-Newton step, f = covariance_step_fraction: that step is
-  // applied without a pass to check it, and the estimate is then measured to be off the
-  // converged one by 0.2-0.9 of it (Huber reweighting shortens the steps). 0.5 measured (mean
-  // NEES of the frame-to-frame motion 2.9 on the simulator); 0 leaves the sandwich alone.
-  double covariance_step_fraction = 0.5;
+  // applied without a pass to check it, and Gauss-Newton steps under Huber weights fall a
+  // little short (0.1 measured; 0 leaves the sandwich alone).
+  double covariance_step_fraction = 0.1;
+  // The motion's: consecutive frames aligned with one keyframe see the same keyframe pixels,
+  // so their alignment errors share a part (the keyframe's noise and interpolation), which
+  // cancels in the motion between them. Modelled as the cross-covariance rho * C_{k-1} (C_{k-1}
+  // carried into this frame), so the motion's covariance is C_k + (1 - 2 rho) C_{k-1}; rho
+  // measured on the simulator (0 takes the alignments as independent, 0.5 drops C_{k-1}).
+  double consecutive_alignment_correlation = 0.25;
 
   static WarpReduceOptions default_kernel_options();
 };
@@ -81,14 +86,17 @@ struct FrameResult {
   // (T_{k-1}^-1 T_k, conventions.md), metres and radians.
   SE2 motion;
   // Covariance of the right perturbation xi of the motion (motion = m̂ exp(xi)), (x, y) in
-  // metres, theta in radians: this frame's alignment covariance plus the previous frame's
-  // carried through the adjoint, C_k + Ad(m̂^-1) C_{k-1} Ad(m̂^-1)^T, the motion being
-  // (T_kf^-1 T_{k-1})^-1 (T_kf^-1 T_k) (just C_k when the previous frame is the keyframe).
-  // Calibrated against the simulator's truth: mean NEES of the motions 2.9 (1.1-5.3 per 5-s
-  // sequence; README.md, "Covariance (simulator)"). Consecutive motions share the middle frame's alignment error, so their
-  // errors are negatively correlated (about -0.4); the sum of a run of motions is better
-  // known than the sum of their covariances says. Large (1 m^2, 1 rad^2 on the diagonal) when
-  // Lost or First, and for the first frame after a Lost one that did not become the keyframe.
+  // metres, theta in radians. The motion is (T_kf^-1 T_{k-1})^-1 (T_kf^-1 T_k), its error
+  // xi_k - Ad(m̂^-1) xi_{k-1}: this frame's alignment covariance plus the previous frame's
+  // carried through the adjoint, less their shared part, C_k + (1 - 2 rho) Ad C_{k-1} Ad^T
+  // (TrackerOptions::consecutive_alignment_correlation; just C_k when the previous frame is
+  // the keyframe). Measured against the simulator's truth (README.md, "Covariance
+  // (simulator)"): mean NEES of the motions about 3 over many sequences, 1-5 per sequence
+  // (texture-dependent); overconfident (about 5) for frames while the robot stands still,
+  // conservative (about 1.7) at walking speeds. Consecutive motions share the middle frame's
+  // alignment error, so their errors are negatively correlated (about -0.4). Large (1 m^2,
+  // 1 rad^2 on the diagonal) when Lost or First, and for the first frame after a Lost one that
+  // did not become the keyframe.
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Identity();
   // Covariance of this frame's own alignment with the keyframe: the right perturbation of its
   // pose in the keyframe's robot frame (the estimate T_kf^-1 T_k), same units; brightness

@@ -22,13 +22,15 @@ struct ClusterGrid {
   size_t merge_x = 1, merge_y = 1;  // work-groups per cluster along x, y
   size_t clusters_x = 0, clusters_y = 0;
 
-  ClusterGrid(int width, int height, int wg_x, int wg_y_, int pix, int cluster_width, int cluster_height) {
+  ClusterGrid(int width, int height, int wg_x, int wg_y_, int pix, int cluster_width, int cluster_bands) {
     span = static_cast<size_t>(wg_x) * static_cast<size_t>(pix);
     wg_y = static_cast<size_t>(wg_y_);
     groups_x = (static_cast<size_t>(width) + span - 1) / span;
     groups_y = (static_cast<size_t>(height) + wg_y - 1) / wg_y;
+    const size_t bands = static_cast<size_t>(std::max(1, cluster_bands));
+    const size_t band_rows = (static_cast<size_t>(std::max(1, height)) + bands - 1) / bands;
     merge_x = std::max<size_t>(1, (static_cast<size_t>(std::max(0, cluster_width)) + span / 2) / span);
-    merge_y = std::max<size_t>(1, (static_cast<size_t>(std::max(0, cluster_height)) + wg_y / 2) / wg_y);
+    merge_y = std::max<size_t>(1, (band_rows + wg_y / 2) / wg_y);
     clusters_x = (groups_x + merge_x - 1) / merge_x;
     clusters_y = (groups_y + merge_y - 1) / merge_y;
   }
@@ -132,7 +134,7 @@ ReduceSums warp_reduce_reference(const LevelView& ref, const LevelView& live,
   const int wg_x = o.wg_x;
   const int span = wg_x * o.pixels_per_item;
   const ClusterGrid grid(ref.width, ref.height, o.wg_x, o.wg_y, o.pixels_per_item, o.cluster_width,
-                         o.cluster_height);
+                         o.cluster_bands);
   const size_t cstride = cluster_stride(L);
   std::vector<double> cl(grid.clusters() * cstride, 0.0);
   if (in.nparam != L.nparam) throw_invalid_argument("warp_reduce_reference: nparam mismatch");
@@ -319,7 +321,7 @@ void WarpReduce::run(const cl::Buffer& ref, int ref_w, int ref_h, const cl::Buff
 
   // The score clusters from the same rows (a few additions per work-group).
   const ClusterGrid grid(ref_w, ref_h, options_.wg_x, options_.wg_y, options_.pixels_per_item,
-                         options_.cluster_width, options_.cluster_height);
+                         options_.cluster_width, options_.cluster_bands);
   const int nj = layout_.nj(), nh = layout_.nh();
   const size_t cstride = cluster_stride(layout_);
   clusters_.assign(grid.clusters() * cstride, 0.0);

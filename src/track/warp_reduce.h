@@ -66,7 +66,7 @@ struct ReduceSums {
   double ref = 0;    // pixels with a valid reference
   // Cluster-robust outer product of the scores (nj x nj), for a covariance that does not take
   // neighbouring pixels' residuals as independent: the valid pixels are grouped into clusters
-  // of about WarpReduceOptions::cluster_width x cluster_height pixels (whole work-groups), each
+  // of whole work-groups (WarpReduceOptions::cluster_width, cluster_bands), each
   // cluster's score s_c = sum of J w r over its pixels is extrapolated to the Gauss-Newton
   // solution of this pass's own sums (s_c + (J^T W J)_c delta, delta = -(J^T W J)^-1 J^T W r, all
   // nj parameters; the extrapolated scores sum to zero), and score_outer = sum_c s_c s_c^T over
@@ -132,10 +132,12 @@ struct WarpReduceOptions {
   int hist_bins = 16;        // and a histogram of |r| for the robust scale (with stats only)
   bool fast_math = false;    // -cl-fast-relaxed-math (no faster on PoCL: src/track/README.md)
   bool debug_output = false; // per-pixel (r, weight, valid, rho) into a debug buffer
-  // The clusters of ReduceSums::score_outer, pixels: whole work-groups, as many side by side
-  // as come nearest cluster_width and as many rows of them as come nearest cluster_height
-  // (128 x 16 with the default work-group; measured in src/track/README.md, "Covariance").
-  int cluster_width = 128, cluster_height = 16;
+  // The clusters of ReduceSums::score_outer: whole work-groups, as many side by side as come
+  // nearest cluster_width pixels, and as many rows of them as come nearest 1 / cluster_bands of
+  // the level's height (a fixed share of the view, so a fixed patch of ground at every level and
+  // image size: 128 x 60 pixels at 640 x 480, 128 x 30 at 320 x 240; measured in
+  // src/track/README.md, "Covariance (simulator)").
+  int cluster_width = 128, cluster_bands = 8;
 };
 
 // The pass on the device. Builds its program once; run() allocates nothing once the partials

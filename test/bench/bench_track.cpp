@@ -11,7 +11,8 @@
 //   bench_track nees [key=value...]         NEES of the covariances (alignment and frame-to-frame
 //       motion) and the lag-1 correlation of the errors per texture x configuration x size x
 //       finest level (seconds=5, seed=1, textures=..|all, configs=1,2,3, sizes=640x480,320x240,
-//       finest=0,1; noise=1 grey level; tracker: conv, huber, brightness=0|1, maxit=l0,l1,..);
+//       finest=0,1; noise=1 grey level; tracker: conv, huber, brightness=0|1, maxit=l0,l1,..,
+//       step_fraction, rho);
 //       BENCH_NEES_CSV=file also writes one row per frame tracked ok
 //   bench_track ecc [w h] [pairs] [levels]   OpenCV's findTransformECC (homography) against the
 //       tracker on the same frame pairs, ECC's homography reduced to planar motion (see bench_ecc)
@@ -835,6 +836,8 @@ int main(int argc, char** argv) {
       else if (k == "conv") topt.convergence_px = std::atof(v.c_str());
       else if (k == "huber") topt.huber_factor = std::atof(v.c_str());
       else if (k == "brightness") topt.estimate_brightness = std::atoi(v.c_str()) != 0;
+      else if (k == "step_fraction") topt.covariance_step_fraction = std::atof(v.c_str());
+      else if (k == "rho") topt.consecutive_alignment_correlation = std::atof(v.c_str());
       else if (k == "maxit") {
         const auto it = split(v);
         for (size_t l = 0; l < it.size() && l < topt.max_iterations.size(); ++l) topt.max_iterations[l] = std::atoi(it[l].c_str());
