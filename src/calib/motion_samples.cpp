@@ -10,8 +10,7 @@ void MotionSampler::add(const track::FrameResult& r, double t, const std::option
   if (sampled) {
     graph::MotionSample s;
     s.interval = t - previous_t_;
-    s.sensor.value = r.motion;
-    s.sensor.covariance = r.covariance;
+    s.sensor = r.motion;
     if (odometry_pose && previous_odometry_) {
       s.odometry = Motion{previous_odometry_->inverse() * *odometry_pose, Eigen::Matrix3d::Zero()};
     } else {

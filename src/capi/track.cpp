@@ -146,8 +146,8 @@ PLANARVO_API planarvo_status planarvo_tracker_track(planarvo_tracker* tracker, c
     out.struct_size = result->struct_size;
     out.status = to_c(r.status);
     out.reason = r.reason;
-    out.motion = planarvo::capi::to_c(r.motion);
-    planarvo::capi::matrix_to_c<3>(r.covariance, out.covariance);
+    out.motion = planarvo::capi::to_c(r.motion.value);
+    planarvo::capi::matrix_to_c<3>(r.motion.covariance, out.covariance);
     out.pose = planarvo::capi::to_c(tracker->tracker->pose());
     for (int i = 0; i < 8; ++i) out.iterations[i] = r.iterations[static_cast<size_t>(i)];
     out.levels_used = r.levels_used;

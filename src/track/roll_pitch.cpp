@@ -123,7 +123,7 @@ struct RollPitchEstimator::Impl {
       if (r.keyframe) restart_map();  // the chain of motions is broken here
       return finish_frame(t0);
     }
-    since_keyframe = since_keyframe * r.motion;
+    since_keyframe = since_keyframe * r.motion.value;
     if (!moved && (std::hypot(since_keyframe.x, since_keyframe.y) > kMovedTranslation ||
                    std::abs(since_keyframe.theta) > kMovedRotation))
       moved = true;

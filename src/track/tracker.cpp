@@ -230,7 +230,7 @@ struct Tracker::Impl {
     if (!independent.allFinite()) independent = lost_covariance();
     res->alignment_covariance = alignment_covariance(s, report.finest_stats[0], n, floor_s2);
     if (!res->alignment_covariance.allFinite()) res->alignment_covariance = lost_covariance();
-    res->covariance = res->alignment_covariance;
+    res->motion.covariance = res->alignment_covariance;
 
     const ReduceSums& st = report.finest_stats[0];
     const double var_ref = st.valid > 0 ? st.iref2 / st.valid - std::pow(st.iref / st.valid, 2) : 0.0;
@@ -316,7 +316,7 @@ struct Tracker::Impl {
   FrameResult track(const Pyramid& live, double t) {
     const auto t0 = std::chrono::steady_clock::now();
     FrameResult res;
-    res.covariance = lost_covariance();
+    res.motion.covariance = lost_covariance();
 
     // Time: the interval, gaps, and the constant-velocity prediction. A timestamp that is not
     // finite or not after the last one is not used (the usual interval is assumed).
@@ -348,8 +348,8 @@ struct Tracker::Impl {
     auto lost = [&](const char* why, bool can_be_keyframe) -> FrameResult {
       res.status = Status::Lost;
       res.reason = why;
-      res.motion = predicted;
-      res.covariance = res.alignment_covariance = lost_covariance();
+      res.motion.value = predicted;
+      res.motion.covariance = res.alignment_covariance = lost_covariance();
       pose = pose * predicted;
       if (can_be_keyframe) {
         make_keyframe(live);
@@ -420,12 +420,12 @@ struct Tracker::Impl {
     // Frame-to-frame motion from the keyframe-relative estimates, and its covariance: with
     // prev.T = P exp(xi_p) and est.T = E exp(xi_e), the motion is m exp(xi_e - Ad(m^-1) xi_p);
     // prev_covariance already holds xi_p's covariance less the part shared with xi_e.
-    res.motion = prev.T.inverse() * est.T;
-    const Eigen::Matrix3d ad = adjoint(res.motion.inverse());
-    res.covariance = res.alignment_covariance + ad * prev_covariance * ad.transpose();
-    if (!res.covariance.allFinite()) res.covariance = lost_covariance();
-    pose = pose * res.motion;
-    if (dt > 0.0) velocity = res.motion.log() / dt;
+    res.motion.value = prev.T.inverse() * est.T;
+    const Eigen::Matrix3d ad = adjoint(res.motion.value.inverse());
+    res.motion.covariance = res.alignment_covariance + ad * prev_covariance * ad.transpose();
+    if (!res.motion.covariance.allFinite()) res.motion.covariance = lost_covariance();
+    pose = pose * res.motion.value;
+    if (dt > 0.0) velocity = res.motion.value.log() / dt;
     since_good = 0.0;
     if (res.overlap < opt.keyframe_overlap) {
       make_keyframe(live);

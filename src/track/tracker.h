@@ -11,6 +11,7 @@
 #include <Eigen/Core>
 
 #include "core/extrinsics.h"
+#include "core/motion.h"
 #include "core/se2.h"
 #include "image/camera.h"
 #include "image/pyramid.h"
@@ -82,11 +83,10 @@ struct FrameResult {
   };
   Status status = Status::First;
   const char* reason = "";  // why Degraded or Lost ("" when Ok)
-  // Frame-to-frame motion: this frame's robot pose in the previous frame's robot frame
-  // (T_{k-1}^-1 T_k, conventions.md), metres and radians.
-  SE2 motion;
-  // Covariance of the right perturbation xi of the motion (motion = m̂ exp(xi)), (x, y) in
-  // metres, theta in radians. The motion is (T_kf^-1 T_{k-1})^-1 (T_kf^-1 T_k), its error
+  // Frame-to-frame motion (core::Motion, the type the graph calibrations take): value is this
+  // frame's robot pose in the previous frame's robot frame (T_{k-1}^-1 T_k, conventions.md),
+  // metres and radians; covariance that of the right perturbation xi in value·exp(xi), (x, y)
+  // in metres, theta in radians. The motion is (T_kf^-1 T_{k-1})^-1 (T_kf^-1 T_k), its error
   // xi_k - Ad(m̂^-1) xi_{k-1}: this frame's alignment covariance plus the previous frame's
   // carried through the adjoint, less their shared part, C_k + (1 - 2 rho) Ad C_{k-1} Ad^T
   // (TrackerOptions::consecutive_alignment_correlation; just C_k when the previous frame is
@@ -97,7 +97,7 @@ struct FrameResult {
   // alignment error, so their errors are negatively correlated (about -0.4). Large (1 m^2,
   // 1 rad^2 on the diagonal) when Lost or First, and for the first frame after a Lost one that
   // did not become the keyframe.
-  Eigen::Matrix3d covariance = Eigen::Matrix3d::Identity();
+  Motion motion{SE2(), Eigen::Matrix3d::Identity()};
   // Covariance of this frame's own alignment with the keyframe: the right perturbation of its
   // pose in the keyframe's robot frame (the estimate T_kf^-1 T_k), same units; brightness
   // marginalised (TrackerOptions::covariance_step_fraction says how it is made). Frames

@@ -227,24 +227,24 @@ SequenceReport run_sequence(ocl::Runtime& rt, const sim::Options& so, const trac
     rep.lost += r.status == track::FrameResult::Status::Lost;
     if (k == 0) continue;
     const SE2 t = traj.pose[k - 1].inverse() * traj.pose[k];
-    est.push_back(r.motion);
+    est.push_back(r.motion.value);
     truth.push_back(t);
     dts.push_back(traj.t[k] - traj.t[k - 1]);
-    const double e = std::hypot(r.motion.x - t.x, r.motion.y - t.y);
+    const double e = std::hypot(r.motion.value.x - t.x, r.motion.value.y - t.y);
     if (r.status == track::FrameResult::Status::Ok) {
-      std_pos.push_back(std::sqrt(std::max(r.covariance(0, 0), r.covariance(1, 1))));
-      std_head.push_back(std::sqrt(r.covariance(2, 2)));
-      const Eigen::Vector2d ev = Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(r.covariance.topLeftCorner<2, 2>()).eigenvalues();
+      std_pos.push_back(std::sqrt(std::max(r.motion.covariance(0, 0), r.motion.covariance(1, 1))));
+      std_head.push_back(std::sqrt(r.motion.covariance(2, 2)));
+      const Eigen::Vector2d ev = Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(r.motion.covariance.topLeftCorner<2, 2>()).eigenvalues();
       rep.aniso_max = std::max(rep.aniso_max, std::sqrt(ev(1) / ev(0)));
       // Normalised error of the motion with its covariance (`bench_track nees` has more).
-      const Eigen::Vector3d xi = (r.motion.inverse() * t).log();
-      nees += xi.dot(r.covariance.ldlt().solve(xi));
+      const Eigen::Vector3d xi = (r.motion.value.inverse() * t).log();
+      nees += xi.dot(r.motion.covariance.ldlt().solve(xi));
       ++nees_n;
     }
     if (verbose && (e > 1e-3 || r.status != track::FrameResult::Status::Ok))
       std::printf("  frame %zu: %s %s err %.3f mm, truth (%.4f %.4f %.4f) est (%.4f %.4f %.4f) overlap %.2f\n", k,
-                  track::status_name(r.status), r.reason, e * 1e3, t.x, t.y, t.theta, r.motion.x, r.motion.y,
-                  r.motion.theta, r.overlap);
+                  track::status_name(r.status), r.reason, e * 1e3, t.x, t.y, t.theta, r.motion.value.x, r.motion.value.y,
+                  r.motion.value.theta, r.overlap);
   }
   rep.acc = track::evaluate_motions(est, truth, dts);
   rep.std_pos_median = median(std_pos);
@@ -358,17 +358,17 @@ struct NeesRun {
       ++st.keyframes;
       return;
     }
-    const SE2 est_align = est_rel * r.motion;
+    const SE2 est_align = est_rel * r.motion.value;
     const bool ok = r.status == track::FrameResult::Status::Ok;
     if (ok) {
       ++st.ok;
       const Eigen::Vector3d xa = (est_align.inverse() * (kf_truth.inverse() * truth)).log();
-      const Eigen::Vector3d xm = (r.motion.inverse() * (truth_prev.inverse() * truth)).log();
+      const Eigen::Vector3d xm = (r.motion.value.inverse() * (truth_prev.inverse() * truth)).log();
       st.align.push_back(nees(xa, r.alignment_covariance));
-      st.motion.push_back(nees(xm, r.covariance));
+      st.motion.push_back(nees(xm, r.motion.covariance));
       if (csv) {
         const Eigen::Matrix3d& A = r.alignment_covariance;
-        const Eigen::Matrix3d& M = r.covariance;
+        const Eigen::Matrix3d& M = r.motion.covariance;
         std::fprintf(csv, "%s,%d,%d,%.4f,%.4f,%d", tag.c_str(), st.frames - 1, since_kf + 1, r.overlap, r.sigma,
                      r.iterations[static_cast<size_t>(std::max(0, tracker.options().finest_level))]);
         for (int i = 0; i < 3; ++i) std::fprintf(csv, ",%.6e", xa(i));
@@ -377,11 +377,11 @@ struct NeesRun {
         for (int i = 0; i < 3; ++i) std::fprintf(csv, ",%.6e", xm(i));
         for (int i = 0; i < 3; ++i)
           for (int j = i; j < 3; ++j) std::fprintf(csv, ",%.6e", M(i, j));
-        const SE2 m = r.motion;
+        const SE2 m = r.motion.value;
         std::fprintf(csv, ",%.6e,%.6e,%.6e,%d\n", m.x, m.y, m.theta, r.keyframe ? 1 : 0);
       }
       if (prev_kf) st.motion_kf.push_back(st.motion.back());
-      const Eigen::Vector3d za = normalised(xa, r.alignment_covariance), zm = normalised(xm, r.covariance);
+      const Eigen::Vector3d za = normalised(xa, r.alignment_covariance), zm = normalised(xm, r.motion.covariance);
       if (prev_ok) {
         st.zm_prev.push_back(prev_zm);
         st.zm_cur.push_back(zm);
@@ -708,7 +708,7 @@ int bench_ecc(int width, int height, int pairs, int levels, int stride) {
       const track::FrameResult r = tracker.track(frames[k + 1].data, width, height, frames[k + 1].step, traj.t[k + 1]);
       const double ms = now_ms() - t0;
       if (r.status == track::FrameResult::Status::Lost) { ++st.fail; continue; }
-      st.add(r.motion, truth_of(k), ms);
+      st.add(r.motion.value, truth_of(k), ms);
     }
     st.print("planarvo, pair fresh (reset, k, k+1)");
   }
@@ -723,7 +723,7 @@ int bench_ecc(int width, int height, int pairs, int levels, int stride) {
     for (size_t k : ks) {
       const track::FrameResult& r = res[k + 1];
       if (r.status == track::FrameResult::Status::Lost) { ++st.fail; continue; }
-      st.add(r.motion, truth_of(k), r.ms);
+      st.add(r.motion.value, truth_of(k), r.ms);
     }
     st.print("planarvo, sequence (frame-to-frame motion)");
   }

@@ -54,18 +54,18 @@ void track_sequence(ocl::Runtime& rt, const std::string& texture, uint64_t seed,
       continue;
     }
     ASSERT_EQ(r.status, FrameResult::Status::Ok) << "frame " << k << ": " << r.reason;
-    const SE2 relative = previous_relative * r.motion;
+    const SE2 relative = previous_relative * r.motion.value;
     // Right perturbations: truth = estimate exp(xi).
-    const Eigen::Vector3d xm = (r.motion.inverse() * (traj.pose[k - 1].inverse() * traj.pose[k])).log();
+    const Eigen::Vector3d xm = (r.motion.value.inverse() * (traj.pose[k - 1].inverse() * traj.pose[k])).log();
     const Eigen::Vector3d xa = (relative.inverse() * (keyframe_truth.inverse() * traj.pose[k])).log();
-    seq.motion += nees(xm, r.covariance);
+    seq.motion += nees(xm, r.motion.covariance);
     seq.alignment += nees(xa, r.alignment_covariance);
     ++seq.n;
     // The motion's covariance is the alignment's right after a keyframe, more otherwise.
     if (previous_is_keyframe) {
-      EXPECT_EQ(r.covariance, r.alignment_covariance) << "frame " << k;
+      EXPECT_EQ(r.motion.covariance, r.alignment_covariance) << "frame " << k;
     } else {
-      const Eigen::Matrix3d extra = r.covariance - r.alignment_covariance;
+      const Eigen::Matrix3d extra = r.motion.covariance - r.alignment_covariance;
       EXPECT_GT(Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(extra).eigenvalues().minCoeff(), 0.0) << "frame " << k;
     }
     previous_is_keyframe = r.keyframe;

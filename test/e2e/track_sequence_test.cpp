@@ -42,7 +42,7 @@ TEST(TrackSequence, SimulatedDataSetIsTrackedAccurately) {
       continue;
     }
     ok += r.status == FrameResult::Status::Ok;
-    est.push_back(r.motion);
+    est.push_back(r.motion.value);
     truth.push_back(ds.groundtruth_at(i - 1)->inverse() * *ds.groundtruth_at(i));
     dts.push_back(ds.timestamp(i) - ds.timestamp(i - 1));
   }

@@ -45,8 +45,8 @@ class TrackBadInput : public ::testing::Test {
 
   FrameResult track(const Pyramid& p, double t) {
     const FrameResult r = tracker_->track(p, t);
-    EXPECT_TRUE(std::isfinite(r.motion.x) && std::isfinite(r.motion.y) && std::isfinite(r.motion.theta));
-    EXPECT_TRUE(r.covariance.allFinite());
+    EXPECT_TRUE(std::isfinite(r.motion.value.x) && std::isfinite(r.motion.value.y) && std::isfinite(r.motion.value.theta));
+    EXPECT_TRUE(r.motion.covariance.allFinite());
     EXPECT_TRUE(std::isfinite(tracker_->pose().x) && std::isfinite(tracker_->pose().theta));
     if (r.status == Status::Lost || r.status == Status::Degraded) {
       EXPECT_STRNE(r.reason, "");
@@ -81,8 +81,8 @@ TEST_F(TrackBadInput, BlackAndSaturatedFramesAreLostThenTrackingResumes) {
   EXPECT_STATUS(black, Lost);
   EXPECT_FALSE(black.keyframe);
   const SE2 step = truth(3 * dt).inverse() * truth(4 * dt);
-  EXPECT_NEAR(black.motion.x, step.x, 1e-4);
-  EXPECT_NEAR(black.motion.theta, step.theta, 1e-3);
+  EXPECT_NEAR(black.motion.value.x, step.x, 1e-4);
+  EXPECT_NEAR(black.motion.value.theta, step.theta, 1e-3);
   // The next good frame is tracked against the keyframe: the pose is right again.
   EXPECT_STATUS(track(good(5 * dt), 5 * dt), Ok);
   EXPECT_LT(pose_error_mm(0, 5 * dt), 0.05);
@@ -127,7 +127,7 @@ TEST_F(TrackBadInput, ShortGapIsDegradedButTracked) {
   const FrameResult r = track(good(8 * dt), 8 * dt);
   EXPECT_STATUS(r, Degraded);
   const SE2 step = truth(2 * dt).inverse() * truth(8 * dt);
-  EXPECT_LT(1e3 * std::hypot(r.motion.x - step.x, r.motion.y - step.y), 0.05);
+  EXPECT_LT(1e3 * std::hypot(r.motion.value.x - step.x, r.motion.value.y - step.y), 0.05);
   EXPECT_STATUS(track(good(9 * dt), 9 * dt), Ok);
   EXPECT_LT(pose_error_mm(0, 9 * dt), 0.05);
 }
@@ -140,12 +140,12 @@ TEST_F(TrackBadInput, LongGapIsLostThenTheFrameIsTheNewKeyframe) {
   const FrameResult r = track(good(3.0), 3.0);
   EXPECT_STATUS(r, Lost);
   EXPECT_TRUE(r.keyframe);
-  EXPECT_EQ(r.motion.x, 0.0);
-  EXPECT_EQ(r.motion.theta, 0.0);
+  EXPECT_EQ(r.motion.value.x, 0.0);
+  EXPECT_EQ(r.motion.value.theta, 0.0);
   const FrameResult next = track(good(3.0 + dt), 3.0 + dt);
   EXPECT_STATUS(next, Ok);
   const SE2 step = truth(3.0).inverse() * truth(3.0 + dt);
-  EXPECT_LT(1e3 * std::hypot(next.motion.x - step.x, next.motion.y - step.y), 0.02);
+  EXPECT_LT(1e3 * std::hypot(next.motion.value.x - step.x, next.motion.value.y - step.y), 0.02);
 }
 
 TEST_F(TrackBadInput, BadTimestampsAreDegradedNotNaN) {
@@ -213,14 +213,14 @@ TEST(TrackWeakTexture, StripesLeaveTheMotionAlongThemUnconstrained) {
   tr.track(frame(a), 0.0);
   const FrameResult r = tr.track(frame(a * m), dt);
   std::printf("status %s (%s), motion %.5f %.5f %.5f, std x %.3g m, y %.3g m, theta %.3g rad\n",
-              status_name(r.status), r.reason, r.motion.x, r.motion.y, r.motion.theta,
-              std::sqrt(r.covariance(0, 0)), std::sqrt(r.covariance(1, 1)), std::sqrt(r.covariance(2, 2)));
+              status_name(r.status), r.reason, r.motion.value.x, r.motion.value.y, r.motion.value.theta,
+              std::sqrt(r.motion.covariance(0, 0)), std::sqrt(r.motion.covariance(1, 1)), std::sqrt(r.motion.covariance(2, 2)));
   EXPECT_STATUS(r, Degraded);
   EXPECT_STREQ(r.reason, "motion poorly constrained");
   // Forward (x, along the stripes) is free, sideways and the heading are not.
-  EXPECT_GT(r.covariance(0, 0), 100 * r.covariance(1, 1));
-  EXPECT_LT(std::abs(r.motion.y - m.y), 1e-4);
-  EXPECT_LT(std::abs(r.motion.theta - m.theta), 1e-3);
+  EXPECT_GT(r.motion.covariance(0, 0), 100 * r.motion.covariance(1, 1));
+  EXPECT_LT(std::abs(r.motion.value.y - m.y), 1e-4);
+  EXPECT_LT(std::abs(r.motion.value.theta - m.theta), 1e-3);
 }
 
 TEST_F(TrackBadInput, ResetStartsOver) {

@@ -68,8 +68,8 @@ TEST_F(TrackEsm, RecoversASmallMotionOnNoiseFreeRenders) {
       ASSERT_EQ(r0.status, FrameResult::Status::First);
       const FrameResult r1 = tr.track(pyramid_at(b, 4), 1.0 / 30);
       EXPECT_EQ(r1.status, FrameResult::Status::Ok) << r1.reason;
-      const double et = std::hypot(r1.motion.x - m.x, r1.motion.y - m.y);
-      const double er = std::abs(wrap_angle(r1.motion.theta - m.theta));
+      const double et = std::hypot(r1.motion.value.x - m.x, r1.motion.value.y - m.y);
+      const double er = std::abs(wrap_angle(r1.motion.value.theta - m.theta));
       std::printf("motion (%.4f %.4f %.4f), finest level %d: error %.5f mm %.6f deg, passes %d %d %d %d\n", m.x, m.y,
                   m.theta, finest, et * 1e3, er / kDeg, r1.iterations[3], r1.iterations[2], r1.iterations[1],
                   r1.iterations[0]);
@@ -103,9 +103,9 @@ TEST_F(TrackEsm, TheTrackerReportsTheAlignersResult) {
     const AlignmentReport rep = aligner.align(pairs, &e, aligner.levels(ref, live));
     ASSERT_TRUE(rep.ok);
     EXPECT_EQ(pairs.data(), storage);
-    EXPECT_EQ(r.motion.x, pairs[0].motion.x) << m.x;
-    EXPECT_EQ(r.motion.y, pairs[0].motion.y) << m.x;
-    EXPECT_EQ(r.motion.theta, pairs[0].motion.theta) << m.x;
+    EXPECT_EQ(r.motion.value.x, pairs[0].motion.x) << m.x;
+    EXPECT_EQ(r.motion.value.y, pairs[0].motion.y) << m.x;
+    EXPECT_EQ(r.motion.value.theta, pairs[0].motion.theta) << m.x;
   }
 }
 
@@ -126,8 +126,8 @@ TEST_F(TrackEsm, RecoversMotionWithNoiseGainAndDistortion) {
     tr.track(frame(a, 1.0, 0.0, 1), 0.0);
     r[i] = tr.track(frame(a * m, i ? 1.04 : 1.0, i ? 3.0 : 0.0, 2), 1.0 / 30);
     EXPECT_EQ(r[i].status, FrameResult::Status::Ok) << r[i].reason;
-    const double et = std::hypot(r[i].motion.x - m.x, r[i].motion.y - m.y);
-    const double er = std::abs(wrap_angle(r[i].motion.theta - m.theta));
+    const double et = std::hypot(r[i].motion.value.x - m.x, r[i].motion.value.y - m.y);
+    const double er = std::abs(wrap_angle(r[i].motion.value.theta - m.theta));
     std::printf("error %.5f mm %.6f deg, log gain %.4f, bias %.2f, sigma %.2f\n", et * 1e3, er / kDeg, r[i].log_gain,
                 r[i].bias, r[i].sigma);
     EXPECT_LT(et, 0.02e-3);
@@ -140,10 +140,10 @@ TEST_F(TrackEsm, RecoversMotionWithNoiseGainAndDistortion) {
   EXPECT_NEAR(r[1].log_gain - r[0].log_gain, -std::log(1.04), 0.002);
   EXPECT_NEAR(r[1].bias, r[0].bias - 3.0 * std::exp(r[1].log_gain), 0.3);
   // The covariance is positive definite and of a plausible size (micrometres, microradians).
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(r[1].covariance);
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(r[1].motion.covariance);
   EXPECT_GT(eig.eigenvalues().minCoeff(), 0.0);
-  EXPECT_LT(std::sqrt(r[1].covariance(0, 0)), 1e-5);
-  EXPECT_LT(std::sqrt(r[1].covariance(2, 2)), 1e-4);
+  EXPECT_LT(std::sqrt(r[1].motion.covariance(0, 0)), 1e-5);
+  EXPECT_LT(std::sqrt(r[1].motion.covariance(2, 2)), 1e-4);
 }
 
 // A smooth analytic ground image (frequencies below 0.12 rad per pixel, so that bilinear
