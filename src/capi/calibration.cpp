@@ -119,7 +119,8 @@ planarvo::calib::PipelineOptions pipeline_options_from_c(const planarvo_camera_c
     planarvo::capi::require_struct_size(options->struct_size, kCameraOptionsEnd, "planarvo_camera_calibration_options");
     o = planarvo::capi::read_versioned(*options, o);
   }
-  require(o.method == PLANARVO_CALIBRATE_ODOMETRY || o.method == PLANARVO_CALIBRATE_NONHOLONOMIC,
+  const int method = planarvo::capi::enum_value(o.method);
+  require(method == PLANARVO_CALIBRATE_ODOMETRY || method == PLANARVO_CALIBRATE_NONHOLONOMIC,
           "planarvo_camera_calibration_options.method is not a planarvo_calibration_method");
   require(std::isfinite(o.height) && o.height >= 0, "planarvo_camera_calibration_options.height must be >= 0");
   require(o.method == PLANARVO_CALIBRATE_ODOMETRY || o.height > 0,
@@ -222,7 +223,8 @@ PLANARVO_API planarvo_status planarvo_roll_pitch_add_frame(planarvo_roll_pitch* 
     require(estimator != nullptr && image != nullptr, "planarvo_roll_pitch_add_frame: NULL argument");
     require(image->data != nullptr && image->width > 0 && image->height > 0,
             "planarvo_roll_pitch_add_frame: the image has no pixels");
-    require(image->format >= PLANARVO_GRAY8 && image->format <= PLANARVO_GRAY32F,
+    require(planarvo::capi::enum_value(image->format) >= PLANARVO_GRAY8 &&
+                planarvo::capi::enum_value(image->format) <= PLANARVO_GRAY32F,
             "planarvo_roll_pitch_add_frame: unknown pixel format");
     size_t stride = 0;
     const uint8_t* grey = planarvo::capi::grey_view(*image, estimator->grey, &stride);
@@ -302,7 +304,8 @@ PLANARVO_API planarvo_status planarvo_camera_calibrator_add_frame(planarvo_camer
     require(!calibrator->finished, "planarvo_camera_calibrator_add_frame: the calibrator has finished");
     require(image->data != nullptr && image->width > 0 && image->height > 0,
             "planarvo_camera_calibrator_add_frame: the image has no pixels");
-    require(image->format >= PLANARVO_GRAY8 && image->format <= PLANARVO_GRAY32F,
+    require(planarvo::capi::enum_value(image->format) >= PLANARVO_GRAY8 &&
+                planarvo::capi::enum_value(image->format) <= PLANARVO_GRAY32F,
             "planarvo_camera_calibrator_add_frame: unknown pixel format");
     require(std::isfinite(timestamp), "planarvo_camera_calibrator_add_frame: timestamp is not finite");
     require(!direction || (*direction >= -1 && *direction <= 1),

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cstring>
 #include <string>
+#include <type_traits>
 
 #include <Eigen/Core>
 
@@ -14,6 +15,16 @@
 #include "planarvo/planarvo.h"
 
 namespace planarvo::capi {
+
+// The integer a caller stored in a C enum field. A value outside the enum's constants may not be
+// read as the enum itself in C++ (undefined behaviour, which UBSan reports), so its bytes are
+// read as the underlying integer: check the result against the constants, then convert.
+template <class E>
+int enum_value(const E& e) {
+  std::underlying_type_t<E> v;
+  std::memcpy(&v, &e, sizeof v);
+  return static_cast<int>(v);
+}
 
 // Copies src into a fixed-size C string field, truncating and always terminating.
 inline void copy_string(char* dst, size_t capacity, const std::string& src) {

@@ -59,8 +59,8 @@ planarvo_robust_loss to_c(planarvo::graph::RobustLoss l) {
   }
   return PLANARVO_ROBUST_LOSS_CAUCHY;
 }
-planarvo::graph::RobustLoss to_cpp(planarvo_robust_loss l) {
-  switch (l) {
+planarvo::graph::RobustLoss to_cpp(const planarvo_robust_loss& loss) {
+  switch (planarvo::capi::enum_value(loss)) {
     case PLANARVO_ROBUST_LOSS_NONE: return planarvo::graph::RobustLoss::None;
     case PLANARVO_ROBUST_LOSS_HUBER: return planarvo::graph::RobustLoss::Huber;
     case PLANARVO_ROBUST_LOSS_CAUCHY: return planarvo::graph::RobustLoss::Cauchy;
@@ -167,7 +167,8 @@ planarvo::graph::CalibrationOptions calibration_options_from_c(const planarvo_ca
                                         "planarvo_calibration_options");
     o = planarvo::capi::read_versioned(*options, o);
   }
-  require(o.method == PLANARVO_CALIBRATE_ODOMETRY || o.method == PLANARVO_CALIBRATE_NONHOLONOMIC,
+  const int method = planarvo::capi::enum_value(o.method);
+  require(method == PLANARVO_CALIBRATE_ODOMETRY || method == PLANARVO_CALIBRATE_NONHOLONOMIC,
           "planarvo_calibration_options.method is not a planarvo_calibration_method");
   require(o.max_iterations > 0, "planarvo_calibration_options.max_iterations must be positive");
   require(!o.fix_scale || (std::isfinite(o.fixed_scale) && o.fixed_scale > 0),
@@ -247,7 +248,8 @@ PLANARVO_API planarvo_status planarvo_posegraph_optimize(const char* in_path, co
       o = planarvo::capi::read_versioned(*options, o);
     }
     require(o.max_iterations > 0, "planarvo_posegraph_options.max_iterations must be positive");
-    require(o.init == PLANARVO_POSEGRAPH_INIT_NONE || o.init == PLANARVO_POSEGRAPH_INIT_ROTATION_FIRST,
+    const int init = planarvo::capi::enum_value(o.init);
+    require(init == PLANARVO_POSEGRAPH_INIT_NONE || init == PLANARVO_POSEGRAPH_INIT_ROTATION_FIRST,
             "planarvo_posegraph_options.init is not a planarvo_posegraph_init");
     planarvo::graph::G2oFile file = planarvo::graph::read_g2o(in_path);
     if (file.vertices.empty()) planarvo::throw_invalid_input(std::string(in_path) + ": no VERTEX_SE2 lines");

@@ -63,7 +63,7 @@ PLANARVO_API planarvo_status planarvo_simulate(planarvo_context* context, const 
     s.seconds = o->seconds;
     s.fps = o->fps;
     s.seed = o->seed;
-    switch (o->motion) {
+    switch (planarvo::capi::enum_value(o->motion)) {
       case PLANARVO_MOTION_MIXED: s.motion = planarvo::sim::MotionProfile::Mixed; break;
       case PLANARVO_MOTION_STRAIGHT: s.motion = planarvo::sim::MotionProfile::Straight; break;
       case PLANARVO_MOTION_CIRCLE: s.motion = planarvo::sim::MotionProfile::Circle; break;

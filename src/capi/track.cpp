@@ -132,7 +132,8 @@ PLANARVO_API planarvo_status planarvo_tracker_track(planarvo_tracker* tracker, c
                                         "planarvo_track_result");
     require(image->data != nullptr && image->width > 0 && image->height > 0,
             "planarvo_tracker_track: the image has no pixels");
-    require(image->format >= PLANARVO_GRAY8 && image->format <= PLANARVO_GRAY32F,
+    require(planarvo::capi::enum_value(image->format) >= PLANARVO_GRAY8 &&
+                planarvo::capi::enum_value(image->format) <= PLANARVO_GRAY32F,
             "planarvo_tracker_track: unknown pixel format");
     const size_t bpp = image->format == PLANARVO_GRAY8 ? 1 : image->format == PLANARVO_GRAY32F ? 4 : 3;
     require(image->stride >= bpp * static_cast<size_t>(image->width), "planarvo_tracker_track: stride < row size");
