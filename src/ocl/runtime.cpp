@@ -432,7 +432,8 @@ cl::Program Runtime::load_from_binaries(const std::string& name, const std::stri
     throw_invalid_input("mismatched binary for " + name + " with options " + quote(options) +
                         " in " + where + ": built for " + built_for + ", this device is " +
                         quote(info_.device_name) + " (driver " + info_.driver_version +
-                        "); export the binaries on this device and driver");
+                        "); export the binaries on this device and driver (`planarvo kernels " +
+                        "--export " + dir + "` adds them beside the others)");
   }
 
   const fs::path file = fs::path(dir) / entry->file;

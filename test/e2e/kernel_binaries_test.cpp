@@ -240,5 +240,22 @@ TEST_F(KernelBinaries, ExportForTrackIsASubsetThatSufficesForTrack) {
   EXPECT_NE(r.output.find("--for calibrate`"), std::string::npos) << r.output;
 }
 
+// --for names commands; commands that run no kernels, unknown names, and an export that would
+// load binaries instead of building them are usage errors, caught before any device work.
+TEST(KernelExport, UsageErrorsExitWith2) {
+  test::ScratchDir d;
+  const std::string dir = (d / "k").string();
+  auto r = run_cli("kernels --export " + dir + " --for posegraph");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("runs no kernels"), std::string::npos) << r.output;
+  r = run_cli("kernels --export " + dir + " --for track,flying");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("\"flying\""), std::string::npos) << r.output;
+  r = run_cli("kernels --export " + dir + " --kernel-binaries " + dir);
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("--kernel-binaries"), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(dir));
+}
+
 }  // namespace
 }  // namespace planarvo
