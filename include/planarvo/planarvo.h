@@ -180,7 +180,12 @@ typedef struct planarvo_context_options {
   const char* cache_dir;
   int32_t disable_cache; /* non-zero: always compile from source */
   /* Directory of prebuilt program binaries (planarvo_context_export_kernels). When set, the
-   * engine loads those and never compiles: what FPGA runtimes need. */
+   * engine loads those and never compiles a kernel, not even as a fallback: what FPGA and DSP
+   * runtimes need. A call that needs a program the directory lacks (no manifest, no line for
+   * the program and its build options, a binary for another device or driver, a missing file)
+   * fails with PLANARVO_ERROR_INVALID_INPUT, and a binary the driver rejects with
+   * PLANARVO_ERROR_OPENCL; the message names the program, its build options, the device, the
+   * directory, what needs the program and how to export it. The cache options are then unused. */
   const char* kernel_binaries_dir;
 } planarvo_context_options;
 
@@ -195,10 +200,26 @@ PLANARVO_API planarvo_status planarvo_context_create(const planarvo_context_opti
 PLANARVO_API void planarvo_context_destroy(planarvo_context* context);
 PLANARVO_API planarvo_status planarvo_context_device(const planarvo_context* context,
                                                      planarvo_device_info* info);
-/* Builds every kernel program for the context's device and writes the binaries into dir (created
- * if missing), for later use with kernel_binaries_dir. */
+/* Builds every kernel program variant that the library's calls use with their default options
+ * for the context's device and writes the binaries into dir (created if missing), with the
+ * manifest planarvo-kernels.txt, for later use with kernel_binaries_dir. Lines of the manifest
+ * for other devices are kept, so one directory can serve several devices. No option of
+ * planarvo_tracker_options, planarvo_roll_pitch_options or the calibration options changes how
+ * kernels are built, so these binaries serve every setting of them. */
 PLANARVO_API planarvo_status planarvo_context_export_kernels(planarvo_context* context,
                                                              const char* dir);
+/* As planarvo_context_export_kernels, but only the variants that the named uses need, a
+ * comma-separated list of:
+ *   "track"     the tracker (planarvo_tracker_*, planarvo_track_motions);
+ *   "calibrate" the camera calibration (planarvo_calibrate_dataset, planarvo_camera_calibrator_*,
+ *               planarvo_roll_pitch_*): roll and pitch, then the tracker;
+ *   "simulate"  the simulator (planarvo_simulate).
+ * uses NULL or "" exports everything, as planarvo_context_export_kernels does; an unknown name
+ * is PLANARVO_ERROR_INVALID_ARGUMENT. exported, when not NULL, receives the number of binaries
+ * written. */
+PLANARVO_API planarvo_status planarvo_context_export_kernels_for(planarvo_context* context,
+                                                                 const char* dir, const char* uses,
+                                                                 size_t* exported);
 /* Builds (or loads) every kernel program now, so that the first frame does not pay for it. */
 PLANARVO_API planarvo_status planarvo_context_prepare_kernels(planarvo_context* context);
 

@@ -2,10 +2,12 @@
 #include <cstring>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "capi/convert.h"
 #include "capi/handles.h"
 #include "capi/status.h"
+#include "core/error.h"
 #include "ocl/runtime.h"
 
 using planarvo::capi::guard;
@@ -105,6 +107,30 @@ PLANARVO_API planarvo_status planarvo_context_export_kernels(planarvo_context* c
     require(context != nullptr, "planarvo_context_export_kernels: context is NULL");
     require(dir != nullptr && *dir, "planarvo_context_export_kernels: dir is NULL or empty");
     context->runtime->export_binaries(dir);
+  });
+}
+
+PLANARVO_API planarvo_status planarvo_context_export_kernels_for(planarvo_context* context,
+                                                                 const char* dir, const char* uses,
+                                                                 size_t* exported) {
+  return guard([&] {
+    require(context != nullptr, "planarvo_context_export_kernels_for: context is NULL");
+    require(dir != nullptr && *dir, "planarvo_context_export_kernels_for: dir is NULL or empty");
+    std::vector<std::string> names;
+    for (const char* p = uses ? uses : ""; *p;) {
+      const char* end = std::strchr(p, ',');
+      if (!end) end = p + std::strlen(p);
+      std::string name(p, end);
+      name.erase(0, name.find_first_not_of(' '));
+      name.erase(name.find_last_not_of(' ') + 1);
+      if (name.empty())
+        planarvo::throw_invalid_argument("planarvo_context_export_kernels_for: an empty name in uses \"" +
+                                         std::string(uses) + "\"");
+      names.push_back(name);
+      p = *end ? end + 1 : end;
+    }
+    const size_t n = context->runtime->export_binaries(dir, names);
+    if (exported) *exported = n;
   });
 }
 

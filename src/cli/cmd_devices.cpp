@@ -16,6 +16,36 @@ std::string bytes(uint64_t b) {
   return buf;
 }
 
+// What `--for COMMAND,...` asks the C API to export: the uses each command runs (demo runs
+// all three). Commands without a device need no kernels.
+std::string uses_of_commands(const std::string& list) {
+  std::string uses;
+  const auto add = [&](const char* u) {
+    if (("," + uses + ",").find(std::string(",") + u + ",") == std::string::npos)
+      uses += (uses.empty() ? "" : ",") + std::string(u);
+  };
+  size_t start = 0;
+  for (;;) {
+    const size_t comma = list.find(',', start);
+    const std::string cmd = list.substr(start, comma == std::string::npos ? comma : comma - start);
+    if (cmd == "track" || cmd == "calibrate" || cmd == "simulate") {
+      add(cmd.c_str());
+    } else if (cmd == "demo") {
+      add("simulate");
+      add("track");
+      add("calibrate");
+    } else if (cmd == "info" || cmd == "posegraph" || cmd == "devices" || cmd == "kernels") {
+      throw UsageError("--for " + cmd + ": " + cmd + " runs no kernels, so it needs no binaries");
+    } else {
+      throw UsageError("--for: \"" + cmd + "\" is not a command that runs kernels (track, calibrate, "
+                       "simulate, demo; several separated by commas)");
+    }
+    if (comma == std::string::npos) break;
+    start = comma + 1;
+  }
+  return uses;
+}
+
 }  // namespace
 
 int cmd_devices(int argc, char** argv) {
@@ -51,23 +81,36 @@ int cmd_devices(int argc, char** argv) {
 
 int cmd_kernels(int argc, char** argv) {
   std::vector<OptionSpec> specs = {
-      {"export", "DIR", "build every kernel program for the device and write the binaries to DIR", ""},
+      {"export", "DIR", "build the kernel programs for the device and write the binaries to DIR", ""},
+      {"for", "COMMAND", "only what COMMAND needs: track, calibrate, simulate or demo (several separated by "
+                         "commas)", "every command"},
       {"help", "", "show this help", ""}};
   for (auto& s : device_options()) specs.push_back(s);
   Args args(specs, argc, argv, 1);
   if (args.has("help") || !args.has("export")) {
-    std::printf("usage: planarvo kernels --export DIR [--device SEL]\n\n"
+    std::printf("usage: planarvo kernels --export DIR [--for COMMAND] [--device SEL]\n\n"
                 "Writes prebuilt program binaries for the selected device into DIR, with a manifest\n"
-                "(planarvo-kernels.txt). Pass DIR to --kernel-binaries (or the C API's\n"
-                "kernel_binaries_dir) to run without compiling kernels, as FPGA runtimes require.\n\n%s",
+                "(planarvo-kernels.txt) whose last field says which commands need each binary. By\n"
+                "default every kernel variant that any command uses; --for narrows it to what the\n"
+                "named commands need (calibrate --motions, posegraph and info need none). No option\n"
+                "of track or calibrate changes how kernels are built, so one export serves them all.\n"
+                "Pass DIR to --kernel-binaries (or the C API's kernel_binaries_dir) to run without\n"
+                "compiling kernels, as FPGA and DSP runtimes require. Exporting again on another\n"
+                "device adds its binaries to the same DIR.\n\n%s",
                 format_options(specs).c_str());
     return args.has("help") ? kExitOk : kExitUsage;
   }
   if (!args.positionals().empty()) throw UsageError("unexpected argument " + args.positionals()[0]);
+  if (args.has("kernel-binaries"))
+    throw UsageError("kernels --export builds the binaries, so it cannot load them: leave out --kernel-binaries");
+  const std::string uses = args.has("for") ? uses_of_commands(args.get("for")) : std::string();
   ContextPtr ctx = make_context(args);
   const std::string dir = args.get("export");
-  check(planarvo_context_export_kernels(ctx.get(), dir.c_str()));
-  std::printf("wrote kernel binaries for %s to %s\n", device_name(ctx.get()).c_str(), dir.c_str());
+  size_t n = 0;
+  check(planarvo_context_export_kernels_for(ctx.get(), dir.c_str(), uses.c_str(), &n));
+  std::printf("wrote %zu kernel binaries%s for %s to %s\n", n,
+              uses.empty() ? "" : (" (for " + args.get("for") + ")").c_str(), device_name(ctx.get()).c_str(),
+              dir.c_str());
   return kExitOk;
 }
 

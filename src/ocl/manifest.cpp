@@ -52,11 +52,11 @@ std::vector<ManifestEntry> parse_manifest(const std::string& text, const std::st
 
     const auto where = [&] { return path + ":" + std::to_string(line_no) + ": "; };
     std::vector<std::string> f = split_tabs(line);
-    // A hand-written line without options may end in a TAB that an editor kept.
-    if (f.size() == 6 && f[5].empty()) f.pop_back();
-    if (f.size() != 5 && f.size() != 6)
-      throw_invalid_input(where() + "expected 5 or 6 TAB-separated fields (program, options " +
-                          "hash, file, device, driver, options), found " +
+    // A hand-written line may end in a TAB that an editor kept.
+    if (f.size() >= 6 && f.back().empty()) f.pop_back();
+    if (f.size() < 5 || f.size() > 7)
+      throw_invalid_input(where() + "expected 5 to 7 TAB-separated fields (program, options " +
+                          "hash, file, device, driver, options, for), found " +
                           std::to_string(f.size()) + " (are the fields separated by TABs?)");
     ManifestEntry e;
     e.program = f[0];
@@ -64,7 +64,8 @@ std::vector<ManifestEntry> parse_manifest(const std::string& text, const std::st
     e.file = f[2];
     e.device = f[3];
     e.driver = f[4];
-    e.options = normalize_build_options(f.size() == 6 ? f[5] : std::string());
+    e.options = normalize_build_options(f.size() >= 6 ? f[5] : std::string());
+    e.uses = f.size() == 7 ? f[6] : std::string();
     e.line = line_no;
     if (e.program.empty() || e.file.empty() || e.device.empty() || e.driver.empty())
       throw_invalid_input(where() + "program, file, device and driver must not be empty (use * " +
@@ -80,13 +81,15 @@ std::vector<ManifestEntry> parse_manifest(const std::string& text, const std::st
 
 std::string format_manifest(const std::vector<ManifestEntry>& entries) {
   std::string out =
-      "# planarvo kernel binaries manifest, format 1 (see src/ocl/README.md).\n"
+      "# planarvo kernel binaries manifest, format 2 (see src/ocl/README.md).\n"
       "# One binary per line, TAB-separated: program, options-hash (FNV-1a 64 of the options,\n"
       "# or - to skip the check), file (relative to this directory), device (CL_DEVICE_NAME or\n"
-      "# *), driver (CL_DRIVER_VERSION or *), options (normalised build options; may be absent).\n";
+      "# *), driver (CL_DRIVER_VERSION or *), options (normalised build options; may be absent),\n"
+      "# for (the commands that need it, comma-separated; may be absent).\n";
   for (const ManifestEntry& e : entries) {
     out += e.program + '\t' + e.options_hash + '\t' + e.file + '\t' + e.device + '\t' + e.driver;
-    if (!e.options.empty()) out += '\t' + e.options;
+    if (!e.options.empty() || !e.uses.empty()) out += '\t' + e.options;
+    if (!e.uses.empty()) out += '\t' + e.uses;
     out += '\n';
   }
   return out;

@@ -2,10 +2,10 @@
 // which options, for which device. Internal to src/ocl; README.md repeats the format for users.
 //
 // <dir>/planarvo-kernels.txt is UTF-8 text. Lines that are blank or whose first non-blank
-// character is '#' are comments. Every other line describes one binary in 5 or 6 fields
+// character is '#' are comments. Every other line describes one binary in 5, 6 or 7 fields
 // separated by TAB characters (spaces around a field are ignored):
 //
-//   program  options-hash  file  device  driver  [options]
+//   program  options-hash  file  device  driver  [options  [for]]
 //
 //   program       the program's name: kernels/<program>.cl, e.g. "fill"
 //   options-hash  FNV-1a 64 of the normalised options, as 16 lowercase hex digits; "-" skips
@@ -17,6 +17,11 @@
 //   options       the build options as given to Runtime::program(), normalised
 //                 (normalize_build_options): trimmed, whitespace runs outside double quotes
 //                 turned into one space; an absent sixth field means "" (no options)
+//   for           what needs the binary: the uses it is registered for
+//                 (Runtime::register_build_options), comma-separated, e.g. "calibrate,track";
+//                 absent or empty when unknown. Informative only: lookups never read it.
+//                 Manifests of format 1 (before this field) have 5 or 6 fields and stay valid;
+//                 a line with this field and no options has an empty sixth field.
 //
 // A program is looked up by (program, normalised options); among its lines, the first whose
 // device and driver match the running device is used. Lines for other devices may share one
@@ -34,6 +39,7 @@ struct ManifestEntry {
   std::string device;        // or "*"
   std::string driver;        // or "*"
   std::string options;       // normalised
+  std::string uses;          // the "for" field: comma-separated uses, "" when unknown
   int line = 0;              // 1-based line in the manifest, for messages
 };
 

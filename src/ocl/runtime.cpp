@@ -122,10 +122,11 @@ std::pair<int, int> opencl_c_version(const std::string& s) {
   return {major, minor};
 }
 
-// The process-wide registry behind Runtime::register_build_options().
+// The process-wide registry behind Runtime::register_build_options(): program -> normalised
+// options -> the uses that need that variant.
 struct OptionRegistry {
   std::mutex mutex;
-  std::map<std::string, std::set<std::string>> options;
+  std::map<std::string, std::map<std::string, std::set<std::string>>> options;
 };
 OptionRegistry& option_registry() {
   static OptionRegistry registry;
@@ -133,6 +134,38 @@ OptionRegistry& option_registry() {
 }
 
 std::string quote(const std::string& s) { return "\"" + s + "\""; }
+
+std::string join(const std::vector<std::string>& items, const std::string& sep) {
+  std::string out;
+  for (const std::string& i : items) out += (out.empty() ? "" : sep) + i;
+  return out;
+}
+
+// "a", "a and b", "a, b and c".
+std::string words(const std::vector<std::string>& items) {
+  if (items.size() <= 1) return join(items, "");
+  return join(std::vector<std::string>(items.begin(), items.end() - 1), ", ") + " and " +
+         items.back();
+}
+
+// What a user does about a variant missing from a prebuilt-binaries directory, in the tool's
+// and the C API's words: which of the engine's uses (the tool's commands) need it and how to
+// export it.
+std::string export_advice(const std::string& program, const std::string& options,
+                          const std::string& dir) {
+  const std::vector<std::string> uses = Runtime::registered_uses(program, options);
+  const std::string all = "`planarvo kernels --export " + dir + "`";
+  if (uses.empty())
+    return "No command of the tool uses this variant with its default options, so " + all +
+           " does not write it: build it with the vendor's offline compiler from the "
+           "program's source and add a line for it to the manifest (src/ocl/README.md)";
+  const bool one = uses.size() == 1;
+  return std::string(one ? "The command " : "The commands ") + words(uses) + (one ? " uses" : " use") +
+         " it with " + (one ? "its" : "their") + " default options: export what " +
+         (one ? "it needs" : "they need") + " on this device and driver with `planarvo kernels " +
+         "--export " + dir + " --for " + join(uses, ",") + "`, or every kernel with " + all +
+         " (C API: planarvo_context_export_kernels)";
+}
 
 }  // namespace
 
@@ -348,13 +381,15 @@ cl::Program Runtime::load_from_binaries(const std::string& name, const std::stri
   const std::string what = "program " + quote(name) + " with options " + quote(options) +
                            " on device " + quote(info_.device_name) + " (driver " +
                            info_.driver_version + ")";
-  const std::string where = "prebuilt binaries directory " + quote(dir);
+  const std::string where = "the prebuilt binaries directory " + quote(dir) +
+                            " (--kernel-binaries)";
 
   const auto text = detail::read_file(manifest_path);
   if (!text)
     throw_invalid_input("cannot load " + what + ": " + where + " has no manifest " +
-                        kManifestFileName + " (write one with Runtime::export_binaries, or by " +
-                        "hand as src/ocl/README.md describes)");
+                        kManifestFileName + ", and with prebuilt binaries the engine never " +
+                        "compiles kernels. " + export_advice(name, options, dir) +
+                        "; or write the manifest by hand as src/ocl/README.md describes.");
   std::vector<detail::ManifestEntry> entries;
   try {
     entries = detail::parse_manifest(std::string(text->begin(), text->end()),
@@ -378,8 +413,8 @@ cl::Program Runtime::load_from_binaries(const std::string& name, const std::stri
       msg += "; the manifest has " + quote(name) + " only with options";
       for (const auto& o : other_options) msg += " " + o;
     }
-    throw_invalid_input(msg + " (export it with these options registered, see " +
-                        "Runtime::register_build_options)");
+    throw_invalid_input(msg + ". With prebuilt binaries the engine never compiles kernels. " +
+                        export_advice(name, options, dir) + ".");
   }
   const detail::ManifestEntry* entry = nullptr;
   for (const auto* e : candidates) {
@@ -397,7 +432,8 @@ cl::Program Runtime::load_from_binaries(const std::string& name, const std::stri
     throw_invalid_input("mismatched binary for " + name + " with options " + quote(options) +
                         " in " + where + ": built for " + built_for + ", this device is " +
                         quote(info_.device_name) + " (driver " + info_.driver_version +
-                        "); export the binaries on this device and driver");
+                        "); export the binaries on this device and driver (`planarvo kernels " +
+                        "--export " + dir + "` adds them beside the others)");
   }
 
   const fs::path file = fs::path(dir) / entry->file;
@@ -447,7 +483,31 @@ void Runtime::prepare_all() {
   }
 }
 
-void Runtime::export_binaries(const std::string& dir) {
+size_t Runtime::export_binaries(const std::string& dir, const std::vector<std::string>& uses) {
+  const std::vector<std::string> known = known_uses();
+  for (const std::string& u : uses)
+    if (std::find(known.begin(), known.end(), u) == known.end())
+      throw Error(ErrorCode::InvalidArgument,
+                  "no kernels are registered for " + quote(u) + "; the uses are " + join(known, ", "));
+  // The option sets to export for a program: every registered one (or "" when none is) when
+  // no use is asked for; otherwise those registered for one of the uses.
+  const auto wanted = [&](const std::string& program) {
+    std::vector<std::string> sets = registered_build_options(program);
+    if (uses.empty()) {
+      if (sets.empty()) sets.push_back("");
+      return sets;
+    }
+    std::vector<std::string> out;
+    for (const std::string& options : sets) {
+      const std::vector<std::string> has = registered_uses(program, options);
+      if (std::any_of(uses.begin(), uses.end(), [&](const std::string& u) {
+            return std::find(has.begin(), has.end(), u) != has.end();
+          }))
+        out.push_back(options);
+    }
+    return out;
+  };
+
   std::lock_guard<std::mutex> lock(mutex_);
   std::error_code ec;
   fs::create_directories(dir, ec);
@@ -464,12 +524,11 @@ void Runtime::export_binaries(const std::string& dir) {
 
   const std::string device_tag =
       detail::hex64(fnv1a64(info_.device_name + "\n" + info_.driver_version)).substr(0, 8);
+  size_t written = 0;
   for (const EmbeddedSource* s = embedded_sources(); s->name; ++s) {
     const std::string name = s->name;
     if (name == kPreludeName) continue;
-    std::vector<std::string> option_sets = registered_build_options(name);
-    if (option_sets.empty()) option_sets.push_back("");
-    for (const std::string& options : option_sets) {
+    for (const std::string& options : wanted(name)) {
       if (options.find_first_of("\t\r\n") != std::string::npos)
         throw Error(ErrorCode::InvalidArgument,
                     "the options " + quote(options) + " registered for program " + quote(name) +
@@ -494,6 +553,7 @@ void Runtime::export_binaries(const std::string& dir) {
       e.file = name + "-" + e.options_hash + "-" + device_tag + ".bin";
       e.device = info_.device_name;
       e.driver = info_.driver_version;
+      e.uses = join(registered_uses(name, options), ",");
       if (!detail::write_file_atomically(fs::path(dir) / e.file, binaries[0].data(),
                                          binaries[0].size()))
         throw Error(ErrorCode::Io, "cannot write " + quote((fs::path(dir) / e.file).string()));
@@ -504,6 +564,7 @@ void Runtime::export_binaries(const std::string& dir) {
                                    }),
                     entries.end());
       entries.push_back(std::move(e));
+      ++written;
     }
   }
   const std::string text = detail::format_manifest(entries);
@@ -511,12 +572,15 @@ void Runtime::export_binaries(const std::string& dir) {
                                      reinterpret_cast<const unsigned char*>(text.data()),
                                      text.size()))
     throw Error(ErrorCode::Io, "cannot write " + quote(manifest_path.string()));
+  return written;
 }
 
-void Runtime::register_build_options(const std::string& program, const std::string& options) {
+void Runtime::register_build_options(const std::string& program, const std::string& options,
+                                     const std::vector<std::string>& uses) {
   OptionRegistry& r = option_registry();
   std::lock_guard<std::mutex> lock(r.mutex);
-  r.options[program].insert(normalize_build_options(options));
+  std::set<std::string>& u = r.options[program][normalize_build_options(options)];
+  u.insert(uses.begin(), uses.end());
 }
 
 std::vector<std::string> Runtime::registered_build_options(const std::string& program) {
@@ -524,7 +588,29 @@ std::vector<std::string> Runtime::registered_build_options(const std::string& pr
   std::lock_guard<std::mutex> lock(r.mutex);
   auto it = r.options.find(program);
   if (it == r.options.end()) return {};
-  return {it->second.begin(), it->second.end()};
+  std::vector<std::string> out;
+  for (const auto& [options, uses] : it->second) out.push_back(options);
+  return out;
+}
+
+std::vector<std::string> Runtime::registered_uses(const std::string& program,
+                                                  const std::string& options) {
+  OptionRegistry& r = option_registry();
+  std::lock_guard<std::mutex> lock(r.mutex);
+  auto it = r.options.find(program);
+  if (it == r.options.end()) return {};
+  auto jt = it->second.find(normalize_build_options(options));
+  if (jt == it->second.end()) return {};
+  return {jt->second.begin(), jt->second.end()};
+}
+
+std::vector<std::string> Runtime::known_uses() {
+  OptionRegistry& r = option_registry();
+  std::lock_guard<std::mutex> lock(r.mutex);
+  std::set<std::string> all;
+  for (const auto& [program, sets] : r.options)
+    for (const auto& [options, uses] : sets) all.insert(uses.begin(), uses.end());
+  return {all.begin(), all.end()};
 }
 
 const char* error_name(cl_int code) {

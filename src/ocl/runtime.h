@@ -45,8 +45,9 @@ struct RuntimeOptions {
   std::string cache_dir;
   bool use_cache = true;
   // When set, programs are loaded from prebuilt binaries in this directory
-  // (clCreateProgramWithBinary) and never compiled; see export_binaries() and README.md for
-  // the directory's manifest, kManifestFileName.
+  // (clCreateProgramWithBinary) and never compiled, not even as a fallback: a program whose
+  // binary is missing or unusable is an error saying what needs it and how to export it. See
+  // export_binaries() and README.md for the directory's manifest, kManifestFileName.
   std::string binaries_dir;
 };
 
@@ -67,6 +68,13 @@ inline constexpr const char* kManifestFileName = "planarvo-kernels.txt";
 // The name of the embedded program that is a prelude to all others (kernels/common.cl), never
 // a program by itself.
 inline constexpr const char* kPreludeName = "common";
+
+// The uses that program variants are registered for (Runtime::register_build_options): the
+// engine's tasks, named as the tool's commands that run them, which is also how the C API's
+// planarvo_context_export_kernels_for and the manifest's "for" field name them.
+inline constexpr const char* kUseTrack = "track";          // the tracker: planarvo_tracker_*
+inline constexpr const char* kUseCalibrate = "calibrate";  // roll and pitch, then the tracker
+inline constexpr const char* kUseSimulate = "simulate";    // the simulator's renderer
 
 // Every platform's devices, in the order `planarvo devices` lists them. Never throws for a
 // machine without OpenCL: returns an empty list. A platform or device that cannot be queried
@@ -93,22 +101,34 @@ class Runtime {
   // directory when no usable binary is there.
   cl::Program& program(const std::string& name, const std::string& options = "");
 
-  // Writes prebuilt binaries of every embedded program (except the prelude), built with the
-  // options that the engine's layers register for it (register_build_options; "" for a
-  // program with none registered), into dir, and adds them to dir's manifest. Always builds
-  // from source (or the program cache), never from binaries_dir. Throws Error(Io) when dir
-  // cannot be written, Error(OpenCL) when a build fails.
-  void export_binaries(const std::string& dir);
+  // Writes prebuilt binaries into dir and adds them to dir's manifest, each line saying which
+  // uses need it. With uses empty: every embedded program (except the prelude), built with
+  // each option set the engine's layers register for it (register_build_options; "" for a
+  // program with none registered). Otherwise only the option sets registered for at least one
+  // of the given uses (names from known_uses(); an unknown one is Error(InvalidArgument)).
+  // Always builds from source (or the program cache), never from binaries_dir. Returns the
+  // number of binaries written. Throws Error(Io) when dir cannot be written, Error(OpenCL)
+  // when a build fails.
+  size_t export_binaries(const std::string& dir, const std::vector<std::string>& uses = {});
 
   // Builds (or loads) every embedded program with each registered option set, as
   // export_binaries() would, so that the first frame does not pay for compilation.
   void prepare_all();
 
   // Layers declare the build options they will use for a program, so that export_binaries()
-  // can build exactly those variants. Idempotent; thread-safe.
-  static void register_build_options(const std::string& program, const std::string& options);
+  // can build exactly those variants. uses names what needs the variant in the user's words:
+  // the engine's tasks, which are the tool's commands that run them ("track", "calibrate",
+  // "simulate"); the defaults are registered with them before main(), variants made at run
+  // time from other options without. Registering again adds uses. Thread-safe.
+  static void register_build_options(const std::string& program, const std::string& options,
+                                     const std::vector<std::string>& uses = {});
   // The normalised option sets registered for a program, sorted.
   static std::vector<std::string> registered_build_options(const std::string& program);
+  // The uses registered for a program's option set, sorted; empty when none is known.
+  static std::vector<std::string> registered_uses(const std::string& program,
+                                                  const std::string& options);
+  // Every use registered for any variant, sorted: what export_binaries() accepts.
+  static std::vector<std::string> known_uses();
 
   ProgramStats stats() const;
   // The program cache directory in use; "" when caching is off.

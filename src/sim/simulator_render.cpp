@@ -283,6 +283,15 @@ struct Renderer::Impl {
 // work-group size back from the compiled kernel, so other -D values need no host change.
 std::string Renderer::build_options() { return ""; }
 
+namespace {
+// The default, registered before main() so that `planarvo kernels --export` exports it for
+// simulation without a renderer having been made (FPGA flows cannot compile at run time).
+const bool kDefaultOptionsRegistered = [] {
+  ocl::Runtime::register_build_options("render", Renderer::build_options(), {ocl::kUseSimulate});
+  return true;
+}();
+}  // namespace
+
 Renderer::Renderer(ocl::Runtime& runtime, const cv::Mat& texture, const Options& options)
     : impl_(std::make_unique<Impl>(runtime)) {
   Impl& m = *impl_;

@@ -80,17 +80,19 @@ void simulate(ocl::Runtime& runtime, const Options& options, const std::string& 
   if (texture.empty())
     throw_invalid_input(options.texture + ": cannot be read as an image (the simulator's texture)");
 
+  report(options, 0.0, "setting up");
+  const Trajectory tr = generate_trajectory(options);
+  // The renderer (its kernel program) before the directory: a device that cannot have the
+  // program (e.g. no prebuilt binary of it) leaves nothing behind.
+  Renderer renderer(runtime, texture, options);
+  const std::vector<Exposure> exposure = exposure_series(options, tr.t);
+
   namespace fs = std::filesystem;
   const fs::path dir(out_dir), images = dir / "images";
   std::error_code ec;
   fs::create_directories(images, ec);
   if (ec || !fs::is_directory(images))
     throw Error(ErrorCode::Io, images.string() + ": cannot create the directory (" + ec.message() + ")");
-
-  report(options, 0.0, "setting up");
-  const Trajectory tr = generate_trajectory(options);
-  Renderer renderer(runtime, texture, options);
-  const std::vector<Exposure> exposure = exposure_series(options, tr.t);
   st.setup = seconds_since(t0);
 
   t0 = Clock::now();

@@ -34,14 +34,19 @@ WarpReduceOptions kernel_options(const AlignerOptions& o, bool stats) {
   return k;
 }
 
-// The fused pass's variants with the default options (the tracker's NPARAM 3 and the roll/pitch
-// estimator's 5, each plain and STATS), registered before main() so that exported kernel
-// binaries hold them without an aligner having been made (FPGA flows cannot compile at run time).
+// The fused pass's variants with the default options (the tracker's NPARAM 3, which tracking
+// and calibration use, and the roll/pitch estimator's 5, which calibration uses; each plain and
+// STATS), registered before main() so that exported kernel binaries hold them without an aligner
+// having been made (FPGA flows cannot compile at run time).
 const bool kDefaultVariantsRegistered = [] {
-  for (int nparam : {kMotionParams, kMotionParams + kOrientationParams})
+  for (int nparam : {kMotionParams, kMotionParams + kOrientationParams}) {
+    const std::vector<std::string> uses =
+        nparam == kMotionParams ? std::vector<std::string>{ocl::kUseTrack, ocl::kUseCalibrate}
+                                : std::vector<std::string>{ocl::kUseCalibrate};
     for (bool stats : {false, true})
-      ocl::Runtime::register_build_options("warp_reduce",
-                                           WarpReduce::build_options(nparam, kernel_options(AlignerOptions(), stats)));
+      ocl::Runtime::register_build_options(
+          "warp_reduce", WarpReduce::build_options(nparam, kernel_options(AlignerOptions(), stats)), uses);
+  }
   return true;
 }();
 

@@ -46,9 +46,12 @@ struct CommandResult {
   std::string output;  // stdout and stderr together
 };
 
-// Runs the planarvo command-line tool with the given arguments (a shell-quoted string).
-inline CommandResult run_cli(const std::string& args) {
-  const std::string cmd = std::string("\"") + PLANARVO_CLI_PATH + "\" " + args + " 2>&1";
+// Runs the planarvo command-line tool with the given arguments (a shell-quoted string), and
+// with env (shell-quoted NAME=value words, e.g. "POCL_CACHE_DIR=/tmp/x") added to its
+// environment.
+inline CommandResult run_cli(const std::string& args, const std::string& env = "") {
+  const std::string cmd = (env.empty() ? "" : "env " + env + " ") + "\"" + PLANARVO_CLI_PATH +
+                          "\" " + args + " 2>&1";
   CommandResult r;
   FILE* p = popen(cmd.c_str(), "r");
   if (!p) return r;

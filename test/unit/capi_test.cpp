@@ -77,6 +77,28 @@ TEST(CApi, ContextOnDefaultDevice) {
   planarvo_context_destroy(c);
 }
 
+// The FPGA path's export: by use, with the count written, and names that are not uses refused.
+TEST(CApi, ExportKernelsForAUse) {
+  planarvo_context* c = nullptr;
+  ASSERT_EQ(planarvo_context_create(nullptr, &c), PLANARVO_OK) << planarvo_last_error();
+  planarvo::test::ScratchDir d;
+  const std::string dir = (d / "bins").string();
+  size_t n = 0;
+  ASSERT_EQ(planarvo_context_export_kernels_for(c, dir.c_str(), "simulate", &n), PLANARVO_OK)
+      << planarvo_last_error();
+  EXPECT_EQ(n, 1u);  // the renderer
+  EXPECT_EQ(planarvo_context_export_kernels_for(c, dir.c_str(), " simulate ,simulate", nullptr), PLANARVO_OK)
+      << planarvo_last_error();
+  EXPECT_EQ(planarvo_context_export_kernels_for(c, dir.c_str(), "track,no-such-use", &n),
+            PLANARVO_ERROR_INVALID_ARGUMENT);
+  EXPECT_NE(std::string(planarvo_last_error()).find("no-such-use"), std::string::npos);
+  EXPECT_EQ(planarvo_context_export_kernels_for(c, dir.c_str(), "track,,simulate", &n),
+            PLANARVO_ERROR_INVALID_ARGUMENT);
+  EXPECT_EQ(planarvo_context_export_kernels_for(nullptr, dir.c_str(), nullptr, &n), PLANARVO_ERROR_INVALID_ARGUMENT);
+  EXPECT_EQ(planarvo_context_export_kernels_for(c, nullptr, nullptr, &n), PLANARVO_ERROR_INVALID_ARGUMENT);
+  planarvo_context_destroy(c);
+}
+
 TEST(CApi, LastErrorIsPerThread) {
   EXPECT_EQ(planarvo_context_create(nullptr, nullptr), PLANARVO_ERROR_INVALID_ARGUMENT);
   const std::string here = planarvo_last_error();

@@ -5,10 +5,12 @@
 
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <sstream>
 
 #include "common/test_util.h"
 #include "core/error.h"
+#include "ocl/manifest.h"
 #include "ocl/runtime.h"
 #include "unit/ocl_test_helpers.h"
 
@@ -38,15 +40,24 @@ std::vector<std::string> split(const std::string& s, char sep) {
   return out;
 }
 
-// The manifest's non-comment lines of the test program `fill`, split into fields (the engine's
-// other programs are exported too, and are none of these tests' business).
-std::vector<std::vector<std::string>> manifest_lines(const fs::path& dir) {
+// The manifest's non-comment lines, split into fields.
+std::vector<std::vector<std::string>> all_manifest_lines(const fs::path& dir) {
   std::vector<std::vector<std::string>> out;
   for (const std::string& line : split(read_text(dir / ocl::kManifestFileName), '\n'))
-    if (!line.empty() && line[0] != '#') {
-      auto fields = split(line, '\t');
-      if (fields[0] == "fill") out.push_back(std::move(fields));
-    }
+    if (!line.empty() && line[0] != '#') out.push_back(split(line, '\t'));
+  return out;
+}
+
+// Those of the test program `fill` with the fixture's variants, "" and "-D VARIANT=7" (the
+// engine's other programs are exported too, and other tests register other variants of fill:
+// none of these tests' business).
+std::vector<std::vector<std::string>> manifest_lines(const fs::path& dir) {
+  std::vector<std::vector<std::string>> out;
+  for (auto& fields : all_manifest_lines(dir)) {
+    const std::string options = fields.size() > 5 ? fields[5] : std::string();
+    if (fields[0] == "fill" && (options.empty() || options == "-D VARIANT=7"))
+      out.push_back(std::move(fields));
+  }
   return out;
 }
 
@@ -244,6 +255,89 @@ TEST_F(OclBinaries, ReExportKeepsOtherDevicesAndReplacesThisOne) {
   const auto lines = manifest_lines(dir_);
   EXPECT_EQ(lines.size(), 3u);
   EXPECT_THAT(read_text(dir_ / ocl::kManifestFileName), HasSubstr(foreign));
+}
+
+// The uses a variant is registered for narrow the export (`planarvo kernels --for`), reach the
+// manifest's seventh field, and name what to export when a variant is missing.
+TEST(OclBinariesExport, ForAUseWritesOnlyItsVariantsAndSaysWhatTheyAreFor) {
+  ocl::Runtime::register_build_options("fill", "-D VARIANT=21", {"fill-use-a"});
+  ocl::Runtime::register_build_options("fill", "-D VARIANT=22", {"fill-use-a", "fill-use-b"});
+  ocl::Runtime::register_build_options("fill", "-D VARIANT=23", {"fill-use-b"});
+  ocl::Runtime::register_build_options("fill", "-D VARIANT=23");  // adds no use, removes none
+  EXPECT_EQ(ocl::Runtime::registered_uses("fill", " -D  VARIANT=22"),
+            (std::vector<std::string>{"fill-use-a", "fill-use-b"}));
+  EXPECT_EQ(ocl::Runtime::registered_uses("fill", "-D VARIANT=23"),
+            (std::vector<std::string>{"fill-use-b"}));
+  const std::vector<std::string> known = ocl::Runtime::known_uses();
+  for (const char* u : {"fill-use-a", "fill-use-b", ocl::kUseTrack, ocl::kUseCalibrate, ocl::kUseSimulate})
+    EXPECT_NE(std::find(known.begin(), known.end(), u), known.end()) << u;
+
+  test::ScratchDir scratch;
+  const fs::path dir = scratch / "for-a";
+  ocl::RuntimeOptions o;
+  o.use_cache = false;
+  ocl::Runtime rt(o);
+  EXPECT_EQ(rt.export_binaries(dir.string(), {"fill-use-a"}), 2u);
+  const auto lines = all_manifest_lines(dir);
+  ASSERT_EQ(lines.size(), 2u);  // VARIANT=21 and 22; nothing of the engine's own programs
+  std::map<std::string, std::string> for_field;
+  for (const auto& f : lines) {
+    ASSERT_EQ(f.size(), 7u);
+    EXPECT_EQ(f[0], "fill");
+    for_field[f[5]] = f[6];
+  }
+  EXPECT_EQ(for_field["-D VARIANT=21"], "fill-use-a");
+  EXPECT_EQ(for_field["-D VARIANT=22"], "fill-use-a,fill-use-b");
+
+  // The binaries load; a variant of another use is missing, and the message says which command
+  // needs it and how to export it, without C++ names.
+  ocl::Runtime from(from_binaries(dir));
+  test::expect_fill_works(from, from.program("fill", "-D VARIANT=22"));
+  const std::string msg = test::error_message([&] { from.program("fill", "-D VARIANT=23"); },
+                                              ErrorCode::InvalidInput);
+  EXPECT_THAT(msg, HasSubstr("\"fill\" with options \"-D VARIANT=23\""));
+  EXPECT_THAT(msg, HasSubstr("never compiles"));
+  EXPECT_THAT(msg, HasSubstr("The command fill-use-b uses it"));
+  EXPECT_THAT(msg, HasSubstr("`planarvo kernels --export " + dir.string() + " --for fill-use-b`"));
+  EXPECT_THAT(msg, ::testing::Not(HasSubstr("::")));
+  EXPECT_EQ(from.stats().built_from_source, 0);
+
+  const std::string unknown = test::error_message(
+      [&] { rt.export_binaries((scratch / "x").string(), {"no-such-use"}); }, ErrorCode::InvalidArgument);
+  EXPECT_THAT(unknown, HasSubstr("\"no-such-use\""));
+  EXPECT_THAT(unknown, HasSubstr(ocl::kUseTrack));
+}
+
+TEST(OclManifest, ReadsFormat1And2Lines) {
+  const std::string text =
+      "# format 1: 5 or 6 fields\n"
+      "fill\t-\ta.bin\t*\t*\n"
+      "fill\t-\tb.bin\t*\t*\t-D VARIANT=7\n"
+      "fill\t-\tc.bin\t*\t*\t\n"
+      "# format 2: a seventh field says what the binary is for\n"
+      "fill\t-\td.bin\t*\t*\t-D VARIANT=7\tcalibrate,track\n"
+      "fill\t-\te.bin\t*\t*\t\tsimulate\r\n"
+      "fill\t-\tf.bin\t*\t*\t\t\n";
+  const auto e = ocl::detail::parse_manifest(text, "m.txt");
+  ASSERT_EQ(e.size(), 6u);
+  const std::vector<std::pair<std::string, std::string>> want = {
+      {"", ""}, {"-D VARIANT=7", ""}, {"", ""}, {"-D VARIANT=7", "calibrate,track"}, {"", "simulate"}, {"", ""}};
+  for (size_t i = 0; i < e.size(); ++i) {
+    EXPECT_EQ(e[i].options, want[i].first) << i;
+    EXPECT_EQ(e[i].uses, want[i].second) << i;
+  }
+  // Written back, a line keeps its field, and one without says nothing more than format 1 did.
+  const std::string out = ocl::detail::format_manifest(e);
+  EXPECT_THAT(out, HasSubstr("fill\t-\ta.bin\t*\t*\n"));
+  EXPECT_THAT(out, HasSubstr("fill\t-\td.bin\t*\t*\t-D VARIANT=7\tcalibrate,track\n"));
+  EXPECT_THAT(out, HasSubstr("fill\t-\te.bin\t*\t*\t\tsimulate\n"));
+  EXPECT_EQ(ocl::detail::parse_manifest(out, "m.txt").size(), 6u);
+
+  const std::string eight = test::error_message(
+      [&] { ocl::detail::parse_manifest("fill\t-\ta.bin\t*\t*\t\tx\ty\n", "m.txt"); },
+      ErrorCode::InvalidInput);
+  EXPECT_THAT(eight, HasSubstr("m.txt:1"));
+  EXPECT_THAT(eight, HasSubstr("found 8"));
 }
 
 TEST(OclBinariesExport, UnwritableDirectoryIsAnIoError) {
