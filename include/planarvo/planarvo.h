@@ -289,7 +289,10 @@ PLANARVO_API planarvo_status planarvo_write_tum(const char* path, const double* 
                                                 const planarvo_se2* poses, size_t count);
 
 /* Per-frame statistics CSV (timestamp, vx, vy, omega, iterations, final_cost, inlier_fraction,
- * ms, status): the header on open, then one row per call, flushed, so that a crash loses no row. */
+ * ms, status): the header on open, then one row per call, flushed. Written as PATH.partial and
+ * renamed onto PATH by planarvo_stats_writer_close, so PATH is complete or untouched:
+ * planarvo_stats_writer_discard (after an error, say) removes the partial file and leaves an
+ * existing PATH as it was; a crash leaves the rows written so far in PATH.partial. */
 typedef struct planarvo_stats_writer planarvo_stats_writer;
 typedef struct planarvo_frame_stats {
   double timestamp;
@@ -302,8 +305,11 @@ typedef struct planarvo_frame_stats {
 PLANARVO_API planarvo_status planarvo_stats_writer_open(const char* path, planarvo_stats_writer** writer);
 PLANARVO_API planarvo_status planarvo_stats_writer_add(planarvo_stats_writer* writer,
                                                        const planarvo_frame_stats* row);
-/* Closes the file (reporting a failed final write) and releases the writer; NULL is allowed. */
+/* Completes the file (renames it onto PATH, reporting a failed write) and releases the writer;
+ * NULL is allowed. */
 PLANARVO_API planarvo_status planarvo_stats_writer_close(planarvo_stats_writer* writer);
+/* Removes the partial file, leaves PATH as it was, and releases the writer; NULL is allowed. */
+PLANARVO_API void planarvo_stats_writer_discard(planarvo_stats_writer* writer);
 
 /* ------------------------------------------------------------------------------------------ */
 /* Simulator                                                                                   */

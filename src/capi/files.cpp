@@ -132,4 +132,8 @@ PLANARVO_API planarvo_status planarvo_stats_writer_close(planarvo_stats_writer* 
   });
 }
 
+PLANARVO_API void planarvo_stats_writer_discard(planarvo_stats_writer* writer) {
+  delete writer;  // the writer's destructor removes the partial file
+}
+
 }  // extern "C"

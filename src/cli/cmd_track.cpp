@@ -23,8 +23,9 @@ const char* status_label(planarvo_track_status s) {
   return "?";
 }
 
-struct StatsCloser {
-  void operator()(planarvo_stats_writer* w) const { planarvo_stats_writer_close(w); }
+// A stats file left unfinished by an error is removed, not completed (close() completes it).
+struct StatsDiscarder {
+  void operator()(planarvo_stats_writer* w) const { planarvo_stats_writer_discard(w); }
 };
 struct TrackerDeleter {
   void operator()(planarvo_tracker* t) const { planarvo_tracker_destroy(t); }
@@ -40,7 +41,7 @@ TrackRun track_dataset(planarvo_context* ctx, planarvo_dataset* ds, const planar
   planarvo_tracker* raw = nullptr;
   check(planarvo_tracker_create(ctx, &info.camera, &extrinsics, &options, &raw));
   std::unique_ptr<planarvo_tracker, TrackerDeleter> tracker(raw);
-  std::unique_ptr<planarvo_stats_writer, StatsCloser> stats;
+  std::unique_ptr<planarvo_stats_writer, StatsDiscarder> stats;
   if (!outputs.stats.empty()) {
     planarvo_stats_writer* w = nullptr;
     check(planarvo_stats_writer_open(outputs.stats.c_str(), &w));

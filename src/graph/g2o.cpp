@@ -12,6 +12,7 @@
 #include <Eigen/Cholesky>
 
 #include "core/error.h"
+#include "core/output_file.h"
 #include "graph/factors.h"
 
 namespace planarvo::graph {
@@ -139,8 +140,8 @@ G2oFile read_g2o(const std::filesystem::path& path) {
 }
 
 void write_g2o(const std::filesystem::path& path, const G2oFile& file) {
-  FILE* f = std::fopen(path.string().c_str(), "w");
-  if (!f) throw Error(ErrorCode::Io, path.string() + ": cannot open the file for writing");
+  OutputFile out(path.string());  // complete or untouched (core/output_file.h)
+  FILE* f = out.stream();
   for (const G2oVertex& v : file.vertices)
     std::fprintf(f, "VERTEX_SE2 %d %.17g %.17g %.17g\n", v.id, v.pose.x, v.pose.y, v.pose.theta);
   for (const G2oEdge& e : file.edges) {
@@ -150,9 +151,7 @@ void write_g2o(const std::filesystem::path& path, const G2oFile& file) {
                  I(0, 1), I(0, 2), I(1, 1), I(1, 2), I(2, 2));
   }
   for (int id : file.fixed) std::fprintf(f, "FIX %d\n", id);
-  const bool ok = std::ferror(f) == 0;
-  if (std::fclose(f) != 0 || !ok)
-    throw Error(ErrorCode::Io, path.string() + ": writing the file failed");
+  out.commit();
 }
 
 FactorGraph make_pose_graph(const G2oFile& file, bool fix_first_vertex) {

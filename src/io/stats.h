@@ -1,5 +1,6 @@
 // The per-frame statistics CSV (formats.md, Outputs: --stats FILE): one row per frame, written
-// and flushed as the frames are processed, so that a crash loses no earlier row.
+// and flushed as the frames are processed into FILE.partial, renamed onto FILE by close()
+// (core/output_file.h): FILE is complete or untouched; a crash leaves the rows in FILE.partial.
 #pragma once
 #include <string>
 
@@ -27,7 +28,8 @@ class StatsWriter {
 
   explicit StatsWriter(const std::string& path);
   void add(const FrameStats& row);
-  // Closes the file, reporting a failed final write (the destructor closes without reporting).
+  // Completes the file, reporting a failed final write. Destroyed without close(), the writer
+  // removes its partial file and leaves FILE as it was.
   void close();
   const std::string& path() const { return out_.path(); }
 

@@ -87,39 +87,29 @@ std::string format_fixed(double v, int decimals) {
   return std::string(buf, r.ptr);
 }
 
-TextWriter::TextWriter(std::string path) : path_(std::move(path)) {
-  file_ = std::fopen(path_.c_str(), "wb");
-  if (!file_) fail("cannot open for writing");
-}
+TextWriter::TextWriter(std::string path) : file_(std::move(path)) {}
 
-TextWriter::~TextWriter() {
-  if (file_) std::fclose(file_);
-}
+TextWriter::~TextWriter() = default;
 
 void TextWriter::write(std::string_view text) {
-  if (!file_) throw Error(ErrorCode::Internal, path_ + ": written after it was closed");
-  if (std::fwrite(text.data(), 1, text.size(), file_) != text.size()) fail("write failed");
+  if (!file_.is_open()) throw Error(ErrorCode::Internal, path() + ": written after it was closed");
+  if (std::fwrite(text.data(), 1, text.size(), file_.stream()) != text.size()) fail("write failed");
 }
 
 void TextWriter::flush() {
-  if (!file_) throw Error(ErrorCode::Internal, path_ + ": flushed after it was closed");
-  if (std::fflush(file_) != 0) fail("write failed");
+  if (!file_.is_open()) throw Error(ErrorCode::Internal, path() + ": flushed after it was closed");
+  if (std::fflush(file_.stream()) != 0) fail("write failed");
 }
 
 void TextWriter::close() {
-  if (!file_) return;
-  const bool flushed = std::fflush(file_) == 0;
-  const int flush_errno = errno;
-  const bool closed = std::fclose(file_) == 0;
-  file_ = nullptr;
-  if (!flushed) errno = flush_errno;
-  if (!flushed || !closed) fail("write failed");
+  if (!file_.is_open()) return;
+  file_.commit();
 }
 
 void TextWriter::fail(const char* what) const {
   const int err = errno;
   throw Error(ErrorCode::Io,
-              path_ + ": " + what + " (" + std::generic_category().message(err) + ")");
+              path() + ": " + what + " (" + std::generic_category().message(err) + ")");
 }
 
 }  // namespace planarvo::io::detail

@@ -8,6 +8,8 @@
 #include <string_view>
 #include <vector>
 
+#include "core/output_file.h"
+
 namespace planarvo::io::detail {
 
 // "path:line: message", the form compilers use, so editors can jump to it.
@@ -44,7 +46,9 @@ double parse_number(const LineReader& reader, std::string_view field, const char
 std::string format_exact(double v);
 std::string format_fixed(double v, int decimals);
 
-// A file opened for writing whose every failure is Error(Io) naming the file.
+// A file opened for writing whose every failure is Error(Io) naming the file. It appears
+// complete or not at all (core/output_file.h): close() renames the finished file onto the
+// path; destroyed without close(), it leaves the path as it was.
 class TextWriter {
  public:
   explicit TextWriter(std::string path);
@@ -53,16 +57,17 @@ class TextWriter {
   TextWriter& operator=(const TextWriter&) = delete;
 
   void write(std::string_view text);
-  // Hands the written text to the operating system, so that a crash of this process loses none.
+  // Hands the written text to the operating system, so that a crash of this process loses none
+  // (it is then in the path's temporary, PATH.partial).
   void flush();
-  // Closes the file, reporting a failed final write; the destructor closes silently.
+  // Completes the file: flushes, closes and renames it onto the path, reporting any failure.
+  // The destructor, without close(), removes the temporary and leaves the path as it was.
   void close();
-  const std::string& path() const { return path_; }
+  const std::string& path() const { return file_.path(); }
 
  private:
   [[noreturn]] void fail(const char* what) const;
-  std::string path_;
-  std::FILE* file_ = nullptr;
+  OutputFile file_;
 };
 
 }  // namespace planarvo::io::detail

@@ -2,6 +2,7 @@
 // 3 no device) and messages that name the file and line, for each kind of bad input.
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -9,6 +10,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "common/test_util.h"
+#include "io/formats.h"
 
 namespace planarvo {
 namespace {
@@ -19,7 +21,12 @@ using test::ScratchDir;
 
 void write(const fs::path& p, const std::string& text) {
   fs::create_directories(p.parent_path());
-  std::ofstream(p) << text;
+  std::ofstream(p, std::ios::binary) << text;
+}
+
+std::string read(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
 }
 
 const char* kCameraYaml =
@@ -161,6 +168,37 @@ TEST(Cli, SimulateRejectsBadTexture) {
   auto r = run_cli("simulate --quiet --out " + (d / "sim").string() + " --texture /nonexistent/floor.png");
   EXPECT_EQ(r.exit_code, 2) << r.output;
   EXPECT_NE(r.output.find("/nonexistent/floor.png"), std::string::npos) << r.output;
+}
+
+// A track that stops on a corrupt frame halfway (exit 2) writes nothing and overwrites nothing:
+// the user's earlier trajectory, statistics and motions are left byte for byte, and no partial
+// file remains. The same run on the intact data set replaces them.
+TEST(Cli, TrackStoppedByACorruptFrameLeavesEarlierOutputsAsTheyWere) {
+  ScratchDir d;
+  const fs::path sim = d / "sim";
+  auto r = run_cli("simulate --quiet --out " + sim.string() + " --seconds 0.5 --width 160 --height 120 --seed 5");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const fs::path traj = d / "traj.txt", stats = d / "stats.csv", motions = d / "motions.csv";
+  for (const fs::path& p : {traj, stats, motions}) write(p, "the user's earlier " + p.filename().string() + "\n");
+  const std::string cmd = "track " + sim.string() + " --quiet --extrinsics " + (sim / "extrinsics_gt.yaml").string() +
+                          " -o " + traj.string() + " --stats " + stats.string() + " --motions-out " + motions.string();
+  const std::string intact = read(sim / "images" / "000010.png");
+  write(sim / "images" / "000010.png", "not a png");
+  r = run_cli(cmd);
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("000010.png"), std::string::npos) << r.output;
+  for (const fs::path& p : {traj, stats, motions}) {
+    EXPECT_EQ(read(p), "the user's earlier " + p.filename().string() + "\n") << p;
+    EXPECT_FALSE(fs::exists(p.string() + ".partial")) << p;
+  }
+  write(sim / "images" / "000010.png", intact);
+  r = run_cli(cmd);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_EQ(io::read_tum(traj.string()).size(), 15u);
+  for (const fs::path& p : {stats, motions}) {
+    EXPECT_NE(read(p).rfind("the user's earlier", 0), 0u) << p;
+    EXPECT_FALSE(fs::exists(p.string() + ".partial")) << p;
+  }
 }
 
 // FPGA flow: export binaries, then run a device job with them and without a compiler.

@@ -10,6 +10,7 @@
 #include <opencv2/core.hpp>
 
 #include "common/test_util.h"
+#include "core/output_file.h"
 #include "io/formats.h"
 #include "io/stats.h"
 #include "unit/io_test_helpers.h"
@@ -483,8 +484,10 @@ TEST(IoStats, HeaderRowsAndFlushedAsItGoes) {
   ScratchDir dir;
   const std::string path = (dir / "stats.csv").string();
   io::StatsWriter w(path);
-  EXPECT_EQ(test::read_text(path),
+  const std::string partial = path + OutputFile::kSuffix;  // where the rows go until close()
+  EXPECT_EQ(test::read_text(partial),
             "timestamp,vx,vy,omega,iterations,final_cost,inlier_fraction,ms,status\n");
+  EXPECT_FALSE(std::filesystem::exists(path));
   io::FrameStats r;
   r.timestamp = 12.5;
   r.vx = 0.25;
@@ -500,11 +503,43 @@ TEST(IoStats, HeaderRowsAndFlushedAsItGoes) {
   r.status = "lost, \"really\"";
   r.final_cost = std::numeric_limits<double>::quiet_NaN();
   w.add(r);
-  // Read while the writer is still open: the rows must already be in the file.
-  const std::string text = test::read_text(path);
+  // Read while the writer is still open: the rows must already be in the partial file.
+  const std::string text = test::read_text(partial);
   EXPECT_THAT(text, HasSubstr("\n12.500000000,0.25,-0.001,0.1,17,3.5,0.875,1.25,ok\n"));
   EXPECT_THAT(text, HasSubstr("\n12.600000000,0.25,-0.001,0.1,17,nan,0.875,1.25,\"lost, \"\"really\"\"\"\n"));
   w.close();
+  EXPECT_EQ(test::read_text(path), text);
+  EXPECT_FALSE(std::filesystem::exists(partial));
+}
+
+// A writer destroyed before close() (a command that stopped on an error) leaves an existing
+// file byte for byte as it was and no partial file; one that completes replaces it.
+TEST(IoWriters, AFileIsCompleteOrUntouched) {
+  ScratchDir dir;
+  const std::string path = (dir / "stats.csv").string();
+  test::write_text(path, "the user's earlier file\n");
+  {
+    io::StatsWriter w(path);
+    w.add(io::FrameStats{});
+    EXPECT_TRUE(std::filesystem::exists(path + OutputFile::kSuffix));
+  }
+  EXPECT_EQ(test::read_text(path), "the user's earlier file\n");
+  EXPECT_FALSE(std::filesystem::exists(path + OutputFile::kSuffix));
+  {
+    io::StatsWriter w(path);
+    w.close();
+  }
+  EXPECT_EQ(test::read_text(path), std::string(io::StatsWriter::kHeader) + "\n");
+  // The whole-file writers too: a complete write replaces, and nothing partial is left.
+  io::write_tum(path, {{0.5, SE2(1, 2, 0.25)}});
+  EXPECT_EQ(io::read_tum(path).size(), 1u);
+  EXPECT_FALSE(std::filesystem::exists(path + OutputFile::kSuffix));
+}
+
+// A destination that is not a regular file (a device) is written directly: nothing to rename.
+TEST(IoWriters, ADeviceIsWrittenDirectly) {
+  io::write_tum("/dev/null", {{0.5, SE2(1, 2, 0.25)}});
+  EXPECT_TRUE(std::filesystem::is_character_file("/dev/null"));
 }
 
 }  // namespace

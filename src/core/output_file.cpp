@@ -1,0 +1,61 @@
+#include "core/output_file.h"
+
+#include <cerrno>
+#include <cstdio>
+#include <filesystem>
+#include <system_error>
+
+#include "core/error.h"
+
+namespace planarvo {
+
+namespace {
+
+// A destination to write directly: one that exists and is not a regular file.
+bool write_directly(const std::string& path) {
+  std::error_code ec;
+  const std::filesystem::file_status st = std::filesystem::status(path, ec);
+  return !ec && std::filesystem::exists(st) && !std::filesystem::is_regular_file(st);
+}
+
+}  // namespace
+
+OutputFile::OutputFile(std::string path) : path_(std::move(path)) {
+  temporary_ = write_directly(path_) ? path_ : path_ + kSuffix;
+  file_ = std::fopen(temporary_.c_str(), "wb");
+  if (!file_) fail("cannot open for writing", errno);
+}
+
+OutputFile::~OutputFile() { discard(); }
+
+void OutputFile::commit() {
+  if (!file_) throw Error(ErrorCode::Internal, path_ + ": committed after it was closed");
+  int err = std::ferror(file_) ? EIO : 0;  // a write that failed earlier
+  errno = 0;
+  if (std::fflush(file_) != 0 && err == 0) err = errno != 0 ? errno : EIO;
+  errno = 0;
+  if (std::fclose(file_) != 0 && err == 0) err = errno != 0 ? errno : EIO;
+  file_ = nullptr;
+  if (err != 0) {
+    if (temporary_ != path_) std::remove(temporary_.c_str());
+    fail("write failed", err);
+  }
+  if (temporary_ != path_ && std::rename(temporary_.c_str(), path_.c_str()) != 0) {
+    const int rename_errno = errno;
+    std::remove(temporary_.c_str());
+    fail("cannot replace the file with the completed " + temporary_, rename_errno);
+  }
+}
+
+void OutputFile::discard() noexcept {
+  if (!file_) return;
+  std::fclose(file_);
+  file_ = nullptr;
+  if (temporary_ != path_) std::remove(temporary_.c_str());
+}
+
+void OutputFile::fail(const std::string& what, int err) {
+  throw Error(ErrorCode::Io, path_ + ": " + what + " (" + std::generic_category().message(err) + ")");
+}
+
+}  // namespace planarvo
