@@ -104,6 +104,8 @@ G2oFile read_g2o(const std::filesystem::path& path) {
       double u[6];
       for (int k = 0; k < 6; ++k) u[k] = r.number(names[k]);
       r.expect_end();
+      if (!std::isfinite(e.measurement.x) || !std::isfinite(e.measurement.y) || !std::isfinite(e.measurement.theta))
+        r.fail("the edge measurement is not finite");
       e.information << u[0], u[1], u[2], u[1], u[3], u[4], u[2], u[4], u[5];
       Eigen::LLT<Eigen::Matrix3d> llt(e.information);
       if (!e.information.allFinite() || llt.info() != Eigen::Success)

@@ -73,6 +73,17 @@ TEST(CliPosegraph, BadFileNamesTheLine) {
   EXPECT_NE(r.output.find("bad.g2o:2"), std::string::npos) << r.output;
 }
 
+// A NaN in an edge is bad input like one in a vertex: exit 2 naming the line, no output graph.
+TEST(CliPosegraph, NanInAnEdgeIsBadInputAndWritesNothing) {
+  ScratchDir d;
+  const fs::path bad = d / "bad.g2o", out = d / "out.g2o";
+  std::ofstream(bad) << "VERTEX_SE2 0 0 0 0\nVERTEX_SE2 1 1 0 0\nEDGE_SE2 0 1 nan 0 0 1 0 0 1 0 1\n";
+  auto r = run_cli("posegraph " + bad.string() + " -o " + out.string());
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("bad.g2o:3"), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(out));
+}
+
 TEST(CliCalibrate, CensiLmovAgainstOdometry) {
   ScratchDir d;
   const std::string out = (d / "extrinsics.yaml").string();

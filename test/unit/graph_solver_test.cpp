@@ -493,6 +493,9 @@ TEST(GraphG2o, ErrorsNameFileAndLine) {
   expect_error(v + "EDGE_SE2 0 1 1 0 0 1 0 0 1 0\n", "3", "I33");
   expect_error(v + "EDGE_SE2 0 7 1 0 0 1 0 0 1 0 1\n", "3", "no vertex 7");
   expect_error(v + "EDGE_SE2 0 1 1 0 0 1 0 0 -1 0 1\n", "3", "positive definite");
+  expect_error(v + "EDGE_SE2 0 1 nan 0 0 1 0 0 1 0 1\n", "3", "not finite");
+  expect_error(v + "EDGE_SE2 0 1 1 0 inf 1 0 0 1 0 1\n", "3", "not finite");
+  expect_error(v + "EDGE_SE2 0 1 1 0 0 1 0 0 nan 0 1\n", "3", "positive definite");
   expect_error(v + "# comment\nVERTEX_XY 2 1 1\n", "4", "VERTEX_XY");
   expect_error("VERTEX_SE2 0 0 0 0\nVERTEX_SE2 0 1 0 0\n", "2", "twice");
   expect_error("VERTEX_SE2 0 0 zero 0\n", "1", "y");
