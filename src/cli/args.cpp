@@ -77,6 +77,20 @@ long long Args::get_int(const std::string& name, long long fallback) const {
   return v;
 }
 
+int Args::get_int_in(const std::string& name, int fallback, int lo, int hi) const {
+  if (!has(name)) return fallback;
+  const long long v = get_int(name, fallback);
+  if (v < lo || v > hi)
+    throw UsageError("option --" + name + " must be " + std::to_string(lo) + " to " + std::to_string(hi) + ", not " +
+                     get(name));
+  return static_cast<int>(v);
+}
+
+void Args::expect_positionals(size_t count, const std::string& what) const {
+  if (positionals_.size() < count) throw UsageError("missing " + what);
+  if (positionals_.size() > count) throw UsageError("unexpected argument " + positionals_[count]);
+}
+
 std::vector<double> Args::get_doubles(const std::string& name, size_t count) const {
   std::vector<double> out;
   std::stringstream ss(get(name));

@@ -29,6 +29,12 @@ class Args {
   std::string get(const std::string& name, const std::string& fallback = "") const;
   double get_double(const std::string& name, double fallback) const;
   long long get_int(const std::string& name, long long fallback) const;
+  // An integer option that, when given, must lie in [lo, hi]: UsageError naming the option
+  // otherwise; fallback when not given.
+  int get_int_in(const std::string& name, int fallback, int lo, int hi) const;
+  // Exactly `count` positional arguments (what: their names, e.g. "DATASET"): UsageError saying
+  // which is missing or which one is unexpected.
+  void expect_positionals(size_t count, const std::string& what) const;
   // Comma-separated numbers, exactly `count` of them.
   std::vector<double> get_doubles(const std::string& name, size_t count) const;
   const std::vector<std::string>& positionals() const { return positionals_; }

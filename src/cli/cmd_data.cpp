@@ -219,13 +219,14 @@ int cmd_info(int argc, char** argv) {
       {"quiet", "", "no progress bar", ""},
       {"help", "", "show this help", ""}};
   Args args(specs, argc, argv, 1);
-  if (args.has("help") || args.positionals().size() != 1) {
+  if (args.has("help")) {
     std::printf("usage: planarvo info DATASET [--verify] [--video FILE]\n\n"
                 "Reads a data set (shared layout: camera.yaml, frames.txt, images/, optional odometry.txt,\n"
                 "direction.txt, groundtruth.txt, extrinsics.yaml), checks it and prints what it holds.\n\n%s",
                 format_options(specs).c_str());
-    return args.has("help") ? kExitOk : kExitUsage;
+    return kExitOk;
   }
+  args.expect_positionals(1, "DATASET, the data set folder");
   Progress progress(!args.has("quiet"));
   DatasetPtr ds = open_dataset(args.positionals()[0], args.get("video"), args.has("verify"), &progress);
   progress.finish();

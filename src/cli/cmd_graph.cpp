@@ -46,16 +46,17 @@ int cmd_posegraph(int argc, char** argv) {
       {"verbose", "", "print the iteration table", ""},
       {"help", "", "show this help", ""}};
   Args args(specs, argc, argv, 1);
-  if (args.has("help") || args.positionals().size() != 1) {
+  if (args.has("help")) {
     std::printf("usage: planarvo posegraph IN.g2o [-o OUT.g2o] [--init rotation] [--verbose]\n\n"
                 "Optimises a 2-D pose graph in g2o's format (VERTEX_SE2, EDGE_SE2; the first vertex held\n"
                 "fixed) with planarvo's sparse Levenberg-Marquardt solver on CHOLMOD.\n\n%s",
                 format_options(specs).c_str());
-    return args.has("help") ? kExitOk : kExitUsage;
+    return kExitOk;
   }
+  args.expect_positionals(1, "IN.g2o, the pose graph to optimise");
   planarvo_posegraph_options o;
   planarvo_posegraph_options_init(&o);
-  o.max_iterations = static_cast<int32_t>(args.get_int("max-iterations", o.max_iterations));
+  o.max_iterations = args.get_int_in("max-iterations", o.max_iterations, 1, 1000000);
   const std::string init = args.get("init", "none");
   if (init == "rotation") o.init = PLANARVO_POSEGRAPH_INIT_ROTATION_FIRST;
   else if (init != "none") throw UsageError("--init must be none or rotation");
@@ -106,7 +107,7 @@ int cmd_calibrate(int argc, char** argv) {
   for (auto& d : device_options()) specs.push_back(d);
   Args args(specs, argc, argv, 1);
   const bool dataset = !args.positionals().empty();
-  if (args.has("help") || (!dataset && !args.has("motions"))) {
+  if (args.has("help")) {
     std::printf("usage: planarvo calibrate DATASET [--method odometry|nonholonomic] [--height METRES] [--frames N]\n"
                 "                          [--initial-extrinsics FILE] -o extrinsics.yaml\n"
                 "       planarvo calibrate --motions FILE.csv [--method odometry|nonholonomic] [--fix-scale | "
@@ -117,8 +118,9 @@ int cmd_calibrate(int argc, char** argv) {
                 "pairs: x, y, yaw and the camera height only. Exit code 1 when the data cannot determine the answer\n"
                 "(it says why; no file is written), 2 when an input the method needs is missing.\n\n%s",
                 format_options(specs).c_str());
-    return args.has("help") ? kExitOk : kExitUsage;
+    return kExitOk;
   }
+  if (!dataset && !args.has("motions")) throw UsageError("missing DATASET, the data set folder (or --motions FILE.csv)");
   if (dataset && args.has("motions")) throw UsageError("give a DATASET or --motions FILE.csv, not both");
   if (args.positionals().size() > 1) throw UsageError("unexpected argument " + args.positionals()[1]);
   const std::string method = args.get("method", "odometry");

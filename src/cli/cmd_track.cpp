@@ -169,14 +169,21 @@ int cmd_track(int argc, char** argv) {
       {"help", "", "show this help", ""}};
   for (auto& d : device_options()) specs.push_back(d);
   Args args(specs, argc, argv, 1);
-  if (args.has("help") || args.positionals().size() != 1) {
+  if (args.has("help")) {
     std::printf("usage: planarvo track DATASET [--extrinsics FILE] [-o trajectory.txt] [--stats stats.csv]\n\n"
                 "Dense planar visual odometry over a data set: prints a summary, and the accuracy against\n"
                 "groundtruth.txt when the data set has one.\n\n%s",
                 format_options(specs).c_str());
-    return args.has("help") ? kExitOk : kExitUsage;
+    return kExitOk;
   }
+  args.expect_positionals(1, "DATASET, the data set folder");
   const std::string dir = args.positionals()[0];
+  // The options first: a usage error is reported before any file is read.
+  planarvo_tracker_options o;
+  planarvo_tracker_options_init(&o);
+  o.levels = args.get_int_in("levels", o.levels, 1, 8);
+  if (args.has("finest-level")) o.finest_level = args.get_int_in("finest-level", 0, 0, o.levels - 1);
+  o.max_iterations = args.get_int_in("max-iterations", 0, 1, 1000);
   std::string extr = args.get("extrinsics");
   if (extr.empty()) {
     extr = (std::filesystem::path(dir) / "extrinsics.yaml").string();
@@ -185,11 +192,6 @@ int cmd_track(int argc, char** argv) {
   }
   planarvo_extrinsics e{};
   check(planarvo_extrinsics_load(extr.c_str(), &e));
-  planarvo_tracker_options o;
-  planarvo_tracker_options_init(&o);
-  o.levels = static_cast<int32_t>(args.get_int("levels", o.levels));
-  o.finest_level = static_cast<int32_t>(args.get_int("finest-level", o.finest_level));
-  o.max_iterations = static_cast<int32_t>(args.get_int("max-iterations", 0));
   ContextPtr ctx = make_context(args);
   Progress progress(!args.has("quiet"));
   DatasetPtr ds = open_dataset(dir, args.get("video"), false, &progress);

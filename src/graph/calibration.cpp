@@ -43,10 +43,10 @@ bool spd(const Eigen::Matrix3d& c) {
 }
 
 void validate(const std::vector<MotionSample>& samples, const CalibrationOptions& o) {
-  if (samples.empty()) throw_invalid_argument("calibrate: no motion samples");
+  if (samples.empty()) throw_invalid_argument("graph calibration: no motion samples");
   for (size_t i = 0; i < samples.size(); ++i) {
     const MotionSample& s = samples[i];
-    const std::string where = "calibrate: sample " + std::to_string(i) + ": ";
+    const std::string where = "graph calibration: motion sample " + std::to_string(i) + " (counting from 0): ";
     if (!(s.interval > 0.0) || !std::isfinite(s.interval))
       throw_invalid_argument(where + "the interval must be positive and finite");
     if (!finite(s.sensor.value)) throw_invalid_argument(where + "the sensor motion is not finite");
@@ -63,26 +63,26 @@ void validate(const std::vector<MotionSample>& samples, const CalibrationOptions
   }
   auto positive = [](double v) { return v > 0.0 && std::isfinite(v); };
   auto non_negative = [](double v) { return v >= 0.0 && std::isfinite(v); };
-  if (!positive(o.fixed_scale)) throw_invalid_argument("calibrate: fixed_scale must be positive");
+  if (!positive(o.fixed_scale)) throw_invalid_argument("graph calibration: the fixed scale (camera height) must be positive");
   if (!non_negative(o.sensor_sigma_relative) || !non_negative(o.sensor_sigma_floor) ||
       !non_negative(o.odometry_sigma_relative) || !non_negative(o.odometry_sigma_floor) ||
       !positive(o.sensor_sigma_theta) || !positive(o.odometry_sigma_theta) ||
       !(o.sensor_sigma_floor > 0.0 || o.sensor_sigma_relative > 0.0) ||
       !(o.odometry_sigma_floor > 0.0 || o.odometry_sigma_relative > 0.0))
     throw_invalid_argument(
-        "calibrate: the default sigmas must be non-negative, the angle ones positive, and each "
+        "graph calibration: the default sigmas must be non-negative, the angle ones positive, and each "
         "translation model must have a positive floor or relative part");
-  if (!positive(o.loss_scale)) throw_invalid_argument("calibrate: loss_scale must be positive");
-  if (!non_negative(o.gate_sigma)) throw_invalid_argument("calibrate: gate_sigma must be >= 0");
-  if (!non_negative(o.still_speed)) throw_invalid_argument("calibrate: still_speed must be >= 0");
+  if (!positive(o.loss_scale)) throw_invalid_argument("graph calibration: the robust loss scale must be positive");
+  if (!non_negative(o.gate_sigma)) throw_invalid_argument("graph calibration: the gate (sigmas) must be 0 or more");
+  if (!non_negative(o.still_speed)) throw_invalid_argument("graph calibration: the still speed must be 0 or more");
   if (!positive(o.max_sigma_position) || !positive(o.max_sigma_angle) ||
       !positive(o.max_sigma_scale))
-    throw_invalid_argument("calibrate: the max_sigma limits must be positive");
+    throw_invalid_argument("graph calibration: the largest acceptable sigmas must be positive");
   if (o.initial) {
     for (double v : *o.initial)
-      if (!std::isfinite(v)) throw_invalid_argument("calibrate: the initial value is not finite");
+      if (!std::isfinite(v)) throw_invalid_argument("graph calibration: the initial value is not finite");
     if (!o.fix_scale && o.method == CalibrationMethod::Odometry && !((*o.initial)[2] > 0.0))
-      throw_invalid_argument("calibrate: the initial scale must be positive");
+      throw_invalid_argument("graph calibration: the initial scale must be positive");
   }
 }
 

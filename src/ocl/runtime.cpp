@@ -220,11 +220,13 @@ std::vector<DeviceInfo> list_devices() {
 
 Runtime::Runtime(const RuntimeOptions& options) : options_(options) {
   std::string selector = trim(options.device);
-  std::string origin = "from RuntimeOptions::device";
+  // Where the selector came from, said only when it is not the caller's own (the tool's
+  // --device, the C API's device field): the environment.
+  std::string origin;
   if (selector.empty()) {
     if (const char* env = std::getenv("PLANARVO_DEVICE")) {
       selector = trim(env);
-      origin = "from PLANARVO_DEVICE";
+      origin = "from PLANARVO_DEVICE; ";
     }
   }
   std::vector<Found> all = enumerate();
@@ -241,8 +243,9 @@ Runtime::Runtime(const RuntimeOptions& options) : options_(options) {
                          [](unsigned char c) { return std::isdigit(c); })) {
     const long idx = std::strtol(selector.c_str(), nullptr, 10);
     if (idx < 0 || idx >= static_cast<long>(all.size()))
-      throw Error(ErrorCode::NoDevice, "device index " + selector + " (" + origin +
-                                           ") is out of range: there " +
+      throw Error(ErrorCode::NoDevice, "device index " + selector +
+                                           (origin.empty() ? "" : " (from PLANARVO_DEVICE)") +
+                                           " is out of range: there " +
                                            (all.size() == 1 ? "is 1 device"
                                                             : "are " + std::to_string(all.size()) +
                                                                   " devices") +
@@ -253,7 +256,7 @@ Runtime::Runtime(const RuntimeOptions& options) : options_(options) {
       if (lower(f.info.type) == want) { chosen = &f; break; }
     if (!chosen)
       throw Error(ErrorCode::NoDevice, "no OpenCL device of type " + quote(selector) + " (" +
-                                           origin + "; see `planarvo devices`)");
+                                           origin + "see `planarvo devices`)");
   } else {
     for (auto& f : all) {
       const std::string name = lower(f.info.platform_name + " / " + f.info.device_name + " / " +
@@ -262,7 +265,7 @@ Runtime::Runtime(const RuntimeOptions& options) : options_(options) {
     }
     if (!chosen)
       throw Error(ErrorCode::NoDevice, "no OpenCL device matches " + quote(selector) + " (" +
-                                           origin + "; see `planarvo devices` for the names)");
+                                           origin + "see `planarvo devices` for the names)");
   }
   info_ = chosen->info;
   platform_ = chosen->platform;

@@ -170,6 +170,29 @@ TEST(Cli, SimulateRejectsBadTexture) {
   EXPECT_NE(r.output.find("/nonexistent/floor.png"), std::string::npos) << r.output;
 }
 
+// A usage error says what was wrong (exit 2), in the tool's words: the option as typed, the
+// argument that is missing or extra; --help alone is exit 0.
+TEST(Cli, UsageErrorsSayWhatWasWrong) {
+  struct Case { const char* args; const char* says; };
+  const Case cases[] = {
+      {"track a b", "unexpected argument b"},
+      {"track", "missing DATASET"},
+      {"info", "missing DATASET"},
+      {"posegraph", "missing IN.g2o"},
+      {"calibrate", "missing DATASET"},
+      {"track d --levels 12", "--levels must be 1 to 8, not 12"},
+      {"track d --levels 3 --finest-level 3", "--finest-level must be 0 to 2, not 3"},
+      {"track d --levels 4294967297", "--levels must be 1 to 8"},
+  };
+  for (const Case& c : cases) {
+    auto r = run_cli(c.args);
+    EXPECT_EQ(r.exit_code, 2) << c.args << ": " << r.output;
+    EXPECT_NE(r.output.find(c.says), std::string::npos) << c.args << ": " << r.output;
+    EXPECT_EQ(r.output.find("usage:"), std::string::npos) << c.args << ": " << r.output;
+  }
+  EXPECT_EQ(run_cli("track --help").exit_code, 0);
+}
+
 // A track that stops on a corrupt frame halfway (exit 2) writes nothing and overwrites nothing:
 // the user's earlier trajectory, statistics and motions are left byte for byte, and no partial
 // file remains. The same run on the intact data set replaces them.
