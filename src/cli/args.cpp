@@ -3,6 +3,7 @@
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
+#include <filesystem>
 #include <sstream>
 
 namespace planarvo::cli {
@@ -89,6 +90,21 @@ int Args::get_int_in(const std::string& name, int fallback, int lo, int hi) cons
 void Args::expect_positionals(size_t count, const std::string& what) const {
   if (positionals_.size() < count) throw UsageError("missing " + what);
   if (positionals_.size() > count) throw UsageError("unexpected argument " + positionals_[count]);
+}
+
+void Args::expect_output_files(const std::vector<std::string>& names) const {
+  for (const std::string& name : names) {
+    if (!has(name)) continue;
+    const std::string path = get(name);
+    const std::string flag = name == "output" ? "-o" : "--" + name;
+    if (path.empty()) throw UsageError("option " + flag + " needs a file name");
+    const std::filesystem::path dir = std::filesystem::path(path).parent_path();
+    std::error_code ec;
+    if (std::filesystem::is_directory(std::filesystem::path(path), ec))
+      throw UsageError("option " + flag + ": " + path + " is a directory, not a file");
+    if (!dir.empty() && !std::filesystem::is_directory(dir, ec))
+      throw UsageError("option " + flag + ": the directory " + dir.string() + " does not exist (create it first)");
+  }
 }
 
 std::vector<double> Args::get_doubles(const std::string& name, size_t count) const {

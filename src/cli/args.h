@@ -35,6 +35,11 @@ class Args {
   // Exactly `count` positional arguments (what: their names, e.g. "DATASET"): UsageError saying
   // which is missing or which one is unexpected.
   void expect_positionals(size_t count, const std::string& what) const;
+  // The file options that name outputs (e.g. "output", "stats"): each one given must be in a
+  // directory that exists, checked before any work (the tool's one rule: it never creates
+  // directories for output files; `simulate --out` and `kernels --export` name directories and
+  // create them). UsageError naming the option as typed otherwise.
+  void expect_output_files(const std::vector<std::string>& names) const;
   // Comma-separated numbers, exactly `count` of them.
   std::vector<double> get_doubles(const std::string& name, size_t count) const;
   const std::vector<std::string>& positionals() const { return positionals_; }

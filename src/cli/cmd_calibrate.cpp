@@ -62,6 +62,7 @@ int cmd_calibrate_dataset(const Args& args, const planarvo_calibration_options& 
     check(planarvo_extrinsics_load(args.get("initial-extrinsics").c_str(), &o.initial));
     o.has_initial = 1;
   }
+  args.expect_output_files({"output"});
   const std::string out = args.get("output");
   ContextPtr ctx = make_context(args);
   Progress progress(!args.has("quiet"));

@@ -63,6 +63,7 @@ int cmd_posegraph(int argc, char** argv) {
   if (args.has("verbose")) o.log = &print_line;
   planarvo_solver_summary s{};
   s.struct_size = sizeof s;
+  args.expect_output_files({"output"});
   const std::string out = args.get("output");
   const planarvo_status st = planarvo_posegraph_optimize(args.positionals()[0].c_str(), out.empty() ? nullptr : out.c_str(), &o, &s);
   if (st != PLANARVO_OK && st != PLANARVO_ERROR_FAILED) check(st);
@@ -196,6 +197,7 @@ int cmd_calibrate(int argc, char** argv) {
   if (r.ambiguous) std::printf("ambiguous: (-x, -y, yaw + 180 deg) fits equally well\n");
   if (r.unobservable_reason[0]) std::printf("%s\n", r.unobservable_reason);
 
+  args.expect_output_files({"output"});
   const std::string out = args.get("output");
   if (!out.empty() && !r.ok) std::printf("%s not written: the calibration is not determined\n", out.c_str());
   if (!out.empty() && r.ok) {

@@ -179,6 +179,7 @@ int cmd_track(int argc, char** argv) {
   args.expect_positionals(1, "DATASET, the data set folder");
   const std::string dir = args.positionals()[0];
   // The options first: a usage error is reported before any file is read.
+  args.expect_output_files({"output", "stats", "motions-out"});
   planarvo_tracker_options o;
   planarvo_tracker_options_init(&o);
   o.levels = args.get_int_in("levels", o.levels, 1, 8);

@@ -183,6 +183,12 @@ TEST(Cli, UsageErrorsSayWhatWasWrong) {
       {"track d --levels 12", "--levels must be 1 to 8, not 12"},
       {"track d --levels 3 --finest-level 3", "--finest-level must be 0 to 2, not 3"},
       {"track d --levels 4294967297", "--levels must be 1 to 8"},
+      // Output files never get directories made for them (simulate --out and kernels --export,
+      // which name directories, do).
+      {"track d -o /nonexistent-planarvo/t.txt", "-o: the directory /nonexistent-planarvo does not exist"},
+      {"track d --stats /nonexistent-planarvo/s.csv", "--stats: the directory /nonexistent-planarvo does not exist"},
+      {"calibrate d -o /nonexistent-planarvo/e.yaml", "-o: the directory /nonexistent-planarvo does not exist"},
+      {"posegraph in.g2o -o /nonexistent-planarvo/o.g2o", "-o: the directory /nonexistent-planarvo does not exist"},
   };
   for (const Case& c : cases) {
     auto r = run_cli(c.args);
