@@ -10,7 +10,9 @@
  * frame is x forward, y left, z up (ROS REP-103) with the ground at z = 0; the camera frame is
  * OpenCV's (x right, y down, z forward). Extrinsics T_robot_camera map camera coordinates into
  * robot coordinates, R = Rz(yaw) Ry(pitch) Rx(roll) R0, with R0 the camera looking straight
- * down, image top towards the robot's front.
+ * down, image top towards the robot's front. docs/conventions.md gives them in full (motions
+ * T_{k-1}^-1 T_k, their covariances, time stamps, direction labels); docs/formats.md describes
+ * every file the functions below read and write.
  *
  * Rules that hold for every function:
  * - Every function returns a planarvo_status. PLANARVO_OK is 0. A function never lets a C++
@@ -132,7 +134,7 @@ PLANARVO_API planarvo_status planarvo_camera_save(const char* path, const planar
 /* Reads extrinsics YAML (x y z roll pitch yaw required; a T_robot_camera that disagrees with them
  * is an error). covariance (6x6 row-major, order x y z roll pitch yaw) may be NULL. */
 PLANARVO_API planarvo_status planarvo_extrinsics_load(const char* path, planarvo_extrinsics* e);
-/* Writes extrinsics YAML (formats.md). covariance: 36 doubles or NULL (zeros); estimated:
+/* Writes extrinsics YAML (docs/formats.md). covariance: 36 doubles or NULL (zeros); estimated:
  * comma-separated names such as "x,yaw" or NULL; method and notes may be NULL. */
 PLANARVO_API planarvo_status planarvo_extrinsics_save(const char* path,
                                                       const planarvo_extrinsics* e,
@@ -224,7 +226,7 @@ PLANARVO_API planarvo_status planarvo_context_export_kernels_for(planarvo_contex
 PLANARVO_API planarvo_status planarvo_context_prepare_kernels(planarvo_context* context);
 
 /* ------------------------------------------------------------------------------------------ */
-/* Data sets (shared/spec/formats.md)                                                          */
+/* Data sets (docs/formats.md)                                                                 */
 
 /* A data set directory (camera.yaml, frames.txt + images/, or a video; optional odometry.txt,
  * direction.txt, groundtruth.txt, extrinsics.yaml, extrinsics_gt.yaml), read and validated on
