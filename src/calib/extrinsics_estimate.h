@@ -7,7 +7,7 @@
 // the planar motion of the camera's ground frame s (on the ground below the camera, yaw of the
 // camera) in units of the height. With T_vs = (x, y, yaw) on the ground and T_sc = (Ry(pitch)
 // Rx(roll) R0 | (0, 0, z)), T_vs T_sc = (Rz(yaw) Ry(pitch) Rx(roll) R0 | (x, y, z)) is exactly
-// conventions.md's T_vc, and the graph's m_r = T_vs S_z(m_s) T_vs^-1 estimates (x, y, z, yaw).
+// docs/conventions.md's T_vc, and the graph's m_r = T_vs S_z(m_s) T_vs^-1 estimates (x, y, z, yaw).
 // The two stages' errors are taken as independent (the cross-covariance is zero): the graph
 // sees the tilt only through the motions' scale, a second-order effect for small tilt errors.
 #pragma once

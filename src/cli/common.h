@@ -11,7 +11,7 @@
 
 namespace planarvo::cli {
 
-// Exit codes (shared/spec/formats.md).
+// Exit codes (docs/outputs.md).
 enum Exit { kExitOk = 0, kExitFailed = 1, kExitUsage = 2, kExitNoDevice = 3 };
 
 // A failed C API call: main() prints "planarvo: <message>" and exits with exit_code().

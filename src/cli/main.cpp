@@ -1,5 +1,5 @@
 // The `planarvo` command-line tool: a client of the C API (include/planarvo/planarvo.h) only.
-// Exit codes (shared/spec/formats.md): 0 success; 1 the work ran but failed; 2 bad usage or
+// Exit codes (docs/outputs.md): 0 success; 1 the work ran but failed; 2 bad usage or
 // unreadable/invalid input; 3 no usable OpenCL device.
 #include <cstdio>
 #include <cstring>

@@ -1,5 +1,5 @@
 // The camera's pose on the robot, T_vc = (R_vc | t_vc), in the conventions of
-// shared/spec/conventions.md: R_vc = Rz(yaw) Ry(pitch) Rx(roll) R0, with R0 the camera looking
+// docs/conventions.md: R_vc = Rz(yaw) Ry(pitch) Rx(roll) R0, with R0 the camera looking
 // straight down, image top towards the robot's front.
 #pragma once
 #include <Eigen/Core>
@@ -25,8 +25,8 @@ struct Extrinsics {
 };
 
 // The homography mapping undistorted reference pixels to undistorted live pixels on the ground
-// plane, for the robot's relative motion T_k^-1 T_{k+1} = motion (conventions.md, "Homography
-// between two frames"; the paper's eq. 3). K is the 3x3 camera matrix.
+// plane, for the robot's relative motion T_k^-1 T_{k+1} = motion (docs/conventions.md, "The
+// homography between two frames"; the paper's eq. 3). K is the 3x3 camera matrix.
 Eigen::Matrix3d ground_homography(const Eigen::Matrix3d& K, const Extrinsics& e,
                                   const Eigen::Matrix4d& robot_motion);
 

@@ -1,5 +1,5 @@
 // SE(2): planar rigid motion (x, y, theta), the robot's pose and relative motion
-// (conventions.md: relative motion between frames k and k+1 is T_k^-1 * T_{k+1}).
+// (docs/conventions.md: relative motion between frames k and k+1 is T_k^-1 * T_{k+1}).
 #pragma once
 #include <cmath>
 #include <Eigen/Core>
@@ -74,7 +74,7 @@ struct SE2 {
   }
 };
 
-// Pose interpolation between two samples, linear in x, y and theta (formats.md), the angle
+// Pose interpolation between two samples, linear in x, y and theta (docs/formats.md), the angle
 // taken along the shorter way.
 inline SE2 interpolate_linear(const SE2& a, const SE2& b, double f) {
   return {a.x + f * (b.x - a.x), a.y + f * (b.y - a.y),

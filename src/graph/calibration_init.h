@@ -10,7 +10,7 @@
 namespace planarvo::graph::calibration_detail {
 
 // Odometry method (5.2.1). The calibration T = SE2(x, y, γ) and scale h satisfy
-// m_r · T = T · S_h(m_s) for every interval (conventions.md: m_r = T · S_h(m_s) · T⁻¹). Its
+// m_r · T = T · S_h(m_s) for every interval (docs/conventions.md: m_r = T·S_h(m_s)·T⁻¹). Its
 // rotation part holds for any T (planar rotations commute: the angles only say θ_r = θ_s); its
 // translation part is
 //     (I − R(θ_r)) p + h R(γ) t_s = t_r,

@@ -59,7 +59,7 @@ class VectorPriorFactor final : public Factor {
 // robot frame and the scale of its translations (the camera height for up-to-scale visual
 // odometry; held fixed at 1 for a metric sensor). A sensor motion m_s maps into the robot frame
 // as m_r = T_vs · S_h(m_s) · T_vs⁻¹, S_h scaling the translation by the height
-// (shared/spec/conventions.md).
+// (docs/conventions.md).
 struct CalibrationIndex {
   static constexpr int kX = 0, kY = 1, kHeight = 2, kYaw = 3, kDim = 4;
 };

@@ -1,4 +1,4 @@
-// A data set directory (shared/spec/formats.md): camera.yaml, frames.txt + images/ or a video,
+// A data set directory (docs/formats.md): camera.yaml, frames.txt + images/ or a video,
 // and the optional odometry, direction labels, ground truth and extrinsics. Everything but the
 // image pixels is read and validated when the data set is opened; a bad file is
 // Error(InvalidInput) naming the file (and line), never a crash and never silently skipped.

@@ -1,4 +1,4 @@
-// The files users already have (shared/spec/formats.md): OpenCV calibration YAML, extrinsics
+// The files users already have (docs/formats.md): OpenCV calibration YAML, extrinsics
 // YAML, TUM trajectories, direction labels, frames.txt (the statistics CSV is in stats.h).
 // Every reader names the file, and the line where one applies ("file:line: ..."), in its
 // InvalidInput errors: wrong field count, unparsable number, NaN or inf, non-increasing

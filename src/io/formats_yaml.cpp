@@ -1,5 +1,5 @@
 // The OpenCV FileStorage YAML formats of formats.h: the camera calibration (as OpenCV's
-// calibration sample writes it) and the extrinsics (formats.md, Outputs).
+// calibration sample writes it) and the extrinsics (docs/formats.md, "Extrinsics YAML").
 #include <algorithm>
 #include <array>
 #include <cmath>

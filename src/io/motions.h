@@ -1,4 +1,4 @@
-// Motion pairs for calibration without images (formats.md, "--motions FILE.csv"): per interval,
+// Motion pairs for calibration without images (docs/formats.md, "Motion-pair CSV"): per interval,
 // the robot's motion from wheel odometry (optional) and the sensor's own motion, in the robot
 // frame and the sensor frame at the interval's start, plus an optional direction label.
 #pragma once

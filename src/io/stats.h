@@ -1,4 +1,4 @@
-// The per-frame statistics CSV (formats.md, Outputs: --stats FILE): one row per frame, written
+// The per-frame statistics CSV (docs/formats.md, --stats FILE): one row per frame, written
 // and flushed as the frames are processed into FILE.partial, renamed onto FILE by close()
 // (core/output_file.h): FILE is complete or untouched; a crash leaves the rows in FILE.partial.
 #pragma once

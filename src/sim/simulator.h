@@ -1,7 +1,7 @@
 // The simulator: renders test sequences of a downward-looking camera on a differential-drive
 // robot over a textured ground plane, with exact ground truth (see src/sim/SIMULATOR.md).
 //
-// Geometry follows shared/spec/conventions.md: robot pose T_wv in SE(2), camera pose
+// Geometry follows docs/conventions.md: robot pose T_wv in SE(2), camera pose
 // T_wc = T_wv * T_vc, ground plane z = 0. The ground texture is the photograph tiled over the
 // whole plane by mirroring (period two texture sizes along each axis); world point (X, Y) is at
 // texture coordinates (u, v) = (X / texel_size, Y / texel_size), integer (u, v) at texel
@@ -38,7 +38,7 @@ enum class MotionProfile {
 // The paper's camera configuration 1: x 0.2441, y -0.0185, z 0.1787 m, roll 12.4, pitch 17.6,
 // yaw -9.2 degrees.
 Extrinsics default_extrinsics();
-// The paper's camera configurations 1, 2 and 3 (its Tables 1-3) as numbers in conventions.md's
+// The paper's camera configurations 1, 2 and 3 (its Tables 1-3) as numbers in docs/conventions.md's
 // convention (the paper states none; these are borrowed as numbers, not as the same mounts):
 // 1 = default_extrinsics(); 2 = (0.1917, -0.1078, 0.2164 m; 29.8, -4.6, 75.8 degrees);
 // 3 = (0.2226, 0.0806, 0.1469 m; -26.6, 4.7, -18.6 degrees). InvalidArgument for another k.

@@ -1,4 +1,4 @@
-// simulate(): a whole data set in the layout of shared/spec/formats.md, written with the
+// simulate(): a whole data set in the layout of docs/formats.md, written with the
 // writers of formats.h.
 #include <chrono>
 #include <cstdio>

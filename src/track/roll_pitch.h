@@ -95,7 +95,7 @@ struct RollPitchResult {
   };
   Status status = Status::Failed;
   std::string reason;  // "" when Ok; otherwise what went wrong and what would fix it
-  double roll = 0.0, pitch = 0.0;  // radians (conventions.md)
+  double roll = 0.0, pitch = 0.0;  // radians (docs/conventions.md)
   Eigen::Matrix2d covariance = Eigen::Matrix2d::Zero();  // of (roll, pitch), rad^2
   int frames_used = 0;   // frames fed before the map was complete
   int keyframes = 0;

@@ -84,7 +84,7 @@ struct FrameResult {
   Status status = Status::First;
   const char* reason = "";  // why Degraded or Lost ("" when Ok)
   // Frame-to-frame motion (core::Motion, the type the graph calibrations take): value is this
-  // frame's robot pose in the previous frame's robot frame (T_{k-1}^-1 T_k, conventions.md),
+  // frame's robot pose in the previous frame's robot frame (T_{k-1}^-1 T_k, docs/conventions.md),
   // metres and radians; covariance that of the right perturbation xi in value·exp(xi), (x, y)
   // in metres, theta in radians. The motion is (T_kf^-1 T_{k-1})^-1 (T_kf^-1 T_k), its error
   // xi_k - Ad(m̂^-1) xi_{k-1}: this frame's alignment covariance plus the previous frame's

@@ -11,7 +11,7 @@ namespace planarvo::track {
 namespace {
 
 // top3(T) P: the 3x3 map from a ground point's camera coordinates to the moved point, for a
-// 4x4 camera motion T (conventions.md: R - t n^T / z).
+// 4x4 camera motion T (docs/conventions.md: R - t n^T / z).
 Eigen::Matrix3d plane_map(const Eigen::Matrix4d& T, const Eigen::Vector3d& n, double z) {
   return T.topLeftCorner<3, 3>() - T.topRightCorner<3, 1>() * n.transpose() / z;
 }

@@ -1,9 +1,10 @@
 // The tracker's motion model: the ground-plane homography between a reference (keyframe) and a
 // live frame as a function of the robot's planar motion, and its derivatives (the paper's
-// eqs. 8, 9 and 13, re-derived in shared/spec/conventions.md's frames).
+// eqs. 8, 9 and 13, re-derived in docs/conventions.md's frames).
 //
 // Parameterisation. The estimate is T̂, the live robot pose in the reference robot frame (the
-// relative motion T_r^-1 T_l of conventions.md), updated by a right-multiplied se(2) increment:
+// relative motion T_r^-1 T_l of docs/conventions.md), updated by a right-multiplied se(2)
+// increment:
 //     H(x) = ground_homography(K, e, T̂ · exp(x)),     T̂ <- T̂ · exp(x̂)      (eqs. 8, 9)
 // x = (vx, vy, omega) in SE2::exp's coordinates: metres and radians in the live robot frame.
 // The camera motion of T̂ exp(x) is T_cv (T̂ exp(x))^-1 T_vc, so with P = [I; -n_c^T / z] (4x3,
@@ -24,8 +25,8 @@
 // the kernel the same way, as Ĥ^-1 ∂H/∂y_i: the camera's orientation to the ground (section 5.1,
 // below).
 //
-// Orientation (section 5.1, eqs. 19-24, in conventions.md's frames). The camera's tilt is updated
-// by a rotation about the camera centre through the robot's x and y axes,
+// Orientation (section 5.1, eqs. 19-24, in docs/conventions.md's frames). The camera's tilt is
+// updated by a rotation about the camera centre through the robot's x and y axes,
 //     R_vc <- exp([y1, y2, 0]_x) R_vc,          t_vc unchanged                         (eq. 20)
 // (the paper's R̂_cv <- R̂_cv R(ŷ) is the same update written for R_cv = R_vc^T, with R(y) acting
 // on the other side). A rotation about the robot's z axis would be yaw, which planar motions
