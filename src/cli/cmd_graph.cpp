@@ -124,6 +124,7 @@ int cmd_calibrate(int argc, char** argv) {
   if (!dataset && !args.has("motions")) throw UsageError("missing DATASET, the data set folder (or --motions FILE.csv)");
   if (dataset && args.has("motions")) throw UsageError("give a DATASET or --motions FILE.csv, not both");
   if (args.positionals().size() > 1) throw UsageError("unexpected argument " + args.positionals()[1]);
+  args.expect_output_files({"output"});  // both forms: before any work
   const std::string method = args.get("method", "odometry");
   if (method == "odometry") o.method = PLANARVO_CALIBRATE_ODOMETRY;
   else if (method == "nonholonomic") o.method = PLANARVO_CALIBRATE_NONHOLONOMIC;
@@ -197,7 +198,6 @@ int cmd_calibrate(int argc, char** argv) {
   if (r.ambiguous) std::printf("ambiguous: (-x, -y, yaw + 180 deg) fits equally well\n");
   if (r.unobservable_reason[0]) std::printf("%s\n", r.unobservable_reason);
 
-  args.expect_output_files({"output"});
   const std::string out = args.get("output");
   if (!out.empty() && !r.ok) std::printf("%s not written: the calibration is not determined\n", out.c_str());
   if (!out.empty() && r.ok) {

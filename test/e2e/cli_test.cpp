@@ -189,6 +189,7 @@ TEST(Cli, UsageErrorsSayWhatWasWrong) {
       {"track d --stats /nonexistent-planarvo/s.csv", "--stats: the directory /nonexistent-planarvo does not exist"},
       {"calibrate d -o /nonexistent-planarvo/e.yaml", "-o: the directory /nonexistent-planarvo does not exist"},
       {"posegraph in.g2o -o /nonexistent-planarvo/o.g2o", "-o: the directory /nonexistent-planarvo does not exist"},
+      {"calibrate --motions m.csv -o /nonexistent-planarvo/e.yaml", "-o: the directory /nonexistent-planarvo does not exist"},
   };
   for (const Case& c : cases) {
     auto r = run_cli(c.args);
