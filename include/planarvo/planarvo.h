@@ -165,7 +165,13 @@ typedef struct planarvo_device_info {
 
 /* Lists every OpenCL device. Call with devices = NULL to get the count; then with an array of
  * capacity entries, each with struct_size set. Fails with PLANARVO_ERROR_BUFFER_TOO_SMALL (and
- * sets *count) when capacity is less than the count. A machine without OpenCL has count 0. */
+ * sets *count) when capacity is less than the count. A machine without OpenCL has count 0.
+ * Environment: the first call of this or planarvo_context_create in a process sets
+ * POCL_CACHE_DIR to $TMPDIR/planarvo-<uid>/pocl when it is not set and PoCL could not create
+ * its own cache directory ($XDG_CACHE_HOME/pocl, else $HOME/.cache/pocl; HOME unset or not
+ * writable), since PoCL then finds no device. Setting it changes the process environment
+ * (setenv): make that first call before other threads read the environment, or set
+ * POCL_CACHE_DIR yourself. */
 PLANARVO_API planarvo_status planarvo_list_devices(planarvo_device_info* devices, size_t capacity,
                                                    size_t* count);
 
