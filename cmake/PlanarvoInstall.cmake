@@ -22,8 +22,20 @@ install(FILES ${PROJECT_BINARY_DIR}/planarvoConfig.cmake
               ${PROJECT_BINARY_DIR}/planarvoConfigVersion.cmake
         DESTINATION ${PLANARVO_CMAKE_DIR})
 
-# Paths relative to ${prefix} where the install layout allows, so that `pkg-config
-# --define-prefix` relocates the package; absolute (CMAKE_INSTALL_FULL_*) otherwise.
+# A relocatable pkg-config file: prefix is found from the .pc file's own directory
+# (${pcfiledir}, e.g. ${pcfiledir}/../.. for lib/pkgconfig, one more .. for a multiarch
+# lib/x86_64-linux-gnu), and libdir and includedir are relative to prefix, so the installed tree
+# works wherever it is put (`cmake --install --prefix`, DESTDIR, a moved or unpacked tree) with
+# no `--define-prefix`. A LIBDIR or INCLUDEDIR given as an absolute path stays absolute (and an
+# absolute LIBDIR makes prefix CMAKE_INSTALL_PREFIX): such a layout cannot move.
+set(PLANARVO_PC_DIR ${CMAKE_INSTALL_LIBDIR}/pkgconfig)
+if(IS_ABSOLUTE "${CMAKE_INSTALL_LIBDIR}")
+  set(PLANARVO_PC_PREFIX "${CMAKE_INSTALL_PREFIX}")
+else()
+  file(RELATIVE_PATH up "/prefix/${PLANARVO_PC_DIR}" "/prefix")
+  string(REGEX REPLACE "/$" "" up "${up}")
+  set(PLANARVO_PC_PREFIX "\${pcfiledir}/${up}")
+endif()
 foreach(kind LIBDIR INCLUDEDIR)
   if(IS_ABSOLUTE "${CMAKE_INSTALL_${kind}}")
     set(PLANARVO_PC_${kind} "${CMAKE_INSTALL_FULL_${kind}}")
@@ -32,4 +44,4 @@ foreach(kind LIBDIR INCLUDEDIR)
   endif()
 endforeach()
 configure_file(${PROJECT_SOURCE_DIR}/cmake/planarvo.pc.in ${PROJECT_BINARY_DIR}/planarvo.pc @ONLY)
-install(FILES ${PROJECT_BINARY_DIR}/planarvo.pc DESTINATION ${CMAKE_INSTALL_LIBDIR}/pkgconfig)
+install(FILES ${PROJECT_BINARY_DIR}/planarvo.pc DESTINATION ${PLANARVO_PC_DIR})

@@ -167,7 +167,13 @@ typedef struct planarvo_device_info {
 
 /* Lists every OpenCL device. Call with devices = NULL to get the count; then with an array of
  * capacity entries, each with struct_size set. Fails with PLANARVO_ERROR_BUFFER_TOO_SMALL (and
- * sets *count) when capacity is less than the count. A machine without OpenCL has count 0. */
+ * sets *count) when capacity is less than the count. A machine without OpenCL has count 0.
+ * Environment: the first call of this or planarvo_context_create in a process sets
+ * POCL_CACHE_DIR to $TMPDIR/planarvo-<uid>/pocl when it is not set and PoCL could not create
+ * its own cache directory ($XDG_CACHE_HOME/pocl, else $HOME/.cache/pocl; HOME unset or not
+ * writable), since PoCL then finds no device. Setting it changes the process environment
+ * (setenv): make that first call before other threads read the environment, or set
+ * POCL_CACHE_DIR yourself. */
 PLANARVO_API planarvo_status planarvo_list_devices(planarvo_device_info* devices, size_t capacity,
                                                    size_t* count);
 
@@ -178,7 +184,10 @@ typedef struct planarvo_context_options {
    * case-insensitive substring of "platform name / device name". */
   const char* device;
   /* Directory of the on-disk kernel program cache. NULL: $PLANARVO_CACHE_DIR, else
-   * $XDG_CACHE_HOME/planarvo, else ~/.cache/planarvo. */
+   * $XDG_CACHE_HOME/planarvo, else ~/.cache/planarvo; when that cannot be created or written
+   * (a service user with no home), $TMPDIR/planarvo-<uid>/programs (a directory only this user
+   * can write), else none: kernels are then compiled every time (planarvo_context_cache_dir
+   * returns ""). */
   const char* cache_dir;
   int32_t disable_cache; /* non-zero: always compile from source */
   /* Directory of prebuilt program binaries (planarvo_context_export_kernels). When set, the
@@ -202,6 +211,10 @@ PLANARVO_API planarvo_status planarvo_context_create(const planarvo_context_opti
 PLANARVO_API void planarvo_context_destroy(planarvo_context* context);
 PLANARVO_API planarvo_status planarvo_context_device(const planarvo_context* context,
                                                      planarvo_device_info* info);
+/* The directory of the context's kernel program cache, valid until the context is destroyed;
+ * "" when the cache is off: disable_cache, or no usable default location (see cache_dir). With
+ * kernel_binaries_dir set the cache is not used whatever this says. "" for a NULL context. */
+PLANARVO_API const char* planarvo_context_cache_dir(const planarvo_context* context);
 /* Builds every kernel program variant that the library's calls use with their default options
  * for the context's device and writes the binaries into dir (created if missing), with the
  * manifest planarvo-kernels.txt, for later use with kernel_binaries_dir. Lines of the manifest

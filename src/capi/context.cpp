@@ -101,6 +101,10 @@ PLANARVO_API planarvo_status planarvo_context_device(const planarvo_context* con
   });
 }
 
+PLANARVO_API const char* planarvo_context_cache_dir(const planarvo_context* context) {
+  return context ? context->runtime->cache_dir().c_str() : "";
+}
+
 PLANARVO_API planarvo_status planarvo_context_export_kernels(planarvo_context* context,
                                                              const char* dir) {
   return guard([&] {

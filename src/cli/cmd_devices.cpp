@@ -61,7 +61,8 @@ int cmd_devices(int argc, char** argv) {
   check(planarvo_list_devices(nullptr, 0, &n));
   if (n == 0) {
     std::fprintf(stderr, "planarvo devices: no OpenCL platform or device found "
-                         "(install an ICD, e.g. Debian's pocl-opencl-icd)\n");
+                         "(install an ICD, e.g. Debian's pocl-opencl-icd; PoCL also needs a writable "
+                         "cache directory: set POCL_CACHE_DIR if HOME and TMPDIR are not writable)\n");
     return kExitNoDevice;
   }
   std::vector<planarvo_device_info> devs(n);

@@ -28,7 +28,8 @@ std::vector<OptionSpec> device_options() {
       {"device", "SEL", "OpenCL device: index or name substring (see `planarvo devices`)",
        "$PLANARVO_DEVICE, else first GPU/accelerator, else CPU"},
       {"kernel-binaries", "DIR", "load prebuilt kernel binaries from DIR; never compile", ""},
-      {"cache-dir", "DIR", "kernel program cache directory", "~/.cache/planarvo"},
+      {"cache-dir", "DIR", "kernel program cache directory",
+       "$PLANARVO_CACHE_DIR, else ~/.cache/planarvo, else $TMPDIR/planarvo-UID/programs"},
       {"no-cache", "", "do not use the kernel program cache", ""},
   };
 }
@@ -44,6 +45,12 @@ ContextPtr make_context(const Args& args) {
   o.disable_cache = args.has("no-cache") ? 1 : 0;
   planarvo_context* c = nullptr;
   check(planarvo_context_create(&o, &c));
+  // The library stays silent about a cache it could not place (a service user with no home
+  // and no usable temp directory); the tool says so once, since every run then compiles.
+  if (!o.disable_cache && !o.kernel_binaries_dir && !*planarvo_context_cache_dir(c))
+    std::fprintf(stderr, "planarvo: note: no writable directory for the kernel program cache (HOME, "
+                         "XDG_CACHE_HOME, temp directory), so kernels are compiled on every run; set "
+                         "PLANARVO_CACHE_DIR or --cache-dir, or --no-cache to silence this\n");
   return ContextPtr(c);
 }
 

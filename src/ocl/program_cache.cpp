@@ -9,6 +9,8 @@
 #include <random>
 #include <system_error>
 
+#include "ocl/cache_dirs.h"
+
 namespace planarvo::ocl {
 
 uint64_t fnv1a64(const std::string& s) {
@@ -102,11 +104,11 @@ std::string resolve_cache_dir(const RuntimeOptions& options) {
   if (!options.use_cache) return {};
   if (!options.cache_dir.empty()) return options.cache_dir;
   if (std::string d = env("PLANARVO_CACHE_DIR"); !d.empty()) return d;
-  if (std::string d = env("XDG_CACHE_HOME"); !d.empty())
-    return (std::filesystem::path(d) / "planarvo").string();
-  if (std::string d = env("HOME"); !d.empty())
-    return (std::filesystem::path(d) / ".cache" / "planarvo").string();
-  return {};  // nowhere sensible to cache: build every time
+  // The user's cache directory; for a service user with no home (or one it cannot write), a
+  // private directory under the temp directory; failing both, nothing is cached.
+  if (const auto user = user_cache_dir("planarvo"); cache_dir_usable(user)) return user.string();
+  if (const auto temp = private_temp_dir(); !temp.empty()) return (temp / "programs").string();
+  return {};
 }
 
 std::string cache_key(const std::string& name, const std::string& source,

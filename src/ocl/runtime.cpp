@@ -12,6 +12,7 @@
 #include <system_error>
 
 #include "core/error.h"
+#include "ocl/cache_dirs.h"
 #include "ocl/embedded.h"
 #include "ocl/manifest.h"
 #include "ocl/program_cache.h"
@@ -77,6 +78,7 @@ bool describe(const cl::Platform& platform, const cl::Device& device, DeviceInfo
 std::vector<Found> enumerate() {
   std::vector<Found> out;
   std::vector<cl::Platform> platforms;
+  detail::prepare_driver_environment();  // before a driver reads its environment
   try {
     cl::Platform::get(&platforms);
   } catch (const cl::Error&) {
@@ -230,9 +232,12 @@ Runtime::Runtime(const RuntimeOptions& options) : options_(options) {
     }
   }
   std::vector<Found> all = enumerate();
-  if (all.empty())
+  if (all.empty()) {
+    const std::string& driver_problem = detail::prepare_driver_environment();
     throw Error(ErrorCode::NoDevice,
-                "no OpenCL platform or device found (is an ICD such as pocl-opencl-icd installed?)");
+                "no OpenCL platform or device found (is an ICD such as pocl-opencl-icd installed?)" +
+                    (driver_problem.empty() ? std::string() : ". " + driver_problem));
+  }
   const Found* chosen = nullptr;
   const std::string want = lower(selector);
   if (selector.empty()) {

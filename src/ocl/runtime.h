@@ -40,8 +40,10 @@ struct RuntimeOptions {
   // empty, the environment variable PLANARVO_DEVICE is used.
   std::string device;
   // On-disk program cache; "" means $PLANARVO_CACHE_DIR, else $XDG_CACHE_HOME/planarvo, else
-  // ~/.cache/planarvo. Set use_cache = false to always build from source. A cache directory
-  // that cannot be created or written is not an error: programs are then simply not cached.
+  // ~/.cache/planarvo, and when that cannot be created or written (a service user with no
+  // home), <temp>/planarvo-<uid>/programs (cache_dirs.h), else none. Set use_cache = false to
+  // always build from source. A cache directory that cannot be created or written is not an
+  // error: programs are then simply not cached.
   std::string cache_dir;
   bool use_cache = true;
   // When set, programs are loaded from prebuilt binaries in this directory
@@ -78,7 +80,9 @@ inline constexpr const char* kUseSimulate = "simulate";    // the simulator's re
 
 // Every platform's devices, in the order `planarvo devices` lists them. Never throws for a
 // machine without OpenCL: returns an empty list. A platform or device that cannot be queried
-// is left out.
+// is left out. The first call in a process (this, or a Runtime's construction) may set
+// POCL_CACHE_DIR first, for a user whose home PoCL cannot write (cache_dirs.h); a program
+// that queries OpenCL itself before that gets PoCL's own behaviour.
 std::vector<DeviceInfo> list_devices();
 
 class Runtime {
@@ -131,7 +135,8 @@ class Runtime {
   static std::vector<std::string> known_uses();
 
   ProgramStats stats() const;
-  // The program cache directory in use; "" when caching is off.
+  // The program cache directory in use; "" when caching is off (use_cache = false, or no
+  // usable default location).
   const std::string& cache_dir() const { return cache_dir_; }
   // The options a program is actually built with: the normalised options plus what the
   // device needs (-cl-std=CL1.2).

@@ -48,7 +48,8 @@ struct CommandResult {
 
 // Runs the planarvo command-line tool with the given arguments (a shell-quoted string), and
 // with env (shell-quoted NAME=value words, e.g. "POCL_CACHE_DIR=/tmp/x") added to its
-// environment.
+// environment. env is passed to env(1), so "-u NAME" words, before any NAME=value, remove a
+// variable (e.g. "-u HOME TMPDIR=/tmp/x").
 inline CommandResult run_cli(const std::string& args, const std::string& env = "") {
   const std::string cmd = (env.empty() ? "" : "env " + env + " ") + "\"" + PLANARVO_CLI_PATH +
                           "\" " + args + " 2>&1";

@@ -1,24 +1,45 @@
-# CTest script: install the built planarvo into a scratch prefix, then configure, build and run
-# test/consumer against it through find_package and through pkg-config.
+# CTest script: install the built planarvo into a scratch prefix, move the installed tree
+# elsewhere (an installed package must not depend on where it was installed), then configure,
+# build and run test/consumer against the moved tree through find_package and through
+# pkg-config, and build the same program with nothing but `cc $(pkg-config --cflags --libs
+# planarvo)`, as a Makefile user would.
 # Variables: BUILD_DIR (planarvo's build), SOURCE_DIR (test/consumer), WORK_DIR (scratch),
-# CONSUMER_C_FLAGS (the sanitizer flags when planarvo is built with them).
+# C_COMPILER, CONSUMER_C_FLAGS (the sanitizer flags when planarvo is built with them).
 file(REMOVE_RECURSE ${WORK_DIR})
-set(prefix ${WORK_DIR}/prefix)
+set(installed ${WORK_DIR}/installed)
+set(prefix ${WORK_DIR}/moved)
 function(run)
   execute_process(COMMAND ${ARGN} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
   if(NOT rc EQUAL 0)
     message(FATAL_ERROR "failed (${rc}): ${ARGN}\n${out}\n${err}")
   endif()
   message(STATUS "${out}")
+  set(run_output "${out}" PARENT_SCOPE)
 endfunction()
-run(${CMAKE_COMMAND} --install ${BUILD_DIR} --prefix ${prefix})
+run(${CMAKE_COMMAND} --install ${BUILD_DIR} --prefix ${installed})
+file(RENAME ${installed} ${prefix})
 file(GLOB_RECURSE pcfile ${prefix}/*/planarvo.pc)
 get_filename_component(pcdir "${pcfile}" DIRECTORY)
+get_filename_component(libdir "${pcdir}" DIRECTORY)
+
+# Plain pkg-config, no --define-prefix: the flags must point into the moved tree.
+find_program(PKG_CONFIG pkg-config pkgconf REQUIRED)
+run(${CMAKE_COMMAND} -E env PKG_CONFIG_PATH=${pcdir} ${PKG_CONFIG} --cflags --libs planarvo)
+string(STRIP "${run_output}" flags)
+string(FIND "${flags}" "-I${prefix}/" at_include)
+string(FIND "${flags}" "-L${prefix}/" at_lib)
+if(at_include EQUAL -1 OR at_lib EQUAL -1)
+  message(FATAL_ERROR "pkg-config flags do not point into ${prefix}: ${flags}")
+endif()
+separate_arguments(flags UNIX_COMMAND "${flags}")
+separate_arguments(c_flags UNIX_COMMAND "${CONSUMER_C_FLAGS}")
+run(${C_COMPILER} ${c_flags} ${SOURCE_DIR}/consumer.c -o ${WORK_DIR}/consumer_cc ${flags})
+run(${CMAKE_COMMAND} -E env LD_LIBRARY_PATH=${libdir} ${WORK_DIR}/consumer_cc)
+
 run(${CMAKE_COMMAND} -E env PKG_CONFIG_PATH=${pcdir}
     ${CMAKE_COMMAND} -S ${SOURCE_DIR} -B ${WORK_DIR}/build -DCMAKE_PREFIX_PATH=${prefix}
-    -DPKG_CONFIG_ARGN=--define-prefix "-DCMAKE_C_FLAGS=${CONSUMER_C_FLAGS}")
+    "-DCMAKE_C_FLAGS=${CONSUMER_C_FLAGS}")
 run(${CMAKE_COMMAND} --build ${WORK_DIR}/build)
-get_filename_component(libdir "${pcdir}" DIRECTORY)
 run(${CMAKE_COMMAND} -E env LD_LIBRARY_PATH=${libdir} ${WORK_DIR}/build/consumer)
 run(${CMAKE_COMMAND} -E env LD_LIBRARY_PATH=${libdir} ${WORK_DIR}/build/consumer_pkgconfig)
 # The installed tool finds its library through its RPATH, with no environment help.

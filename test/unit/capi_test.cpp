@@ -77,6 +77,25 @@ TEST(CApi, ContextOnDefaultDevice) {
   planarvo_context_destroy(c);
 }
 
+// Where the program cache is: the option when given, "" when the cache is off or the context
+// is NULL. (The default location and its fallbacks are OclCache's tests.)
+TEST(CApi, ContextCacheDir) {
+  planarvo::test::ScratchDir d;
+  const std::string dir = (d / "cache").string();
+  planarvo_context_options o;
+  planarvo_context_options_init(&o);
+  o.cache_dir = dir.c_str();
+  planarvo_context* c = nullptr;
+  ASSERT_EQ(planarvo_context_create(&o, &c), PLANARVO_OK) << planarvo_last_error();
+  EXPECT_EQ(std::string(planarvo_context_cache_dir(c)), dir);
+  planarvo_context_destroy(c);
+  o.disable_cache = 1;
+  ASSERT_EQ(planarvo_context_create(&o, &c), PLANARVO_OK) << planarvo_last_error();
+  EXPECT_EQ(std::string(planarvo_context_cache_dir(c)), "");
+  planarvo_context_destroy(c);
+  EXPECT_EQ(std::string(planarvo_context_cache_dir(nullptr)), "");
+}
+
 // The FPGA path's export: by use, with the count written, and names that are not uses refused.
 TEST(CApi, ExportKernelsForAUse) {
   planarvo_context* c = nullptr;

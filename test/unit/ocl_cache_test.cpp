@@ -1,5 +1,5 @@
 // The on-disk program cache (src/ocl/program_cache.h): hits, misses, corrupt and stale entries,
-// unwritable directories. Each test names its own cache directory instead of the
+// unwritable directories, and where it lives by default (src/ocl/cache_dirs.h). Each test names its own cache directory instead of the
 // PLANARVO_CACHE_DIR that CTest sets.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -8,7 +8,11 @@
 #include <fstream>
 #include <set>
 
+#include <unistd.h>
+
 #include "core/error.h"
+#include "ocl/cache_dirs.h"
+#include "ocl/program_cache.h"
 #include "ocl/runtime.h"
 #include "common/test_util.h"
 #include "unit/ocl_test_helpers.h"
@@ -190,6 +194,76 @@ TEST(OclCache, DirectoryComesFromOptionsThenEnvironment) {
     test::ScopedEnv home("HOME", (scratch / "home").string().c_str());
     EXPECT_EQ(ocl::Runtime().cache_dir(), (scratch / "home" / ".cache" / "planarvo").string());
   }
+}
+
+TEST(OclCache, CacheDirUsableWhenItIsOrCanBeAWritableDirectory) {
+  test::ScratchDir scratch;
+  std::ofstream(scratch / "file") << "x";
+  EXPECT_TRUE(ocl::detail::cache_dir_usable(scratch.path()));
+  EXPECT_TRUE(ocl::detail::cache_dir_usable(scratch / "missing" / "deeper"));
+  EXPECT_FALSE(ocl::detail::cache_dir_usable(scratch / "file"));
+  EXPECT_FALSE(ocl::detail::cache_dir_usable(scratch / "file" / ".cache" / "planarvo"));
+  EXPECT_FALSE(ocl::detail::cache_dir_usable(""));
+  EXPECT_FALSE(fs::exists(scratch / "missing"));  // asking creates nothing
+}
+
+// A service user with no home, or a home it cannot write, caches in <temp>/planarvo-<uid>, a
+// directory only it can enter; with no usable temp directory either, nothing is cached.
+TEST(OclCache, DefaultWithoutAHomeIsAPrivateTempDirectory) {
+  test::ScratchDir scratch;
+  fs::create_directories(scratch / "tmp");
+  std::ofstream(scratch / "file") << "x";
+  test::ScopedEnv no_env("PLANARVO_CACHE_DIR", nullptr);
+  test::ScopedEnv no_xdg("XDG_CACHE_HOME", nullptr);
+  test::ScopedEnv tmp("TMPDIR", (scratch / "tmp").c_str());
+  const fs::path private_dir = scratch / "tmp" / ("planarvo-" + std::to_string(::geteuid()));
+  const std::string in_temp = (private_dir / "programs").string();
+  {
+    test::ScopedEnv no_home("HOME", nullptr);
+    EXPECT_EQ(ocl::detail::resolve_cache_dir({}), in_temp);
+    EXPECT_EQ(fs::symlink_status(private_dir).permissions(), fs::perms::owner_all);
+    ocl::RuntimeOptions off;
+    off.use_cache = false;
+    EXPECT_EQ(ocl::detail::resolve_cache_dir(off), "");
+  }
+  {
+    test::ScopedEnv home("HOME", (scratch / "file").c_str());  // cannot hold a .cache
+    EXPECT_EQ(ocl::detail::resolve_cache_dir({}), in_temp);
+  }
+  {
+    test::ScopedEnv xdg("XDG_CACHE_HOME", (scratch / "file").c_str());
+    EXPECT_EQ(ocl::detail::resolve_cache_dir({}), in_temp);
+  }
+  {
+    test::ScopedEnv home("HOME", (scratch / "home").c_str());  // missing, but can be made
+    EXPECT_EQ(ocl::detail::resolve_cache_dir({}), (scratch / "home" / ".cache" / "planarvo").string());
+  }
+  {
+    test::ScopedEnv no_home("HOME", nullptr);
+    test::ScopedEnv bad_tmp("TMPDIR", (scratch / "file").c_str());
+    EXPECT_EQ(ocl::detail::resolve_cache_dir({}), "");
+  }
+}
+
+// Another user could plant binaries in a directory it can write: such a directory, or a
+// symlink in its place, is refused.
+TEST(OclCache, PrivateTempDirectoryIsRefusedWhenOthersCanWriteIt) {
+  test::ScratchDir scratch;
+  fs::create_directories(scratch / "tmp");
+  test::ScopedEnv tmp("TMPDIR", (scratch / "tmp").c_str());
+  const fs::path private_dir = scratch / "tmp" / ("planarvo-" + std::to_string(::geteuid()));
+  fs::create_directories(private_dir);
+  fs::permissions(private_dir, fs::perms::all);
+  EXPECT_EQ(ocl::detail::private_temp_dir(), fs::path());
+  fs::permissions(private_dir, fs::perms::owner_all | fs::perms::group_read |
+                                   fs::perms::group_exec | fs::perms::others_read |
+                                   fs::perms::others_exec);
+  EXPECT_EQ(ocl::detail::private_temp_dir(), private_dir);
+  fs::remove(private_dir);
+  fs::create_directories(scratch / "elsewhere");
+  fs::permissions(scratch / "elsewhere", fs::perms::owner_all);
+  fs::create_directory_symlink(scratch / "elsewhere", private_dir);
+  EXPECT_EQ(ocl::detail::private_temp_dir(), fs::path());
 }
 
 }  // namespace
