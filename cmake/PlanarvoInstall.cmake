@@ -9,6 +9,10 @@ install(TARGETS planarvo EXPORT planarvoTargets
   PUBLIC_HEADER DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/planarvo)
 set_target_properties(planarvo_cli PROPERTIES INSTALL_RPATH "$ORIGIN/../${CMAKE_INSTALL_LIBDIR}")
 install(TARGETS planarvo_cli RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
+# The licence and the user documentation (file formats, conventions, outputs) go where Debian
+# puts a package's: <prefix>/share/doc/planarvo.
+install(FILES ${PROJECT_SOURCE_DIR}/LICENSE ${PROJECT_SOURCE_DIR}/README.md DESTINATION ${CMAKE_INSTALL_DOCDIR})
+install(DIRECTORY ${PROJECT_SOURCE_DIR}/docs/ DESTINATION ${CMAKE_INSTALL_DOCDIR})
 install(FILES ${PROJECT_SOURCE_DIR}/data/textures/asphalt_01.png
         DESTINATION ${CMAKE_INSTALL_DATADIR}/planarvo/textures)
 
