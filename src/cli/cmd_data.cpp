@@ -221,7 +221,7 @@ int cmd_info(int argc, char** argv) {
   Args args(specs, argc, argv, 1);
   if (args.has("help")) {
     std::printf("usage: planarvo info DATASET [--verify] [--video FILE]\n\n"
-                "Reads a data set (shared layout: camera.yaml, frames.txt, images/, optional odometry.txt,\n"
+                "Reads a data set (docs/formats.md: camera.yaml, frames.txt, images/, optional odometry.txt,\n"
                 "direction.txt, groundtruth.txt, extrinsics.yaml), checks it and prints what it holds.\n\n%s",
                 format_options(specs).c_str());
     return kExitOk;

@@ -14,7 +14,7 @@ const std::vector<Command>& commands() {
   static const std::vector<Command> all = {
       {"demo", "simulate a short drive over a real texture, run the engine, print accuracy", cmd_demo},
       {"track", "dense visual odometry over a data set: trajectory, statistics, accuracy", cmd_track},
-      {"calibrate", "calibrate the sensor's pose on the robot from motion pairs (CSV)", cmd_calibrate},
+      {"calibrate", "the camera's pose on the robot from a drive (data set) or from motion pairs (CSV)", cmd_calibrate},
       {"posegraph", "optimise a 2-D pose graph (g2o format)", cmd_posegraph},
       {"simulate", "render a synthetic data set with exact ground truth", cmd_simulate},
       {"info", "read and check a data set, print what it holds", cmd_info},
