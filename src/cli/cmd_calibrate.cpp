@@ -34,6 +34,18 @@ void print_result(const planarvo_camera_calibration_result& r) {
 
 }  // namespace
 
+planarvo_status calibrate_dataset(planarvo_context* ctx, planarvo_dataset* ds,
+                                  planarvo_camera_calibration_options* options, Progress* progress,
+                                  planarvo_camera_calibration_result* result) {
+  options->progress = &Progress::callback;
+  options->progress_user_data = progress;
+  result->struct_size = sizeof *result;
+  const planarvo_status st = planarvo_calibrate_dataset(ctx, ds, options, result);
+  progress->finish();
+  if (st != PLANARVO_OK && st != PLANARVO_ERROR_FAILED) check(st);
+  return st;
+}
+
 int cmd_calibrate_dataset(const Args& args, const planarvo_calibration_options& graph) {
   const std::string dir = args.positionals()[0];
   planarvo_camera_calibration_options o;
@@ -75,13 +87,8 @@ int cmd_calibrate_dataset(const Args& args, const planarvo_calibration_options& 
                            "nonholonomic with direction.txt and --height)");
   if (o.method == PLANARVO_CALIBRATE_NONHOLONOMIC && !info.has_direction)
     throw UsageError(dir + " has no direction.txt: the nonholonomic method needs the direction labels");
-  o.progress = &Progress::callback;
-  o.progress_user_data = &progress;
   planarvo_camera_calibration_result r{};
-  r.struct_size = sizeof r;
-  const planarvo_status st = planarvo_calibrate_dataset(ctx.get(), ds.get(), &o, &r);
-  progress.finish();
-  if (st != PLANARVO_OK && st != PLANARVO_ERROR_FAILED) check(st);
+  const planarvo_status st = calibrate_dataset(ctx.get(), ds.get(), &o, &progress, &r);
 
   std::printf("calibrated %s (%s) on %s\n", dir.c_str(), method.c_str(), device_name(ctx.get()).c_str());
   if (r.roll_pitch.status == PLANARVO_CALIBRATION_OK && r.roll_pitch.keyframes > 0)

@@ -314,13 +314,8 @@ int cmd_demo(int argc, char** argv) {
   t0 = std::chrono::steady_clock::now();
   planarvo_camera_calibration_options co;
   planarvo_camera_calibration_options_init(&co);
-  co.progress = &Progress::callback;
-  co.progress_user_data = &progress;
   planarvo_camera_calibration_result cr{};
-  cr.struct_size = sizeof cr;
-  const planarvo_status cs = planarvo_calibrate_dataset(ctx.get(), ds.get(), &co, &cr);
-  progress.finish();
-  if (cs != PLANARVO_OK && cs != PLANARVO_ERROR_FAILED) check(cs);
+  const planarvo_status cs = calibrate_dataset(ctx.get(), ds.get(), &co, &progress, &cr);
   std::printf("\n5. calibrated the camera from the images and the wheel odometry in %.1f s (planarvo calibrate):\n",
               seconds_since(t0));
   if (cs == PLANARVO_ERROR_FAILED) {

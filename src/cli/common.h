@@ -71,6 +71,13 @@ TrackRun track_dataset(planarvo_context* ctx, planarvo_dataset* ds, const planar
                        const planarvo_tracker_options& options, const TrackOutputs& outputs, Progress* progress);
 void print_track_run(const TrackRun& run);
 
+// The camera calibration of a data set (cmd_calibrate.cpp), for `calibrate` and `demo`, with the
+// progress bar: *result filled, status PLANARVO_OK or PLANARVO_ERROR_FAILED (the result says
+// why); any other status is thrown.
+planarvo_status calibrate_dataset(planarvo_context* ctx, planarvo_dataset* ds,
+                                  planarvo_camera_calibration_options* options, Progress* progress,
+                                  planarvo_camera_calibration_result* result);
+
 // The motion from pose a to pose b, in a's frame (a^-1 b).
 planarvo_se2 relative(const planarvo_se2& a, const planarvo_se2& b);
 

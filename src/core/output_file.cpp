@@ -1,8 +1,12 @@
 #include "core/output_file.h"
 
+#include <atomic>
 #include <cerrno>
+#include <chrono>
+#include <cstdint>
 #include <cstdio>
 #include <filesystem>
+#include <random>
 #include <system_error>
 
 #include "core/error.h"
@@ -18,10 +22,23 @@ bool write_directly(const std::string& path) {
   return !ec && std::filesystem::exists(st) && !std::filesystem::is_regular_file(st);
 }
 
+// A suffix no other writer (thread or process) picks at the same time.
+std::string unique_suffix() {
+  static std::atomic<uint64_t> counter{0};
+  const uint64_t unique =
+      (static_cast<uint64_t>(std::random_device{}()) << 32) ^
+      static_cast<uint64_t>(std::chrono::steady_clock::now().time_since_epoch().count()) ^
+      (counter.fetch_add(1) * 0x9e3779b97f4a7c15ull);
+  char buf[20];
+  std::snprintf(buf, sizeof buf, "-%016llx", static_cast<unsigned long long>(unique));
+  return buf;
+}
+
 }  // namespace
 
-OutputFile::OutputFile(std::string path) : path_(std::move(path)) {
-  temporary_ = write_directly(path_) ? path_ : path_ + kSuffix;
+OutputFile::OutputFile(std::string path, Temporary temporary) : path_(std::move(path)) {
+  temporary_ = write_directly(path_) ? path_
+               : path_ + kSuffix + (temporary == Temporary::Unique ? unique_suffix() : std::string());
   file_ = std::fopen(temporary_.c_str(), "wb");
   if (!file_) fail("cannot open for writing", errno);
 }

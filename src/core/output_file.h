@@ -4,7 +4,9 @@
 // destroyed or discarded without commit() removes its temporary: a command that stops on an
 // error writes nothing and overwrites nothing. A crash of the process leaves what was written
 // in DEST.partial. A destination that exists and is not a regular file (a device such as
-// /dev/stdout, a pipe) is written directly, as there is nothing to rename onto.
+// /dev/stdout, a pipe) is written directly, as there is nothing to rename onto. Where several
+// threads or processes may write the same file at once (a shared cache), each takes a
+// temporary name of its own (Temporary::Unique, DEST.partial-<random>) and the last rename wins.
 #pragma once
 #include <cstdio>
 #include <string>
@@ -13,8 +15,9 @@ namespace planarvo {
 
 class OutputFile {
  public:
+  enum class Temporary { Fixed, Unique };
   // Opens the temporary for writing (binary). Error(Io) naming the destination when it cannot.
-  explicit OutputFile(std::string path);
+  explicit OutputFile(std::string path, Temporary temporary = Temporary::Fixed);
   ~OutputFile();  // discard() without reporting
   OutputFile(const OutputFile&) = delete;
   OutputFile& operator=(const OutputFile&) = delete;
@@ -28,7 +31,6 @@ class OutputFile {
   // Closes and removes the temporary; the destination is left as it was.
   void discard() noexcept;
   const std::string& path() const { return path_; }
-  const std::string& temporary_path() const { return temporary_; }
 
   static constexpr const char* kSuffix = ".partial";
 

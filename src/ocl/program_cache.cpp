@@ -1,14 +1,14 @@
 // The on-disk program cache: key, location, entry format (see program_cache.h).
 #include "ocl/program_cache.h"
 
-#include <atomic>
-#include <chrono>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
-#include <random>
 #include <system_error>
 
+#include "core/error.h"
+#include "core/output_file.h"
 #include "ocl/cache_dirs.h"
 
 namespace planarvo::ocl {
@@ -174,33 +174,15 @@ std::optional<std::vector<unsigned char>> read_file(const std::filesystem::path&
 
 bool write_file_atomically(const std::filesystem::path& path, const unsigned char* data,
                            size_t size) {
-  // A name no other writer (thread or process) picks at the same time; rename() then replaces
-  // the target in one step.
-  static std::atomic<uint64_t> counter{0};
-  const uint64_t unique =
-      (static_cast<uint64_t>(std::random_device{}()) << 32) ^
-      static_cast<uint64_t>(std::chrono::steady_clock::now().time_since_epoch().count()) ^
-      (counter.fetch_add(1) * 0x9e3779b97f4a7c15ull);
-  std::filesystem::path tmp = path;
-  tmp += ".tmp-" + hex64(unique);
-  {
-    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-    if (!out) return false;
-    out.write(reinterpret_cast<const char*>(data), static_cast<std::streamsize>(size));
-    out.close();
-    if (!out) {
-      std::error_code ec;
-      std::filesystem::remove(tmp, ec);
-      return false;
-    }
-  }
-  std::error_code ec;
-  std::filesystem::rename(tmp, path, ec);
-  if (ec) {
-    std::filesystem::remove(tmp, ec);
+  // Other threads and processes may write the same entry: each under a name of its own.
+  try {
+    OutputFile out(path.string(), OutputFile::Temporary::Unique);
+    if (size > 0 && std::fwrite(data, 1, size, out.stream()) != size) return false;  // discarded
+    out.commit();
+    return true;
+  } catch (const Error&) {
     return false;
   }
-  return true;
 }
 
 }  // namespace detail

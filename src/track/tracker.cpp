@@ -176,10 +176,10 @@ struct Tracker::Impl {
   // The alignment's covariance from the finest level's sums (TrackerOptions::
   // covariance_step_fraction, README.md "Covariance"): s is the last pass at the estimate, st
   // the STATS pass that opened the level (the same pass when the level took one). n = 3 or 5
-  // parameters, brightness marginalised by taking the motion block.
-  Eigen::Matrix3d alignment_covariance(const ReduceSums& s, const ReduceSums& st, int n, double floor_s2) const {
-    const MatrixJ A = s.JtWJ.topLeftCorner(n, n);
-    const Eigen::LDLT<MatrixJ> ldlt(A);
+  // parameters, brightness marginalised by taking the motion block; A = s's J^T W J (n x n) and
+  // ldlt its factorisation.
+  Eigen::Matrix3d alignment_covariance(const ReduceSums& s, const ReduceSums& st, int n, double floor_s2,
+                                       const MatrixJ& A, const Eigen::LDLT<MatrixJ>& ldlt) const {
     // Bread: the Huber cost's Hessian, J^T J over the inliers (J^T W J also counts the pixels
     // beyond the threshold, with weight k / |r|, and would understate the spread).
     const ReduceSums& hs = s.has_stats ? s : st;
@@ -222,15 +222,14 @@ struct Tracker::Impl {
     // constrains the motion (the thresholds below were measured with it).
     const double floor_s2 = opt.min_sigma * opt.min_sigma;
     const double s2 = std::max(s.wrr / dof, floor_s2);
-    MatrixJ A = s.JtWJ.topLeftCorner(n, n);
-    Eigen::LDLT<MatrixJ> ldlt(A);
-    MatrixJ I = MatrixJ::Identity(n, n);
-    const MatrixJ inv = ldlt.solve(I);
+    const MatrixJ A = s.JtWJ.topLeftCorner(n, n);
+    const Eigen::LDLT<MatrixJ> ldlt(A);
+    const MatrixJ inv = ldlt.solve(MatrixJ::Identity(n, n));
     Eigen::Matrix3d independent = s2 * inv.topLeftCorner(3, 3);
     if (!independent.allFinite()) independent = lost_covariance();
-    res->alignment_covariance = alignment_covariance(s, report.finest_stats[0], n, floor_s2);
+    // The motion's covariance is composed from this one by the caller (track_gray).
+    res->alignment_covariance = alignment_covariance(s, report.finest_stats[0], n, floor_s2, A, ldlt);
     if (!res->alignment_covariance.allFinite()) res->alignment_covariance = lost_covariance();
-    res->motion.covariance = res->alignment_covariance;
 
     const ReduceSums& st = report.finest_stats[0];
     const double var_ref = st.valid > 0 ? st.iref2 / st.valid - std::pow(st.iref / st.valid, 2) : 0.0;
