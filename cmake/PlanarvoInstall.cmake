@@ -7,6 +7,8 @@ install(TARGETS planarvo EXPORT planarvoTargets
   ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
   RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR}
   PUBLIC_HEADER DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/planarvo)
+# The vision module (src/capi/README.md), found by the library relative to itself.
+install(TARGETS planarvo_vision LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}/planarvo)
 set_target_properties(planarvo_cli PROPERTIES INSTALL_RPATH "$ORIGIN/../${CMAKE_INSTALL_LIBDIR}")
 install(TARGETS planarvo_cli RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
 # The licence and the user documentation (file formats, conventions, outputs) go where Debian

@@ -8,7 +8,6 @@
 
 #include "capi/convert.h"
 #include "capi/graph_convert.h"
-#include "capi/handles.h"
 #include "capi/status.h"
 #include "core/error.h"
 #include "graph/calibration.h"

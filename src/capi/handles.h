@@ -1,8 +1,6 @@
-// The structs behind the C API's opaque handles, and the exception for output buffers that are
-// too small. Only src/capi includes this.
+// The structs behind the C API's opaque handles. Only src/capi includes this.
 #pragma once
 #include <memory>
-#include <stdexcept>
 #include <string>
 
 #include <opencv2/core.hpp>
@@ -19,9 +17,3 @@ struct planarvo_dataset {
   std::unique_ptr<planarvo::io::Dataset> dataset;
   cv::Mat frame;  // the last decoded frame, which planarvo_dataset_frame's image points into
 };
-
-namespace planarvo::capi {
-struct BufferTooSmall : std::runtime_error {
-  using std::runtime_error::runtime_error;
-};
-}  // namespace planarvo::capi

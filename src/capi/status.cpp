@@ -1,19 +1,16 @@
 #include "capi/status.h"
 
+#include <atomic>
 #include <new>
 #include <stdexcept>
 
-#include <CL/opencl.hpp>
-#include <opencv2/core.hpp>
-
-#include "capi/handles.h"
 #include "core/error.h"
-#include "ocl/runtime.h"
 
 namespace planarvo::capi {
 namespace {
 
 thread_local std::string t_last_error;
+std::atomic<ErrorSink> g_error_sink{nullptr};
 
 planarvo_status to_status(ErrorCode code) {
   switch (code) {
@@ -31,7 +28,13 @@ planarvo_status to_status(ErrorCode code) {
 
 }  // namespace
 
+void set_error_sink(ErrorSink sink) noexcept { g_error_sink.store(sink); }
+
 planarvo_status fail(planarvo_status status, const std::string& message) {
+  if (const ErrorSink sink = g_error_sink.load()) {
+    sink(message.c_str());
+    return status;
+  }
   try {
     t_last_error = message;
   } catch (...) {
@@ -47,15 +50,10 @@ planarvo_status translate_current_exception() noexcept {
     return fail(to_status(e.code()), e.what());
   } catch (const BufferTooSmall& e) {
     return fail(PLANARVO_ERROR_BUFFER_TOO_SMALL, e.what());
-  } catch (const cl::Error& e) {
-    return fail(PLANARVO_ERROR_OPENCL,
-                std::string(e.what()) + " failed: " + ocl::error_name(e.err()));
-  } catch (const cv::Exception& e) {
-    return fail(PLANARVO_ERROR_INTERNAL, std::string("OpenCV: ") + e.what());
   } catch (const std::bad_alloc&) {
     return fail(PLANARVO_ERROR_INTERNAL, "out of memory");
   } catch (const std::exception& e) {
-    return fail(PLANARVO_ERROR_INTERNAL, std::string("internal error: ") + e.what());
+    return translate_foreign_exception(e);
   } catch (...) {
     return fail(PLANARVO_ERROR_INTERNAL, "internal error: unknown exception");
   }
