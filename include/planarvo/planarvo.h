@@ -256,6 +256,11 @@ typedef struct planarvo_dataset_options {
   int32_t verify_images;
   planarvo_progress_fn progress;
   void* progress_user_data;
+  /* Non-zero: an image that frames.txt lists but that does not exist is not an error at open
+   * (it is by default, found by one file-system check per image); reading its frame fails with
+   * PLANARVO_ERROR_INVALID_INPUT, like an undecodable image, for callers that skip bad frames
+   * (planarvo track --skip-bad-frames). Ignored with verify_images. */
+  int32_t allow_missing_images;
 } planarvo_dataset_options;
 
 /* What a data set holds. */

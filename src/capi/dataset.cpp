@@ -33,6 +33,8 @@ PLANARVO_API planarvo_status planarvo_dataset_open(const char* directory, const 
                                           "planarvo_dataset_options");
       if (options->video) o.video = options->video;
       o.verify_images = options->verify_images != 0;
+      if (options->struct_size >= offsetof(planarvo_dataset_options, allow_missing_images) + sizeof(int32_t))
+        o.allow_missing_images = options->allow_missing_images != 0 && !o.verify_images;
       if (options->progress) {
         const planarvo_progress_fn fn = options->progress;
         void* user = options->progress_user_data;

@@ -31,6 +31,75 @@ struct TrackerDeleter {
   void operator()(planarvo_tracker* t) const { planarvo_tracker_destroy(t); }
 };
 
+// The tracked frames of a run (a skipped frame has none), for the trajectory, the motion pairs
+// and the accuracy.
+struct Tracked {
+  std::vector<double> t;
+  std::vector<planarvo_se2> pose, motion, truth;
+  std::vector<int32_t> valid;  // the motion since the previous tracked frame is measured
+  bool all_truth = true;
+};
+
+// The motion pair of a tracked interval, with the data set's odometry and direction label when
+// it has them; none for an interval the odometry or the labels do not cover, so that every row
+// has the same columns.
+bool motion_pair(const planarvo_dataset_info& info, const planarvo_frame_data& previous,
+                 const planarvo_frame_data& fd, const planarvo_track_result& r, planarvo_motion_pair* p) {
+  if (r.status != PLANARVO_TRACK_OK && r.status != PLANARVO_TRACK_DEGRADED) return false;
+  if (info.has_odometry && !(fd.has_odometry && previous.has_odometry)) return false;
+  if (info.has_direction && !fd.has_direction) return false;
+  planarvo_motion_pair_init(p);
+  p->interval = fd.timestamp - previous.timestamp;
+  p->sensor = r.motion;
+  p->has_sensor_covariance = 1;
+  for (int k = 0; k < 9; ++k) p->sensor_covariance[k] = r.covariance[k];
+  p->has_odometry = info.has_odometry;
+  if (p->has_odometry) p->odometry = relative(previous.odometry, fd.odometry);
+  p->has_direction = info.has_direction;
+  p->direction = fd.direction;
+  return p->interval > 0;
+}
+
+planarvo_frame_stats stats_row(const planarvo_frame_data& fd, double dt, const planarvo_track_result& r) {
+  planarvo_frame_stats row{};
+  row.timestamp = fd.timestamp;
+  row.vx = dt > 0 ? r.motion.x / dt : 0;
+  row.vy = dt > 0 ? r.motion.y / dt : 0;
+  row.omega = dt > 0 ? r.motion.theta / dt : 0;
+  for (int l = 0; l < 8; ++l) row.iterations += r.iterations[l];
+  row.final_cost = r.final_cost;
+  row.inlier_fraction = r.inlier_fraction;
+  row.ms = r.ms;
+  row.status = status_label(r.status);
+  return row;
+}
+
+void count(const planarvo_track_result& r, TrackRun* run) {
+  ++run->frames;
+  run->ms.push_back(r.ms);
+  run->engine_ms += r.ms;
+  run->keyframes += r.keyframe ? 1 : 0;
+  if (r.status == PLANARVO_TRACK_OK || r.status == PLANARVO_TRACK_FIRST) ++run->ok;
+  if (r.status == PLANARVO_TRACK_DEGRADED) ++run->degraded;
+  if (r.status == PLANARVO_TRACK_LOST) ++run->lost;
+}
+
+void evaluate(const Tracked& k, TrackRun* run) {
+  const size_t n = k.t.size();
+  if (!k.all_truth || n < 2) return;
+  std::vector<planarvo_se2> est(n - 1), tru(n - 1);
+  std::vector<double> dt(n - 1);
+  for (size_t i = 1; i < n; ++i) {
+    est[i - 1] = k.motion[i];
+    tru[i - 1] = relative(k.truth[i - 1], k.truth[i]);
+    dt[i - 1] = k.t[i] - k.t[i - 1];
+  }
+  run->accuracy.struct_size = sizeof run->accuracy;
+  check(planarvo_evaluate_motions(est.data(), tru.data(), dt.data(), k.valid.data() + 1, n - 1, 1e-3,
+                                  &run->accuracy));
+  run->has_accuracy = true;
+}
+
 }  // namespace
 
 TrackRun track_dataset(planarvo_context* ctx, planarvo_dataset* ds, const planarvo_extrinsics& extrinsics,
@@ -48,86 +117,55 @@ TrackRun track_dataset(planarvo_context* ctx, planarvo_dataset* ds, const planar
     stats.reset(w);
   }
   TrackRun run;
-  const auto n = static_cast<size_t>(info.frame_count);
-  std::vector<double> t(n);
-  std::vector<planarvo_se2> pose(n), motion(n), truth(n);
-  std::vector<int32_t> valid(n, 0);
-  bool all_truth = info.has_groundtruth != 0;
-  // Motion pairs: every tracked interval, with the data set's odometry and direction label when it
-  // has them (an interval the odometry or the labels do not cover is left out, so that every row
-  // has the same columns).
+  Tracked k;
   std::vector<planarvo_motion_pair> pairs;
-  planarvo_frame_data previous{};
+  planarvo_frame_data previous{};  // the last tracked frame's
+  const auto n = static_cast<size_t>(info.frame_count);
   for (size_t i = 0; i < n; ++i) {
+    if (progress) Progress::callback(progress, static_cast<double>(i) / static_cast<double>(n), "tracking");
     planarvo_frame_data fd{};
     check(planarvo_dataset_frame_data(ds, static_cast<int64_t>(i), &fd));
     planarvo_image img{};
-    check(planarvo_dataset_frame(ds, static_cast<int64_t>(i), &img));
+    const planarvo_status read = planarvo_dataset_frame(ds, static_cast<int64_t>(i), &img);
+    if (read == PLANARVO_ERROR_INVALID_INPUT && outputs.skip_bad_frames) {
+      const std::string warning = "planarvo track: skipping frame " + std::to_string(i) + ": " + planarvo_last_error();
+      if (progress) progress->warn(warning);
+      else std::fprintf(stderr, "%s\n", warning.c_str());
+      ++run.skipped;
+      if (stats) {
+        planarvo_frame_stats row{};
+        row.timestamp = fd.timestamp;
+        row.status = "skipped";
+        check(planarvo_stats_writer_add(stats.get(), &row));
+      }
+      continue;
+    }
+    check(read);
     planarvo_track_result r{};
     r.struct_size = sizeof r;
     check(planarvo_tracker_track(tracker.get(), &img, fd.timestamp, &r));
-    t[i] = fd.timestamp;
-    pose[i] = r.pose;
-    motion[i] = r.motion;
-    ++run.frames;
-    run.ms.push_back(r.ms);
-    run.engine_ms += r.ms;
-    run.keyframes += r.keyframe ? 1 : 0;
-    if (r.status == PLANARVO_TRACK_OK || r.status == PLANARVO_TRACK_FIRST) ++run.ok;
-    if (r.status == PLANARVO_TRACK_DEGRADED) ++run.degraded;
-    if (r.status == PLANARVO_TRACK_LOST) ++run.lost;
-    valid[i] = r.status == PLANARVO_TRACK_OK || r.status == PLANARVO_TRACK_DEGRADED;
-    if (fd.has_groundtruth) truth[i] = fd.groundtruth;
-    else all_truth = false;
-    if (!outputs.motions.empty() && i > 0 &&
-        (r.status == PLANARVO_TRACK_OK || r.status == PLANARVO_TRACK_DEGRADED) &&
-        (!info.has_odometry || (fd.has_odometry && previous.has_odometry)) &&
-        (!info.has_direction || fd.has_direction)) {
-      planarvo_motion_pair p;
-      planarvo_motion_pair_init(&p);
-      p.interval = fd.timestamp - previous.timestamp;
-      p.sensor = r.motion;
-      p.has_sensor_covariance = 1;
-      for (int k = 0; k < 9; ++k) p.sensor_covariance[k] = r.covariance[k];
-      p.has_odometry = info.has_odometry;
-      if (p.has_odometry) p.odometry = relative(previous.odometry, fd.odometry);
-      p.has_direction = info.has_direction;
-      p.direction = fd.direction;
-      if (p.interval > 0) pairs.push_back(p);
-    }
-    previous = fd;
+    count(r, &run);
+    const bool first = k.t.empty();
     if (stats) {
-      const double dt = i > 0 ? t[i] - t[i - 1] : 0;
-      planarvo_frame_stats row{};
-      row.timestamp = fd.timestamp;
-      row.vx = dt > 0 ? r.motion.x / dt : 0;
-      row.vy = dt > 0 ? r.motion.y / dt : 0;
-      row.omega = dt > 0 ? r.motion.theta / dt : 0;
-      for (int l = 0; l < 8; ++l) row.iterations += r.iterations[l];
-      row.final_cost = r.final_cost;
-      row.inlier_fraction = r.inlier_fraction;
-      row.ms = r.ms;
-      row.status = status_label(r.status);
+      const planarvo_frame_stats row = stats_row(fd, first ? 0 : fd.timestamp - k.t.back(), r);
       check(planarvo_stats_writer_add(stats.get(), &row));
     }
-    if (progress) Progress::callback(progress, static_cast<double>(i + 1) / static_cast<double>(n), "tracking");
+    planarvo_motion_pair p;
+    if (!outputs.motions.empty() && !first && motion_pair(info, previous, fd, r, &p)) pairs.push_back(p);
+    k.t.push_back(fd.timestamp);
+    k.pose.push_back(r.pose);
+    k.motion.push_back(r.motion);
+    k.valid.push_back(r.status == PLANARVO_TRACK_OK || r.status == PLANARVO_TRACK_DEGRADED);
+    k.truth.push_back(fd.groundtruth);
+    k.all_truth = k.all_truth && fd.has_groundtruth;
+    previous = fd;
   }
+  if (progress) Progress::callback(progress, 1.0, "tracking");
   if (stats) check(planarvo_stats_writer_close(stats.release()));
-  if (!outputs.trajectory.empty()) check(planarvo_write_tum(outputs.trajectory.c_str(), t.data(), pose.data(), n));
+  if (!outputs.trajectory.empty())
+    check(planarvo_write_tum(outputs.trajectory.c_str(), k.t.data(), k.pose.data(), k.t.size()));
   if (!outputs.motions.empty()) check(planarvo_motion_pairs_save(outputs.motions.c_str(), pairs.data(), pairs.size()));
-  if (all_truth && n > 1) {
-    std::vector<planarvo_se2> est(n - 1), tru(n - 1);
-    std::vector<double> dt(n - 1);
-    for (size_t i = 1; i < n; ++i) {
-      est[i - 1] = motion[i];
-      tru[i - 1] = relative(truth[i - 1], truth[i]);
-      dt[i - 1] = t[i] - t[i - 1];
-    }
-    run.accuracy.struct_size = sizeof run.accuracy;
-    check(planarvo_evaluate_motions(est.data(), tru.data(), dt.data(), valid.data() + 1, n - 1, 1e-3,
-                                    &run.accuracy));
-    run.has_accuracy = true;
-  }
+  evaluate(k, &run);
   return run;
 }
 
@@ -138,6 +176,9 @@ void print_track_run(const TrackRun& run) {
   std::printf("frames %lld: %lld ok, %lld degraded, %lld lost; %lld keyframes\n", static_cast<long long>(run.frames),
               static_cast<long long>(run.ok), static_cast<long long>(run.degraded), static_cast<long long>(run.lost),
               static_cast<long long>(run.keyframes));
+  if (run.skipped > 0)
+    std::printf("skipped %lld bad frames (missing or undecodable images; see the warnings)\n",
+                static_cast<long long>(run.skipped));
   std::printf("engine time per frame: mean %.2f ms (%.0f fps), median %.2f ms (upload, undistortion, pyramid, "
               "tracking)\n",
               run.engine_ms / std::max<int64_t>(run.frames, 1), 1000.0 * static_cast<double>(run.frames) / run.engine_ms,
@@ -165,6 +206,8 @@ int cmd_track(int argc, char** argv) {
       {"finest-level", "N", "finest pyramid level tracked (0 = full resolution)", "the coarsest at least 320 px wide"},
       {"max-iterations", "N", "cap on alignment steps per level", "per-level defaults"},
       {"video", "FILE", "a video file standing in for images/ and frames.txt", ""},
+      {"skip-bad-frames", "", "a missing or undecodable image is a gap (a warning, a \"skipped\" statistics row, "
+                              "counted in the summary) instead of an error", ""},
       {"quiet", "", "no progress bar", ""},
       {"help", "", "show this help", ""}};
   for (auto& d : device_options()) specs.push_back(d);
@@ -195,8 +238,8 @@ int cmd_track(int argc, char** argv) {
   check(planarvo_extrinsics_load(extr.c_str(), &e));
   ContextPtr ctx = make_context(args);
   Progress progress(!args.has("quiet"));
-  DatasetPtr ds = open_dataset(dir, args.get("video"), false, &progress);
-  const TrackRun run = track_dataset(ctx.get(), ds.get(), e, o, {args.get("output"), args.get("stats"), args.get("motions-out")}, &progress);
+  DatasetPtr ds = open_dataset(dir, args.get("video"), false, &progress, args.has("skip-bad-frames"));
+  const TrackRun run = track_dataset(ctx.get(), ds.get(), e, o, {args.get("output"), args.get("stats"), args.get("motions-out"), args.has("skip-bad-frames")}, &progress);
   progress.finish();
   std::printf("tracked %s on %s\n", dir.c_str(), device_name(ctx.get()).c_str());
   print_track_run(run);

@@ -61,11 +61,13 @@ std::string device_name(const planarvo_context* context) {
   return std::string(info.device_name) + " (" + info.platform_name + ")";
 }
 
-DatasetPtr open_dataset(const std::string& dir, const std::string& video, bool verify, Progress* progress) {
+DatasetPtr open_dataset(const std::string& dir, const std::string& video, bool verify, Progress* progress,
+                        bool allow_missing) {
   planarvo_dataset_options o;
   planarvo_dataset_options_init(&o);
   if (!video.empty()) o.video = video.c_str();
   o.verify_images = verify ? 1 : 0;
+  o.allow_missing_images = allow_missing ? 1 : 0;
   o.progress = &Progress::callback;
   o.progress_user_data = progress;
   planarvo_dataset* d = nullptr;
@@ -99,6 +101,12 @@ int Progress::callback(void* self, double fraction, const char* stage) {
   std::fflush(stderr);
   p->drawn_ = true;
   return 0;
+}
+
+void Progress::warn(const std::string& message) {
+  finish();
+  last_permille_ = -1;
+  std::fprintf(stderr, "%s\n", message.c_str());
 }
 
 void Progress::finish() {

@@ -40,6 +40,8 @@ class Progress {
   ~Progress();
   static int callback(void* self, double fraction, const char* stage);
   void finish();
+  // A warning line on stderr, above the bar (which the next callback redraws).
+  void warn(const std::string& message);
 
  private:
   bool enabled_;
@@ -53,11 +55,14 @@ struct DatasetDeleter {
   void operator()(planarvo_dataset* d) const { planarvo_dataset_destroy(d); }
 };
 using DatasetPtr = std::unique_ptr<planarvo_dataset, DatasetDeleter>;
-DatasetPtr open_dataset(const std::string& dir, const std::string& video, bool verify, Progress* progress);
+// allow_missing: a missing image is found when its frame is read, not at open (--skip-bad-frames).
+DatasetPtr open_dataset(const std::string& dir, const std::string& video, bool verify, Progress* progress,
+                        bool allow_missing = false);
 
 // Tracks every frame of a data set (cmd_track.cpp), for `track` and `demo`.
 struct TrackRun {
   int64_t frames = 0, ok = 0, degraded = 0, lost = 0, keyframes = 0;
+  int64_t skipped = 0;           // bad images skipped (TrackOutputs::skip_bad_frames); not in frames
   double engine_ms = 0;          // sum of the per-frame engine times
   std::vector<double> ms;        // per frame
   bool has_accuracy = false;
@@ -66,6 +71,10 @@ struct TrackRun {
 struct TrackOutputs {
   std::string trajectory, stats;  // "" for none
   std::string motions;            // motion-pair CSV of the tracked intervals, "" for none
+  // A missing or undecodable image (or one of the wrong size) is a gap: a warning, a "skipped"
+  // row in the statistics, no pose; the next frame is tracked against the last good one. When
+  // false it is an error (exit 2, naming the frame).
+  bool skip_bad_frames = false;
 };
 TrackRun track_dataset(planarvo_context* ctx, planarvo_dataset* ds, const planarvo_extrinsics& extrinsics,
                        const planarvo_tracker_options& options, const TrackOutputs& outputs, Progress* progress);

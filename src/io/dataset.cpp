@@ -288,7 +288,7 @@ Dataset::Dataset(const std::string& directory, DatasetOptions options) : impl_(s
     d.frames = read_frames(d.frames_file);
     if (d.frames.empty()) throw_invalid_input(d.frames_file + ": lists no frames");
     // A stat per image is cheap and finds a misspelt path now, not an hour into a run.
-    for (size_t i = 0; i < d.frames.size(); ++i) {
+    for (size_t i = 0; i < d.frames.size() && !options.allow_missing_images; ++i) {
       const fs::path file = d.dir / d.frames[i].path;
       if (!fs::is_regular_file(file, ec))
         throw_invalid_input(file.string() + ": the image does not exist (" +

@@ -29,6 +29,9 @@ struct DatasetOptions {
   // Decode every image (or video frame) while opening, so that an unreadable frame or one of
   // the wrong size is reported at open rather than when the frame is read.
   bool verify_images = false;
+  // A listed image that does not exist is not an error at open (a stat per image finds it by
+  // default); reading its frame throws InvalidInput, like an undecodable image.
+  bool allow_missing_images = false;
   ProgressCallback progress;  // may be empty
 };
 
