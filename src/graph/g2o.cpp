@@ -1,6 +1,7 @@
 #include "graph/g2o.h"
 
 #include <cerrno>
+#include <charconv>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -141,18 +142,47 @@ G2oFile read_g2o(const std::filesystem::path& path) {
   return file;
 }
 
+namespace {
+
+// One g2o line built with std::to_chars: the shortest text that reads back as the same double
+// (as exact as printf's %.17g, and several times faster on graphs of 10^4 edges).
+class G2oLine {
+ public:
+  explicit G2oLine(const char* tag) { put(tag); }
+  G2oLine& operator<<(int v) { return number(v); }
+  G2oLine& operator<<(double v) { return number(v); }
+  void write(FILE* f) {
+    buf_[n_++] = '\n';
+    std::fwrite(buf_, 1, n_, f);
+  }
+
+ private:
+  template <class T>
+  G2oLine& number(T v) {
+    buf_[n_++] = ' ';
+    n_ = static_cast<size_t>(std::to_chars(buf_ + n_, buf_ + sizeof buf_ - 1, v).ptr - buf_);
+    return *this;
+  }
+  void put(const char* text) {
+    while (*text) buf_[n_++] = *text++;
+  }
+  char buf_[512];  // 11 numbers of at most 24 characters, and a tag
+  size_t n_ = 0;
+};
+
+}  // namespace
+
 void write_g2o(const std::filesystem::path& path, const G2oFile& file) {
   OutputFile out(path.string());  // complete or untouched (core/output_file.h)
   FILE* f = out.stream();
-  for (const G2oVertex& v : file.vertices)
-    std::fprintf(f, "VERTEX_SE2 %d %.17g %.17g %.17g\n", v.id, v.pose.x, v.pose.y, v.pose.theta);
+  for (const G2oVertex& v : file.vertices) (G2oLine("VERTEX_SE2") << v.id << v.pose.x << v.pose.y << v.pose.theta).write(f);
   for (const G2oEdge& e : file.edges) {
     const Eigen::Matrix3d& I = e.information;
-    std::fprintf(f, "EDGE_SE2 %d %d %.17g %.17g %.17g %.17g %.17g %.17g %.17g %.17g %.17g\n",
-                 e.from, e.to, e.measurement.x, e.measurement.y, e.measurement.theta, I(0, 0),
-                 I(0, 1), I(0, 2), I(1, 1), I(1, 2), I(2, 2));
+    (G2oLine("EDGE_SE2") << e.from << e.to << e.measurement.x << e.measurement.y << e.measurement.theta << I(0, 0)
+                         << I(0, 1) << I(0, 2) << I(1, 1) << I(1, 2) << I(2, 2))
+        .write(f);
   }
-  for (int id : file.fixed) std::fprintf(f, "FIX %d\n", id);
+  for (int id : file.fixed) (G2oLine("FIX") << id).write(f);
   out.commit();
 }
 
