@@ -1,8 +1,8 @@
 // The camera calibration from images (calib/pipeline.h) end to end on simulated data sets written to
 // disk: through the C API against the simulator's true extrinsics and against the engine's own
-// pipeline; through `planarvo calibrate DATASET`, whose written extrinsics must equal the C API's;
-// and the bad inputs (a method's missing inputs: exit 2; a drive that does not determine the
-// answer or a camera standing still: exit 1, no file written).
+// pipeline; through `planarvo calibrate DATASET`, whose written extrinsics and printed report must
+// be the C API's numbers; and the bad inputs (a method's missing inputs: exit 2; a drive that does
+// not determine the answer or a camera standing still: exit 1, no file written).
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -13,6 +13,7 @@
 #include <gtest/gtest.h>
 
 #include "calib/pipeline.h"
+#include "common/printed_values.h"
 #include "common/test_util.h"
 #include "io/dataset.h"
 #include "io/formats.h"
@@ -64,6 +65,37 @@ planarvo_camera_calibration_result calibrate_c(const std::string& dir, planarvo_
   return r;
 }
 
+// The tool's printed report against the C API's result: the stage counts and, per parameter,
+// the value and sigma to the digits printed.
+void expect_printed_report(const std::string& output, const planarvo_camera_calibration_result& r) {
+  const std::vector<double> tracking = test::numbers_after(output, "tracking: ");
+  ASSERT_GE(tracking.size(), 5u) << output;
+  EXPECT_EQ(tracking[0], r.frames);
+  EXPECT_EQ(tracking[1], r.frames_ok);
+  EXPECT_EQ(tracking[2], r.frames_degraded);
+  EXPECT_EQ(tracking[3], r.frames_lost);
+  EXPECT_EQ(tracking[4], r.samples);
+  const std::vector<double> graph = test::numbers_after(output, "graph calibration: ");
+  ASSERT_GE(graph.size(), 3u) << output;
+  EXPECT_EQ(graph[0], r.graph.total_iterations);
+  EXPECT_EQ(graph[1], r.graph.outliers);
+  EXPECT_NEAR(graph[2], r.graph.variance_factor, 5e-3 * r.graph.variance_factor);  // %.3g
+  const double v[6] = {r.extrinsics.x, r.extrinsics.y, r.extrinsics.z, r.extrinsics.roll, r.extrinsics.pitch,
+                       r.extrinsics.yaw};
+  const char* names[6] = {"x", "y", "z", "roll", "pitch", "yaw"};
+  for (int i = 0; i < 6; ++i) {
+    std::string label = std::string("  ") + names[i];
+    label.resize(8, ' ');
+    const std::string line = test::line_with(output, label);
+    ASSERT_EQ(line.rfind(label, 0), 0u) << label << "\n" << output;
+    const std::vector<double> p = test::numbers_in(line);
+    ASSERT_EQ(p.size(), 2u) << line;
+    const double k = i < 3 ? 1e3 : 1 / kDeg;
+    test::expect_printed(p[0], v[i] * k, 3, line);
+    test::expect_printed(p[1], std::sqrt(r.covariance[i * 7]) * k, 3, line);
+  }
+}
+
 TEST(CalibrateDataset, OdometryMethodThroughTheCApiAndTheTool) {
   test::ScratchDir dir;
   ocl::Runtime rt;
@@ -113,6 +145,7 @@ TEST(CalibrateDataset, OdometryMethodThroughTheCApiAndTheTool) {
   EXPECT_NEAR(f.value.yaw, e.yaw, 1e-12);
   for (int i = 0; i < 36; ++i) EXPECT_NEAR(f.covariance(i / 6, i % 6), r.covariance[i], 1e-20) << i;
   EXPECT_EQ(f.estimated.size(), 6u);
+  expect_printed_report(c.output, r);
 
   // The other route: track at the camera's own frame (true tilt, x = y = 0, z = 1, yaw = 0), write
   // the motions with --motions-out, calibrate from the CSV: x, y, height and yaw again.
