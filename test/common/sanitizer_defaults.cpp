@@ -1,0 +1,18 @@
+// The sanitizers' settings for the test executables, compiled in (the sanitizer runtimes call
+// these hooks at start-up), so that they hold however a test is started: ctest, a debugger, by
+// hand. The runtimes look them up as dynamic symbols (hence default visibility); in a build
+// without sanitizers nothing calls them.
+
+// AddressSanitizer keeps its defaults, LeakSanitizer included: the suite runs clean with it.
+
+extern "C" const char* __tsan_default_options();
+extern "C" __attribute__((visibility("default"))) const char* __tsan_default_options() { return "second_deadlock_stack=1"; }
+
+// ThreadSanitizer suppressions (scripts/test.sh runs the threaded tests under it). Only code
+// that ThreadSanitizer cannot see is suppressed, never planarvo's own:
+// - GDAL, loaded by OpenCV's imgcodecs when a test reads its textures with cv::imread, takes
+//   its own two internal mutexes in both orders on the reading thread while it registers its
+//   drivers (CPLAcquireMutex / CPLCreateOrAcquireMutexEx). GDAL is not instrumented and
+//   planarvo holds no lock across the call: this lock-order report, only inside libgdal.
+extern "C" const char* __tsan_default_suppressions();
+extern "C" __attribute__((visibility("default"))) const char* __tsan_default_suppressions() { return "deadlock:libgdal.so\n"; }
