@@ -2,7 +2,7 @@
 # elsewhere (an installed package must not depend on where it was installed), then configure,
 # build and run test/consumer against the moved tree through find_package and through
 # pkg-config, and build the same program with nothing but `cc $(pkg-config --cflags --libs
-# planarvo)`, as a Makefile user would.
+# planarvo)`, as a Makefile user would, and the installed C example the same way.
 # Variables: BUILD_DIR (planarvo's build), SOURCE_DIR (test/consumer), WORK_DIR (scratch),
 # C_COMPILER, CONSUMER_C_FLAGS (the sanitizer flags when planarvo is built with them).
 file(REMOVE_RECURSE ${WORK_DIR})
@@ -19,7 +19,8 @@ endfunction()
 run(${CMAKE_COMMAND} --install ${BUILD_DIR} --prefix ${installed})
 file(RENAME ${installed} ${prefix})
 # The licence and the user documentation are installed with the package.
-foreach(doc LICENSE README.md formats.md conventions.md outputs.md)
+foreach(doc LICENSE README.md formats.md conventions.md outputs.md examples/README.md
+           examples/c/track_and_calibrate.c examples/python/track_and_calibrate.py)
   if(NOT EXISTS ${prefix}/share/doc/planarvo/${doc})
     message(FATAL_ERROR "not installed: share/doc/planarvo/${doc}")
   endif()
@@ -41,6 +42,9 @@ separate_arguments(flags UNIX_COMMAND "${flags}")
 separate_arguments(c_flags UNIX_COMMAND "${CONSUMER_C_FLAGS}")
 run(${C_COMPILER} ${c_flags} ${SOURCE_DIR}/consumer.c -o ${WORK_DIR}/consumer_cc ${flags})
 run(${CMAKE_COMMAND} -E env LD_LIBRARY_PATH=${libdir} ${WORK_DIR}/consumer_cc)
+# The installed example builds as examples/README.md says.
+run(${C_COMPILER} ${c_flags} ${prefix}/share/doc/planarvo/examples/c/track_and_calibrate.c
+    -o ${WORK_DIR}/track_and_calibrate -lm ${flags})
 
 run(${CMAKE_COMMAND} -E env PKG_CONFIG_PATH=${pcdir}
     ${CMAKE_COMMAND} -S ${SOURCE_DIR} -B ${WORK_DIR}/build -DCMAKE_PREFIX_PATH=${prefix}
