@@ -38,7 +38,12 @@ static int track(planarvo_context* context, planarvo_dataset* dataset, const pla
   planarvo_se2* poses = malloc(n * sizeof *poses);
   planarvo_tracker* tracker = NULL;
   int lost = 0, exit_status = 0;
-  planarvo_status status = planarvo_tracker_create(context, &info->camera, extrinsics, NULL, &tracker);
+  if (times == NULL || poses == NULL) {
+    fprintf(stderr, "track_and_calibrate: out of memory for %zu frames\n", n);
+    exit_status = 1;
+  }
+  planarvo_status status = PLANARVO_OK;
+  if (exit_status == 0) status = planarvo_tracker_create(context, &info->camera, extrinsics, NULL, &tracker);
   if (status != PLANARVO_OK) exit_status = fail("planarvo_tracker_create", status);
   for (size_t i = 0; exit_status == 0 && i < n; ++i) {
     planarvo_frame_data data;
@@ -59,7 +64,7 @@ static int track(planarvo_context* context, planarvo_dataset* dataset, const pla
     status = planarvo_write_tum(trajectory_path, times, poses, n);
     if (status != PLANARVO_OK) exit_status = fail(trajectory_path, status);
   }
-  if (exit_status == 0)
+  if (exit_status == 0 && n > 0)
     printf("tracked %zu frames (%d lost); last pose x %.4f m, y %.4f m, heading %.3f deg; wrote %s\n", n, lost,
            poses[n - 1].x, poses[n - 1].y, poses[n - 1].theta * 180.0 / M_PI, trajectory_path);
   planarvo_tracker_destroy(tracker);
@@ -107,9 +112,10 @@ static int calibrate(planarvo_context* context, planarvo_dataset* dataset, const
   char list[64] = "";
   size_t at = 0;
   for (int i = 0; i < 6; ++i)
-    if (result.estimated[i]) at += (size_t)snprintf(list + at, sizeof list - at, "%s%s", at ? "," : "", names[i]);
+    if (result.estimated[i])
+      at += (size_t)snprintf(list + at, sizeof list - at, "%s%s", at ? "," : "", names[i]);
   const planarvo_status saved = planarvo_extrinsics_save(out_path, &result.extrinsics, result.covariance, list,
-                                                         "planarvo_calibrate_dataset", "examples/c/track_and_calibrate");
+                                                         "planarvo_calibrate_dataset", "examples/c");
   if (saved != PLANARVO_OK) return fail(out_path, saved);
   printf("wrote %s\n", out_path);
   return 0;

@@ -180,7 +180,7 @@ def track(lib, context, dataset, info, extrinsics, trajectory_path):
     finally:
         lib.planarvo_tracker_destroy(tracker)
     check(lib, lib.planarvo_write_tum(trajectory_path.encode(), times, poses, n), trajectory_path)
-    last = poses[n - 1]
+    last = poses[n - 1] if n else SE2()
     print("tracked %d frames (%d lost); last pose x %.4f m, y %.4f m, heading %.3f deg; wrote %s"
           % (n, lost, last.x, last.y, math.degrees(last.theta), trajectory_path))
 

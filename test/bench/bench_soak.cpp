@@ -118,7 +118,8 @@ void check(planarvo_status s, const char* what) {
 double percentile(std::vector<double>* v, size_t n, double p) {
   if (n == 0) return 0;
   const size_t i = std::min(n - 1, static_cast<size_t>(p * static_cast<double>(n)));
-  std::nth_element(v->begin(), v->begin() + static_cast<std::ptrdiff_t>(i), v->begin() + static_cast<std::ptrdiff_t>(n));
+  const auto begin = v->begin();
+  std::nth_element(begin, begin + static_cast<std::ptrdiff_t>(i), begin + static_cast<std::ptrdiff_t>(n));
   return (*v)[i];
 }
 
