@@ -6,6 +6,7 @@
 #include <CL/opencl.hpp>
 #include <opencv2/core.hpp>
 
+#include "capi/convert.h"
 #include "capi/handles.h"
 #include "core/error.h"
 #include "ocl/runtime.h"
@@ -81,7 +82,9 @@ PLANARVO_API const char* planarvo_last_error(void) {
 }
 
 PLANARVO_API const char* planarvo_status_name(planarvo_status status) {
-  switch (status) {
+  // A C caller may pass any int: switching on the enum itself would load an out-of-range value,
+  // which is undefined in C++ (found by fuzzing, UBSan "invalid value for type").
+  switch (planarvo::capi::enum_value(status)) {
     case PLANARVO_OK: return "PLANARVO_OK";
     case PLANARVO_ERROR_INVALID_ARGUMENT: return "PLANARVO_ERROR_INVALID_ARGUMENT";
     case PLANARVO_ERROR_INVALID_INPUT: return "PLANARVO_ERROR_INVALID_INPUT";
