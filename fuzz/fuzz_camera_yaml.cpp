@@ -14,7 +14,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     if (camera.width <= 0 || camera.height <= 0) broken("camera loaded with a non-positive size");
     for (double v : {camera.fx, camera.fy, camera.cx, camera.cy, camera.k1, camera.k2, camera.p1,
                      camera.p2, camera.k3})
-      if (!finite(v)) broken("camera loaded with a non-finite value");
+      if (!is_finite(v)) broken("camera loaded with a non-finite value");
     if (planarvo_camera_save(out.c_str(), &camera) != PLANARVO_OK) broken("a loaded camera does not save");
     planarvo_camera again;
     if (planarvo_camera_load(out.c_str(), &again) != PLANARVO_OK) broken("a saved camera does not load");

@@ -10,7 +10,10 @@
 // or write past them: an output struct is sizeof the struct whatever its struct_size says.
 #include <fuzzer/FuzzedDataProvider.h>
 
+#include <algorithm>
 #include <climits>
+#include <csignal>
+#include <iterator>
 #include <cstring>
 #include <limits>
 #include <memory>
@@ -114,9 +117,10 @@ Image any_image(FuzzedDataProvider& in) {
   const planarvo_camera& cam = device().camera;
   im.view.width = any_size(in, cam.width);
   im.view.height = any_size(in, cam.height);
-  im.view.format = static_cast<planarvo_pixel_format>(
-      in.ConsumeBool() ? PLANARVO_GRAY8 : in.ConsumeIntegralInRange<int>(-1, 4));
-  const size_t bpp = im.view.format == PLANARVO_GRAY32F ? 4 : im.view.format == PLANARVO_GRAY8 ? 1 : 3;
+  // The format as the int a C caller may store (reading an out-of-range enum back is UB in C++).
+  const int format = in.ConsumeBool() ? PLANARVO_GRAY8 : in.ConsumeIntegralInRange<int>(-1, 4);
+  im.view.format = static_cast<planarvo_pixel_format>(format);
+  const size_t bpp = format == PLANARVO_GRAY32F ? 4 : format == PLANARVO_GRAY8 ? 1 : 3;
   const size_t row = im.view.width > 0 ? bpp * static_cast<size_t>(im.view.width) : 0;
   switch (in.ConsumeIntegralInRange<int>(0, 3)) {
     case 0: im.view.stride = row; break;
@@ -131,7 +135,7 @@ Image any_image(FuzzedDataProvider& in) {
     im.pixels.resize(bytes);
     const std::vector<uint8_t> src = in.ConsumeBytes<uint8_t>(bytes);
     for (size_t i = 0; i < bytes; ++i) im.pixels[i] = src.empty() ? uint8_t(i * 37) : src[i % src.size()];
-    if (im.view.format == PLANARVO_GRAY32F)  // finite floats mostly: bytes from the input otherwise
+    if (format == PLANARVO_GRAY32F)  // finite floats mostly: bytes from the input otherwise
       if (in.ConsumeBool())
         for (size_t i = 0; i + 4 <= bytes; i += 4) {
           const float f = static_cast<float>(im.pixels[i]);
@@ -258,7 +262,8 @@ void calibrate(FuzzedDataProvider& in) {
   const size_t count = in.ConsumeIntegralInRange<size_t>(0, 48);
   size_t stride = any_struct_size(in, sizeof(planarvo_motion_pair));
   if (stride > sizeof(planarvo_motion_pair) + 64) stride = sizeof(planarvo_motion_pair) + 64;
-  std::vector<uint8_t> buffer(count * stride + (count ? 0 : 1));
+  // The first element's struct_size is always there (it says what the stride is), however small.
+  std::vector<uint8_t> buffer(std::max(count * stride, sizeof(size_t)));
   for (size_t i = 0; i < count; ++i) {
     planarvo_motion_pair p;
     planarvo_motion_pair_init(&p);
@@ -275,6 +280,7 @@ void calibrate(FuzzedDataProvider& in) {
     for (double& v : p.odometry_covariance) v = in.ConsumeBool() ? 0.01 : any_double(in);
     std::memcpy(buffer.data() + i * stride, &p, std::min(stride, sizeof p));
   }
+  std::memcpy(buffer.data(), &stride, sizeof stride);
   planarvo_calibration_options o;
   planarvo_calibration_options_init(&o);
   o.method = static_cast<planarvo_calibration_method>(in.ConsumeIntegralInRange<int>(-1, 3));
@@ -327,9 +333,42 @@ void evaluate(FuzzedDataProvider& in) {
                                          in.ConsumeBool() ? valid.data() : nullptr, n, any_double(in), acc.get()));
 }
 
+// PoCL compiles kernels with LLVM, which installs its own handlers for SIGSEGV, SIGABRT and the
+// other crash signals: a crash then ends the process without libFuzzer's report or artifact. The
+// handlers from before the device was made are put back, and those in force at the first input
+// (libFuzzer's and the sanitizers') after every input, in case a later compile installs LLVM's again.
+constexpr int kCrashSignals[] = {SIGSEGV, SIGBUS, SIGABRT, SIGILL, SIGFPE, SIGTRAP};
+struct Handlers {
+  struct sigaction action[sizeof kCrashSignals / sizeof kCrashSignals[0]];
+  void save() {
+    for (size_t i = 0; i < std::size(kCrashSignals); ++i) sigaction(kCrashSignals[i], nullptr, &action[i]);
+  }
+  void restore() const {
+    for (size_t i = 0; i < std::size(kCrashSignals); ++i) sigaction(kCrashSignals[i], &action[i], nullptr);
+  }
+};
+
 }  // namespace
 
+// The device objects are made before the first input: compiling the kernels takes longer than an
+// input may (-timeout).
+extern "C" int LLVMFuzzerInitialize(int*, char***) {
+  Handlers before;
+  before.save();
+  (void)device();
+  before.restore();
+  return 0;
+}
+
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
+  static const Handlers fuzzer_handlers = [] {
+    Handlers h;
+    h.save();
+    return h;
+  }();
+  struct Restore {
+    ~Restore() { fuzzer_handlers.restore(); }
+  } restore_after_input;
   FuzzedDataProvider in(data, size);
   for (int step = 0; step < 8 && in.remaining_bytes() > 0; ++step) {
     switch (in.ConsumeIntegralInRange<int>(0, 6)) {

@@ -75,6 +75,6 @@ inline void check_status(planarvo_status st) {
   }
 }
 
-inline bool finite(double v) { return std::isfinite(v); }
+inline bool is_finite(double v) { return std::isfinite(v); }
 
 }  // namespace planarvo_fuzz

@@ -56,7 +56,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   info.struct_size = sizeof info;
   if (planarvo_dataset_info_get(dataset, &info) != PLANARVO_OK) broken("no info for an opened data set");
   if (info.frame_count <= 0) broken("an opened data set without frames");
-  if (!finite(info.first_timestamp) || !finite(info.last_timestamp) || info.first_timestamp > info.last_timestamp)
+  if (!is_finite(info.first_timestamp) || !is_finite(info.last_timestamp) || info.first_timestamp > info.last_timestamp)
     broken("bad first/last timestamps");
   const int64_t n = info.frame_count < 4096 ? info.frame_count : 4096;
   for (int64_t i = -1; i <= n; ++i) {  // one index each side out of range
@@ -66,8 +66,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     const bool in_range = i >= 0 && i < info.frame_count;
     if ((fs == PLANARVO_OK) != in_range) broken("frame_data accepted an index out of range or refused one in range");
     if (fs != PLANARVO_OK) continue;
-    if (!finite(fd.timestamp)) broken("a non-finite frame time");
-    if (fd.has_odometry && !(finite(fd.odometry.x) && finite(fd.odometry.y) && finite(fd.odometry.theta)))
+    if (!is_finite(fd.timestamp)) broken("a non-finite frame time");
+    if (fd.has_odometry && !(is_finite(fd.odometry.x) && is_finite(fd.odometry.y) && is_finite(fd.odometry.theta)))
       broken("non-finite interpolated odometry");
     if (fd.has_direction && (fd.direction < -1 || fd.direction > 1)) broken("a direction label outside -1..1");
   }

@@ -11,7 +11,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   check_status(st);
   if (st == PLANARVO_OK) {
     for (double v : {e.x, e.y, e.z, e.roll, e.pitch, e.yaw})
-      if (!finite(v)) broken("extrinsics loaded with a non-finite value");
+      if (!is_finite(v)) broken("extrinsics loaded with a non-finite value");
     double m[16];
     if (planarvo_extrinsics_matrix(&e, m) != PLANARVO_OK) broken("loaded extrinsics give no matrix");
     if (planarvo_extrinsics_save(out.c_str(), &e, nullptr, nullptr, nullptr, nullptr) != PLANARVO_OK)

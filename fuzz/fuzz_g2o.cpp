@@ -20,7 +20,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   check_status(st);
   if (st != PLANARVO_OK && st != PLANARVO_ERROR_FAILED && st != PLANARVO_ERROR_INVALID_INPUT)
     broken("a bad g2o file gave a status other than INVALID_INPUT or FAILED");
-  if (st == PLANARVO_OK && !(finite(summary.final_chi2) && finite(summary.initial_chi2)))
+  if (st == PLANARVO_OK && !(is_finite(summary.final_chi2) && is_finite(summary.initial_chi2)))
     broken("a solved graph with a non-finite chi2");
   return 0;
 }

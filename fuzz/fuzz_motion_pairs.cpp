@@ -8,10 +8,10 @@
 namespace {
 void check_pair(const planarvo_motion_pair& p) {
   using planarvo_fuzz::broken;
-  using planarvo_fuzz::finite;
-  if (!finite(p.interval) || !finite(p.sensor.x) || !finite(p.sensor.y) || !finite(p.sensor.theta))
+  using planarvo_fuzz::is_finite;
+  if (!is_finite(p.interval) || !is_finite(p.sensor.x) || !is_finite(p.sensor.y) || !is_finite(p.sensor.theta))
     broken("a loaded pair with a non-finite value");
-  if (p.has_odometry && !(finite(p.odometry.x) && finite(p.odometry.y) && finite(p.odometry.theta)))
+  if (p.has_odometry && !(is_finite(p.odometry.x) && is_finite(p.odometry.y) && is_finite(p.odometry.theta)))
     broken("a loaded pair with non-finite odometry");
   if (p.has_direction && (p.direction < -1 || p.direction > 1)) broken("a direction label outside -1..1");
 }

@@ -4,12 +4,13 @@
 # Prints a table: executions, corpus size and findings (crash, hang, out-of-memory and leak
 # artifacts, and sanitizer reports in the log). Exit status 1 when anything was found.
 #
-#   scripts/fuzz.sh [-t SECONDS] [-j JOBS] [-b BUILD_DIR] [--no-build] [TARGET...]
+#   scripts/fuzz.sh [-t SECONDS] [-j JOBS] [-b BUILD_DIR] [--no-build] [--report] [TARGET...]
 #
 #   -t SECONDS   time per target (libFuzzer -max_total_time; default 60)
 #   -j JOBS      targets run at once (default 1)
 #   -b DIR       build directory (default build-fuzz)
 #   --no-build   use the targets already built
+#   --report     run nothing: print the table of the last runs in BUILD_DIR/fuzz-runs
 #   TARGET       camera_yaml extrinsics_yaml frames tum direction motion_pairs g2o capi (default all)
 #
 # Each run's log, working corpus and artifacts are in BUILD_DIR/fuzz-runs/TARGET/. Needs only
@@ -23,6 +24,7 @@ seconds=60
 jobs=1
 build="$root/build-fuzz"
 do_build=1
+do_run=1
 targets=()
 while [ $# -gt 0 ]; do
   case "$1" in
@@ -30,7 +32,8 @@ while [ $# -gt 0 ]; do
     -j) jobs=$2; shift 2 ;;
     -b) build=$(realpath -m "$2"); shift 2 ;;
     --no-build) do_build=0; shift ;;
-    -h|--help) sed -n '2,19p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    --report) do_build=0; do_run=0; shift ;;
+    -h|--help) sed -n '2,20p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     -*) echo "fuzz.sh: unknown option $1 (see --help)" >&2; exit 2 ;;
     *) targets+=("${1#fuzz_}"); shift ;;
   esac
@@ -86,6 +89,7 @@ run_one() {
 
 running=0
 for t in "${targets[@]}"; do
+  [ "$do_run" = 1 ] || break
   echo "fuzz.sh: fuzz_$t for ${seconds} s" >&2
   run_one "$t" &
   running=$((running + 1))
@@ -101,8 +105,11 @@ printf '%-16s %8s %12s %9s %7s %7s %6s %5s %5s %10s\n' \
   target seconds executions exec/s corpus crashes hangs ooms leaks sanitizer
 for t in "${targets[@]}"; do
   dir="$build/fuzz-runs/$t"
+  [ -f "$dir/seconds" ] || { printf '%-16s (not run)\n' "$t"; continue; }
   secs=$(cat "$dir/seconds")
   execs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$dir/log.txt" | tail -1)
+  # A run that died without libFuzzer's final statistics: its last status line "#N ...".
+  [ -n "$execs" ] || execs=$(sed -n 's/^#\([0-9][0-9]*\)[[:space:]].*/\1/p' "$dir/log.txt" | tail -1)
   execs=${execs:-0}
   rate=$(( secs > 0 ? execs / secs : 0 ))
   corpus=$(find "$dir/corpus" -type f | wc -l)
