@@ -71,10 +71,11 @@ int line_nesting(std::string_view line, int& flow_depth) {
   return depth + deepest;
 }
 
-// "---" followed by more than blanks or a comment. OpenCV's parser loops forever on a key there
-// followed by another key ("---a : 1\ny: 2", found by fuzzing); our files have "---" alone.
+// A document marker ("---" or "...") followed by more than blanks or a comment. OpenCV's parser
+// loops forever on a key after "---" followed by another key ("---a : 1\ny: 2"), and on text after
+// "..." ("x: 1\n...-"), both found by fuzzing; our files have "---" alone.
 bool has_content_after_document_marker(std::string_view line) {
-  if (line.substr(0, 3) != "---") return false;
+  if (line.substr(0, 3) != "---" && line.substr(0, 3) != "...") return false;
   const size_t next = line.find_first_not_of(" \t\r", 3);
   return next != std::string_view::npos && line[next] != '#';
 }
@@ -97,7 +98,7 @@ void check_yaml_limits(const std::string& path) {
       fail(detail::where(path, number), "nests deeper than " + std::to_string(kMaxYamlNesting) +
                                             " levels (indentation, '-' entries and brackets)");
     if (has_content_after_document_marker(line))
-      fail(detail::where(path, number), "text after the '---' document marker is not supported");
+      fail(detail::where(path, number), "text after a '---' or '...' document marker is not supported");
   }
 }
 
