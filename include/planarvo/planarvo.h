@@ -118,7 +118,9 @@ typedef enum planarvo_pixel_format {
   PLANARVO_GRAY32F = 3 /* 4-byte float per pixel, grey levels 0..255 */
 } planarvo_pixel_format;
 
-/* An image in caller memory: stride is the number of bytes between the starts of two rows. */
+/* An image in caller memory: stride is the number of bytes between the starts of two rows, at
+ * least width x bytes per pixel, and a multiple of 4 for PLANARVO_GRAY32F (else
+ * PLANARVO_ERROR_INVALID_ARGUMENT). */
 typedef struct planarvo_image {
   const void* data;
   int32_t width, height;

@@ -227,8 +227,8 @@ PLANARVO_API planarvo_status planarvo_roll_pitch_add_frame(planarvo_roll_pitch* 
                 planarvo::capi::enum_value(image->format) <= PLANARVO_GRAY32F,
             "planarvo_roll_pitch_add_frame: unknown pixel format");
     size_t stride = 0;
-    const uint8_t* grey = planarvo::capi::grey_view(*image, estimator->grey, &stride);
-    require(stride >= static_cast<size_t>(image->width), "planarvo_roll_pitch_add_frame: stride is less than the row");
+    const uint8_t* grey =
+        planarvo::capi::grey_view(*image, estimator->grey, &stride, "planarvo_roll_pitch_add_frame");
     const bool done = estimator->estimator->add_frame(grey, image->width, image->height, stride, timestamp);
     if (complete) *complete = done ? 1 : 0;
   });
@@ -313,7 +313,8 @@ PLANARVO_API planarvo_status planarvo_camera_calibrator_add_frame(planarvo_camer
     require(!odometry_pose || std::isfinite(odometry_pose->x + odometry_pose->y + odometry_pose->theta),
             "planarvo_camera_calibrator_add_frame: odometry_pose is not finite");
     size_t stride = 0;
-    const uint8_t* grey = planarvo::capi::grey_view(*image, calibrator->grey, &stride);
+    const uint8_t* grey =
+        planarvo::capi::grey_view(*image, calibrator->grey, &stride, "planarvo_camera_calibrator_add_frame");
     std::optional<planarvo::SE2> odometry;
     if (odometry_pose) odometry = planarvo::capi::to_cpp(*odometry_pose);
     std::optional<int> label;

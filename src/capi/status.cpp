@@ -4,6 +4,7 @@
 #include <new>
 #include <stdexcept>
 
+#include "capi/convert.h"
 #include "core/error.h"
 
 namespace planarvo::capi {
@@ -79,7 +80,9 @@ PLANARVO_API const char* planarvo_last_error(void) {
 }
 
 PLANARVO_API const char* planarvo_status_name(planarvo_status status) {
-  switch (status) {
+  // A C caller may pass any int: switching on the enum itself would load an out-of-range value,
+  // which is undefined in C++ (found by fuzzing, UBSan "invalid value for type").
+  switch (planarvo::capi::enum_value(status)) {
     case PLANARVO_OK: return "PLANARVO_OK";
     case PLANARVO_ERROR_INVALID_ARGUMENT: return "PLANARVO_ERROR_INVALID_ARGUMENT";
     case PLANARVO_ERROR_INVALID_INPUT: return "PLANARVO_ERROR_INVALID_INPUT";

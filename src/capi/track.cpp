@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstring>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include <opencv2/imgproc.hpp>
@@ -41,7 +42,16 @@ planarvo_track_status to_c(planarvo::track::FrameResult::Status s) {
 namespace planarvo::capi {
 
 // The frame as 8-bit grey: a view of the caller's memory when it already is, else converted.
-const uint8_t* grey_view(const planarvo_image& im, cv::Mat& buffer, size_t* stride) {
+const uint8_t* grey_view(const planarvo_image& im, cv::Mat& buffer, size_t* stride, const char* function) {
+  const size_t bpp = im.format == PLANARVO_GRAY8 ? 1 : im.format == PLANARVO_GRAY32F ? 4 : 3;
+  // Checked here for every caller: a colour or float stride below the row was an OpenCV
+  // assertion (PLANARVO_ERROR_INTERNAL) in planarvo_roll_pitch_add_frame and
+  // planarvo_camera_calibrator_add_frame, found by fuzzing.
+  require(im.stride >= bpp * static_cast<size_t>(im.width),
+          (std::string(function) + ": stride is less than the row (width x bytes per pixel)").c_str());
+  // OpenCV asserts on a float image whose rows are not whole floats apart (also found by fuzzing).
+  require(im.stride % (bpp == 4 ? 4 : 1) == 0,
+          (std::string(function) + ": stride of a PLANARVO_GRAY32F image must be a multiple of 4").c_str());
   const int type = im.format == PLANARVO_GRAY8 ? CV_8UC1
                    : im.format == PLANARVO_GRAY32F ? CV_32FC1
                                                    : CV_8UC3;
@@ -139,7 +149,7 @@ PLANARVO_API planarvo_status planarvo_tracker_track(planarvo_tracker* tracker, c
     require(image->stride >= bpp * static_cast<size_t>(image->width), "planarvo_tracker_track: stride < row size");
     require(std::isfinite(timestamp), "planarvo_tracker_track: timestamp is NaN or inf");
     size_t stride = 0;
-    const uint8_t* grey = planarvo::capi::grey_view(*image, tracker->grey, &stride);
+    const uint8_t* grey = planarvo::capi::grey_view(*image, tracker->grey, &stride, "planarvo_tracker_track");
     const planarvo::track::FrameResult r =
         tracker->tracker->track(grey, image->width, image->height, stride, timestamp);
     planarvo_track_result out;

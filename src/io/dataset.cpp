@@ -215,7 +215,14 @@ std::optional<SE2> interpolate_pose(const std::vector<StampedPose>& samples, dou
   if (it->t == t) return it->pose;
   const StampedPose& a = *(it - 1);
   const StampedPose& b = *it;
-  return interpolate_linear(a.pose, b.pose, (t - a.t) / (b.t - a.t));
+  // Finite samples give a finite pose, however far apart (found by fuzzing: x = -1e308 and 1e308
+  // gave inf): the fraction from halved times when the span overflows, and x, y as a convex
+  // combination rather than a + f (b - a), whose difference overflows.
+  const double span = b.t - a.t;
+  double f = std::isfinite(span) ? (t - a.t) / span : (0.5 * t - 0.5 * a.t) / (0.5 * b.t - 0.5 * a.t);
+  f = std::clamp(f, 0.0, 1.0);
+  return SE2((1.0 - f) * a.pose.x + f * b.pose.x, (1.0 - f) * a.pose.y + f * b.pose.y,
+             interpolate_linear(a.pose, b.pose, f).theta);
 }
 
 std::optional<int> direction_at(const std::vector<DirectionLabel>& labels, double t) {

@@ -3,8 +3,12 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
 #include <filesystem>
+#include <fstream>
+#include <stdexcept>
 #include <string>
+#include <string_view>
 
 #include <opencv2/core.hpp>
 
@@ -27,12 +31,90 @@ constexpr double kMatrixAgreement = 1e-6;
   throw_invalid_input(path + ": " + message);
 }
 
+// Limits checked before OpenCV's parser sees a file. Its YAML parser recurses once per level of
+// nesting (flow brackets, block indentation, inline "- - -" sequences) and overflows the stack at a
+// few ten thousand levels (a crash, found by fuzzing); our files nest 2 or 3 levels deep. The size
+// limit is far above any camera or extrinsics file, OpenCV's calibration sample's extra keys
+// (per-view extrinsics, image points) included.
+constexpr int kMaxYamlNesting = 128;
+constexpr std::uintmax_t kMaxYamlBytes = 16u << 20;
+
+// The nesting a YAML line can reach: its indentation, its leading "- " sequence entries, and the
+// open flow collections ('[' '{' outside quotes and comments; flow_depth carries over lines).
+int line_nesting(std::string_view line, int& flow_depth) {
+  size_t i = 0;
+  while (i < line.size() && (line[i] == ' ' || line[i] == '\t')) ++i;
+  int depth = static_cast<int>(std::min<size_t>(i, kMaxYamlNesting + 1));
+  while (i < line.size() && line[i] == '-' &&
+         (i + 1 == line.size() || line[i + 1] == ' ' || line[i + 1] == '\t')) {
+    ++depth;
+    i += 2;
+    while (i < line.size() && (line[i] == ' ' || line[i] == '\t')) ++i;
+  }
+  int deepest = flow_depth;
+  char quote = 0;
+  for (; i < line.size(); ++i) {
+    const char c = line[i];
+    if (quote) {
+      if (c == '\\' && quote == '"') ++i;
+      else if (c == quote) quote = 0;
+    } else if (c == '"' || c == '\'') {
+      quote = c;
+    } else if (c == '#' && (i == 0 || line[i - 1] == ' ' || line[i - 1] == '\t')) {
+      break;
+    } else if (c == '[' || c == '{') {
+      deepest = std::max(deepest, ++flow_depth);
+    } else if ((c == ']' || c == '}') && flow_depth > 0) {
+      --flow_depth;
+    }
+  }
+  return depth + deepest;
+}
+
+// A document marker ("---" or "...") followed by more than blanks or a comment. OpenCV's parser
+// loops forever on a key after "---" followed by another key ("---a : 1\ny: 2"), and on text after
+// "..." ("x: 1\n...-"), both found by fuzzing; our files have "---" alone.
+bool has_content_after_document_marker(std::string_view line) {
+  if (line.substr(0, 3) != "---" && line.substr(0, 3) != "...") return false;
+  const size_t next = line.find_first_not_of(" \t\r", 3);
+  return next != std::string_view::npos && line[next] != '#';
+}
+
+// Refuses what OpenCV's parser cannot take safely: more than kMaxYamlBytes, or nesting deeper
+// than kMaxYamlNesting (reported with the line).
+void check_yaml_limits(const std::string& path) {
+  std::error_code ec;
+  const std::uintmax_t bytes = std::filesystem::file_size(path, ec);
+  if (ec) fail(path, "cannot be read (" + ec.message() + ")");
+  if (bytes > kMaxYamlBytes)
+    fail(path, "is " + std::to_string(bytes) + " bytes, more than a camera or extrinsics file can be (" +
+                   std::to_string(kMaxYamlBytes) + ")");
+  std::ifstream in(path, std::ios::binary);
+  if (!in) fail(path, "cannot be opened");
+  std::string line;
+  int flow_depth = 0;
+  for (int number = 1; std::getline(in, line); ++number) {
+    if (line_nesting(line, flow_depth) > kMaxYamlNesting)
+      fail(detail::where(path, number), "nests deeper than " + std::to_string(kMaxYamlNesting) +
+                                            " levels (indentation, '-' entries and brackets)");
+    if (has_content_after_document_marker(line))
+      fail(detail::where(path, number), "text after a '---' or '...' document marker is not supported");
+  }
+}
+
 // Opens path for reading, with our own message for a missing file (OpenCV's is a log line).
 void open_for_reading(cv::FileStorage& fs, const std::string& path) {
   std::error_code ec;
   if (!std::filesystem::exists(path, ec)) fail(path, "does not exist");
   if (std::filesystem::is_directory(path, ec)) fail(path, "is a directory, not a file");
-  if (!fs.open(path, cv::FileStorage::READ)) fail(path, "cannot be opened as OpenCV YAML");
+  check_yaml_limits(path);
+  try {
+    if (!fs.open(path, cv::FileStorage::READ)) fail(path, "cannot be opened as OpenCV YAML");
+  } catch (const std::logic_error& e) {
+    // OpenCV's parser builds a string of negative length from an empty key at the end of the file
+    // ("%YAML:1.0\n   t:f\n   :", found by fuzzing): std::length_error, not a cv::Exception.
+    fail(path, std::string("not a valid OpenCV FileStorage YAML file (") + e.what() + ")");
+  }
 }
 
 // Runs body, turning OpenCV's parse errors into InvalidInput naming the file.
@@ -67,9 +149,24 @@ int read_int(const cv::FileNode& n, const std::string& path, const char* key) {
   return static_cast<int>(v);
 }
 
+// The largest matrix any of our files holds is 6x6 (covariance) or 14x1 (distortion).
+constexpr int kMaxMatrixSide = 16;
+
 cv::Mat read_matrix(const cv::FileNode& n, const std::string& path, const char* key) {
   cv::Mat m;
   if (!n.isMap()) fail(path, std::string("'") + key + "' is not an opencv-matrix");
+  // Checked before OpenCV reads it: OpenCV allocates rows x cols before it compares that with the
+  // data (a 100000x100000 header is an 80 GB allocation), and takes "sizes" (an n-d matrix).
+  const cv::FileNode rows = n["rows"], cols = n["cols"], data = n["data"];
+  if (!rows.isInt() || !cols.isInt() || !data.isSeq())
+    fail(path, std::string("'") + key + "' is not an opencv-matrix with rows, cols and data");
+  const int nr = rows, nc = cols;
+  const std::string shape = std::to_string(nr) + "x" + std::to_string(nc);
+  if (nr < 1 || nc < 1 || nr > kMaxMatrixSide || nc > kMaxMatrixSide)
+    fail(path, std::string("'") + key + "' is " + shape + ", outside 1.." + std::to_string(kMaxMatrixSide) +
+                   " per side");
+  if (data.size() != static_cast<size_t>(nr) * static_cast<size_t>(nc))
+    fail(path, std::string("'") + key + "' has " + std::to_string(data.size()) + " values for " + shape);
   n >> m;
   if (m.empty() || m.channels() != 1) fail(path, std::string("'") + key + "' is not a matrix");
   m.convertTo(m, CV_64F);

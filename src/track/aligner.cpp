@@ -104,7 +104,7 @@ void damp(M* A, int n, double lambda) {
 
 Aligner::Aligner(ocl::Runtime& runtime, const Eigen::Matrix3d& K, const AlignerOptions& options,
                  bool with_orientation)
-    : runtime_(runtime), K_(K), options_(options), with_orientation_(with_orientation),
+    : K_(K), options_(options), with_orientation_(with_orientation),
       pass_(runtime, with_orientation ? kMotionParams + kOrientationParams : kMotionParams,
             kernel_options(options, false)),
       stats_pass_(runtime, with_orientation ? kMotionParams + kOrientationParams : kMotionParams,

@@ -158,7 +158,6 @@ class Aligner {
  private:
   void evaluate(const AlignmentPair& pair, const Extrinsics& e, int level, bool stats, ReduceSums* out);
 
-  ocl::Runtime& runtime_;
   Eigen::Matrix3d K_;
   AlignerOptions options_;
   bool with_orientation_;
