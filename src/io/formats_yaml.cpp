@@ -80,6 +80,21 @@ bool has_content_after_document_marker(std::string_view line) {
   return next != std::string_view::npos && line[next] != '#';
 }
 
+// A block sequence entry ('-' first on a line outside brackets, a "---" marker aside) that is not
+// "- value": a bare "-", or "-" glued to its value. OpenCV's parser loops forever on such entries
+// when they dedent ("   -x" then "--x-", "   - x" then "-"; found by fuzzing extrinsics.yaml).
+// planarvo writes "   - x" (the extrinsics' estimated parameters); in brackets a line may well
+// start with a negative number.
+bool is_malformed_sequence_entry(std::string_view line, int flow_depth) {
+  if (flow_depth > 0) return false;
+  const size_t first = line.find_first_not_of(" \t");
+  if (first == std::string_view::npos || line[first] != '-') return false;
+  if (first == 0 && line.substr(0, 3) == "---") return false;
+  const size_t value = line.find_first_not_of(" \t\r", first + 1);
+  return first + 1 >= line.size() || (line[first + 1] != ' ' && line[first + 1] != '\t') ||
+         value == std::string_view::npos;
+}
+
 // Refuses what OpenCV's parser cannot take safely: more than kMaxYamlBytes, or nesting deeper
 // than kMaxYamlNesting (reported with the line).
 void check_yaml_limits(const std::string& path) {
@@ -94,6 +109,8 @@ void check_yaml_limits(const std::string& path) {
   std::string line;
   int flow_depth = 0;
   for (int number = 1; std::getline(in, line); ++number) {
+    if (is_malformed_sequence_entry(line, flow_depth))
+      fail(detail::where(path, number), "a '-' sequence entry must be '- value'");
     if (line_nesting(line, flow_depth) > kMaxYamlNesting)
       fail(detail::where(path, number), "nests deeper than " + std::to_string(kMaxYamlNesting) +
                                             " levels (indentation, '-' entries and brackets)");

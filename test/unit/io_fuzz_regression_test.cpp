@@ -129,6 +129,33 @@ TEST(IoFuzzRegression, TextAfterTheDocumentMarkerIsRefusedNotAHang) {
   EXPECT_EQ(io::read_extrinsics_yaml(path).value.z, 0.5);
 }
 
+// OpenCV's parser loops forever on some block sequence entries that dedent
+// (fuzz/open/opencv_yaml_hang.yaml, found by fuzzing extrinsics.yaml); the reader refuses a '-'
+// entry outside brackets that is not "- value", naming the line, and still reads "- value"
+// entries and bracketed data whose lines start with a negative number.
+TEST(IoFuzzRegression, MalformedSequenceEntriesAreRefusedNotAHang) {
+  ScratchDir dir;
+  const std::pair<const char*, int> cases[] = {
+      {"%YAML:1.-\n   -%YAML:1.0\n--x-\n      -9.537\n", 2},  // the fuzzer's file
+      {"%YAML:1.0\n   - x\n-\n", 3},
+      {"%YAML:1.0\nx: 1\n   -x\n--x-\n", 3},
+      {"%YAML:1.0\nx: 1\n   - y\n-  \r\n", 4}};
+  for (const auto& [text, line] : cases) {
+    SCOPED_TRACE(text);
+    const std::string path = (dir / "extrinsics.yaml").string();
+    write_text(path, text);
+    const std::string msg = expect_invalid_input([&] { io::read_extrinsics_yaml(path); }, path, line);
+    EXPECT_THAT(msg, HasSubstr("a '-' sequence entry must be '- value'"));
+  }
+  const std::string path = (dir / "camera.yaml").string();
+  write_text(path, std::string(kCameraHead) +
+                       "camera_matrix: !!opencv-matrix\n   rows: 3\n   cols: 3\n   dt: d\n"
+                       "   data: [ 500., 0., 320., 0., 500.,\n       240., 0., 0., 1. ]\n"
+                       "distortion_coefficients: !!opencv-matrix\n   rows: 5\n   cols: 1\n   dt: d\n"
+                       "   data: [ 0.1,\n       -0.01, 0., 0., 0. ]\n");
+  EXPECT_EQ(io::read_camera_yaml(path).k2, -0.01);
+}
+
 // An empty key at the end of the file made OpenCV's parser throw std::length_error (not a
 // cv::Exception), which reached the C API as PLANARVO_ERROR_INTERNAL; found by fuzzing camera.yaml.
 TEST(IoFuzzRegression, OpenCVsLengthErrorIsInvalidInput) {
