@@ -1,9 +1,16 @@
-// The sanitizers' settings for the test executables, compiled in (the sanitizer runtimes call
-// these hooks at start-up), so that they hold however a test is started: ctest, a debugger, by
-// hand. The runtimes look them up as dynamic symbols (hence default visibility); in a build
-// without sanitizers nothing calls them.
+// The sanitizers' settings, compiled into the test executables and, in sanitizer builds, into the
+// planarvo tool (the sanitizer runtimes call these hooks at start-up), so that they hold however
+// a program is started: ctest, a test running the tool, a debugger, by hand. The runtimes look
+// them up as dynamic symbols (hence default visibility); in a build without sanitizers nothing
+// calls them.
 
-// AddressSanitizer keeps its defaults, LeakSanitizer included: the suite runs clean with it.
+// AddressSanitizer keeps its defaults, LeakSanitizer included, with one suppression: PoCL keeps
+// the LLVM objects with which it compiled kernels (a device's compiler state) to the end of the
+// process and never frees them. Only allocations made inside libpocl and libLLVM are suppressed.
+extern "C" const char* __lsan_default_suppressions();
+extern "C" __attribute__((visibility("default"))) const char* __lsan_default_suppressions() {
+  return "leak:libpocl.so\nleak:libLLVM\n";
+}
 
 extern "C" const char* __tsan_default_options();
 extern "C" __attribute__((visibility("default"))) const char* __tsan_default_options() { return "second_deadlock_stack=1"; }
