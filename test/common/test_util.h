@@ -3,6 +3,8 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <random>
 #include <string>
 
@@ -46,15 +48,10 @@ struct CommandResult {
   std::string output;  // stdout and stderr together
 };
 
-// Runs the planarvo command-line tool with the given arguments (a shell-quoted string), and
-// with env (shell-quoted NAME=value words, e.g. "POCL_CACHE_DIR=/tmp/x") added to its
-// environment. env is passed to env(1), so "-u NAME" words, before any NAME=value, remove a
-// variable (e.g. "-u HOME TMPDIR=/tmp/x").
-inline CommandResult run_cli(const std::string& args, const std::string& env = "") {
-  const std::string cmd = (env.empty() ? "" : "env " + env + " ") + "\"" + PLANARVO_CLI_PATH +
-                          "\" " + args + " 2>&1";
+// Runs a shell command line, stdout and stderr together.
+inline CommandResult run_command(const std::string& command) {
   CommandResult r;
-  FILE* p = popen(cmd.c_str(), "r");
+  FILE* p = popen((command + " 2>&1").c_str(), "r");
   if (!p) return r;
   char buf[4096];
   size_t n;
@@ -62,6 +59,20 @@ inline CommandResult run_cli(const std::string& args, const std::string& env = "
   const int status = pclose(p);
   r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   return r;
+}
+
+// Runs the planarvo command-line tool with the given arguments (a shell-quoted string), and
+// with env (shell-quoted NAME=value words, e.g. "POCL_CACHE_DIR=/tmp/x") added to its
+// environment. env is passed to env(1), so "-u NAME" words, before any NAME=value, remove a
+// variable (e.g. "-u HOME TMPDIR=/tmp/x").
+inline CommandResult run_cli(const std::string& args, const std::string& env = "") {
+  return run_command((env.empty() ? "" : "env " + env + " ") + "\"" + PLANARVO_CLI_PATH + "\" " + args);
+}
+
+// A whole file's bytes ("" when it cannot be read).
+inline std::string read_file(const std::filesystem::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
 }
 
 }  // namespace planarvo::test

@@ -30,10 +30,7 @@ using test::ScratchDir;
 
 constexpr double kDeg = M_PI / 180.0;
 
-std::string read(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-}
+std::string read(const fs::path& p) { return test::read_file(p); }
 
 fs::path posegraph(const std::string& name) { return test::shared_dir() / "data/posegraphs" / name; }
 

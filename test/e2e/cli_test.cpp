@@ -29,10 +29,7 @@ void write(const fs::path& p, const std::string& text) {
   std::ofstream(p, std::ios::binary) << text;
 }
 
-std::string read(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-}
+std::string read(const fs::path& p) { return test::read_file(p); }
 
 const char* kCameraYaml =
     "%YAML:1.0\n---\nimage_width: 64\nimage_height: 48\n"

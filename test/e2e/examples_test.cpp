@@ -20,18 +20,7 @@ namespace {
 
 constexpr double kDeg = M_PI / 180.0;
 
-// Runs a shell command line, stdout and stderr together.
-test::CommandResult run(const std::string& command) {
-  test::CommandResult r;
-  FILE* p = popen((command + " 2>&1").c_str(), "r");
-  if (!p) return r;
-  char buf[4096];
-  size_t n;
-  while ((n = fread(buf, 1, sizeof buf, p)) > 0) r.output.append(buf, n);
-  const int status = pclose(p);
-  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return r;
-}
+test::CommandResult run(const std::string& command) { return test::run_command(command); }
 
 std::string quoted(const std::string& s) { return "\"" + s + "\""; }
 
