@@ -9,6 +9,7 @@
 #include <stdexcept>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include <opencv2/core.hpp>
 
@@ -80,23 +81,73 @@ bool has_content_after_document_marker(std::string_view line) {
   return next != std::string_view::npos && line[next] != '#';
 }
 
-// A block sequence entry ('-' first on a line outside brackets, a "---" marker aside) that is not
-// "- value": a bare "-", or "-" glued to its value. OpenCV's parser loops forever on such entries
-// when they dedent ("   -x" then "--x-", "   - x" then "-"; found by fuzzing extrinsics.yaml).
-// planarvo writes "   - x" (the extrinsics' estimated parameters); in brackets a line may well
-// start with a negative number.
-bool is_malformed_sequence_entry(std::string_view line, int flow_depth) {
-  if (flow_depth > 0) return false;
+// A block sequence entry ('-' first on a line outside brackets, a "---" marker aside).
+enum class DashEntry { None, Value, Bare, Glued };
+DashEntry dash_entry(std::string_view line, int flow_depth) {
+  if (flow_depth > 0) return DashEntry::None;  // in brackets a line may start with a negative number
   const size_t first = line.find_first_not_of(" \t");
-  if (first == std::string_view::npos || line[first] != '-') return false;
-  if (first == 0 && line.substr(0, 3) == "---") return false;
-  const size_t value = line.find_first_not_of(" \t\r", first + 1);
-  return first + 1 >= line.size() || (line[first + 1] != ' ' && line[first + 1] != '\t') ||
-         value == std::string_view::npos;
+  if (first == std::string_view::npos || line[first] != '-') return DashEntry::None;
+  if (first == 0 && line.substr(0, 3) == "---") return DashEntry::None;
+  if (first + 1 < line.size() && line[first + 1] != ' ' && line[first + 1] != '\t' &&
+      line[first + 1] != '\r')
+    return DashEntry::Glued;
+  return line.find_first_not_of(" \t\r", first + 1) == std::string_view::npos ? DashEntry::Bare
+                                                                               : DashEntry::Value;
 }
 
-// Refuses what OpenCV's parser cannot take safely: more than kMaxYamlBytes, or nesting deeper
-// than kMaxYamlNesting (reported with the line).
+// The indentation of a content line outside brackets (not a directive, marker or comment), or
+// npos.
+size_t block_indent(std::string_view line, int flow_depth) {
+  if (flow_depth > 0 || line.empty() || line[0] == '%' || line.substr(0, 3) == "---" ||
+      line.substr(0, 3) == "...")
+    return std::string_view::npos;
+  const size_t indent = line.find_first_not_of(" \t");
+  if (indent == std::string_view::npos || line[indent] == '#' || line[indent] == '\r')
+    return std::string_view::npos;
+  return indent;
+}
+
+// The block structure OpenCV's parser loops forever on (hangs found by fuzzing both YAML
+// readers), checked line by line:
+// - a '-' entry glued to its value ("   -x" then "--x-");
+// - a bare '-' (OpenCV writes one before a nested map or sequence) whose next line is not
+//   indented deeper ("   - x" then "-" at the end);
+// - a line indented less than the lines it belongs to but not as much as any line above it
+//   (" x: 1" then "y: -1"), which YAML does not allow either.
+class BlockShape {
+ public:
+  // The message for a line that breaks a rule, empty if none; line numbers from 1.
+  std::string check(std::string_view line, int number, int flow_depth) {
+    const DashEntry dash = dash_entry(line, flow_depth);
+    if (dash == DashEntry::Glued) return "a '-' sequence entry must be '- value'";
+    const size_t indent = block_indent(line, flow_depth);
+    if (indent == std::string_view::npos) return {};
+    if (bare_line_ > 0 && indent <= bare_indent_) return bare_dash_message();
+    bare_line_ = dash == DashEntry::Bare ? number : 0;
+    bare_indent_ = indent;
+    if (levels_.empty() || indent > levels_.back()) {
+      levels_.push_back(indent);
+      return {};
+    }
+    while (!levels_.empty() && levels_.back() > indent) levels_.pop_back();
+    if (levels_.empty() || levels_.back() != indent)
+      return "indented less than the lines it belongs to, but not as much as any line above it";
+    return {};
+  }
+  // At the end of the file: the line of a bare '-' with nothing under it (else 0).
+  int dangling_bare_dash() const { return bare_line_; }
+  static std::string bare_dash_message() {
+    return "a bare '-' sequence entry must have its value on the lines below, indented deeper";
+  }
+
+ private:
+  std::vector<size_t> levels_;  // the open block indentations
+  int bare_line_ = 0;           // a bare '-' waiting for its value, and its indentation
+  size_t bare_indent_ = 0;
+};
+
+// Refuses what OpenCV's parser cannot take safely: more than kMaxYamlBytes, nesting deeper than
+// kMaxYamlNesting, and the shapes above on which it loops (reported with the line).
 void check_yaml_limits(const std::string& path) {
   std::error_code ec;
   const std::uintmax_t bytes = std::filesystem::file_size(path, ec);
@@ -108,15 +159,23 @@ void check_yaml_limits(const std::string& path) {
   if (!in) fail(path, "cannot be opened");
   std::string line;
   int flow_depth = 0;
-  for (int number = 1; std::getline(in, line); ++number) {
-    if (is_malformed_sequence_entry(line, flow_depth))
-      fail(detail::where(path, number), "a '-' sequence entry must be '- value'");
+  BlockShape shape;
+  int number = 1;
+  for (; std::getline(in, line); ++number) {
+    const std::string wrong = shape.check(line, number, flow_depth);
+    if (!wrong.empty()) {
+      // A bare '-' is reported at its own line.
+      const bool bare = wrong == BlockShape::bare_dash_message();
+      fail(detail::where(path, bare ? shape.dangling_bare_dash() : number), wrong);
+    }
     if (line_nesting(line, flow_depth) > kMaxYamlNesting)
       fail(detail::where(path, number), "nests deeper than " + std::to_string(kMaxYamlNesting) +
                                             " levels (indentation, '-' entries and brackets)");
     if (has_content_after_document_marker(line))
       fail(detail::where(path, number), "text after a '---' or '...' document marker is not supported");
   }
+  if (shape.dangling_bare_dash() > 0)
+    fail(detail::where(path, shape.dangling_bare_dash()), BlockShape::bare_dash_message());
 }
 
 // Opens path for reading, with our own message for a missing file (OpenCV's is a log line).

@@ -4,6 +4,8 @@
 #include <string>
 #include <utility>
 
+#include <opencv2/core.hpp>
+
 #include "common/test_util.h"
 #include "io/dataset.h"
 #include "io/formats.h"
@@ -131,21 +133,29 @@ TEST(IoFuzzRegression, TextAfterTheDocumentMarkerIsRefusedNotAHang) {
 
 // OpenCV's parser loops forever on some block sequence entries that dedent
 // (fuzz/open/opencv_yaml_hang.yaml, found by fuzzing extrinsics.yaml); the reader refuses a '-'
-// entry outside brackets that is not "- value", naming the line, and still reads "- value"
-// entries and bracketed data whose lines start with a negative number.
+// entry outside brackets glued to its value, or bare with nothing indented under it, naming the
+// line, and still reads "- value" entries and bracketed data whose lines start with a negative
+// number.
 TEST(IoFuzzRegression, MalformedSequenceEntriesAreRefusedNotAHang) {
   ScratchDir dir;
-  const std::pair<const char*, int> cases[] = {
-      {"%YAML:1.-\n   -%YAML:1.0\n--x-\n      -9.537\n", 2},  // the fuzzer's file
-      {"%YAML:1.0\n   - x\n-\n", 3},
-      {"%YAML:1.0\nx: 1\n   -x\n--x-\n", 3},
-      {"%YAML:1.0\nx: 1\n   - y\n-  \r\n", 4}};
-  for (const auto& [text, line] : cases) {
-    SCOPED_TRACE(text);
+  const char* const glued = "a '-' sequence entry must be '- value'";
+  const char* const bare = "a bare '-' sequence entry must have its value on the lines below";
+  const struct {
+    const char* text;
+    int line;
+    const char* says;
+  } cases[] = {
+      {"%YAML:1.-\n   -%YAML:1.0\n--x-\n      -9.537\n", 2, glued},  // the fuzzer's file
+      {"%YAML:1.0\n   - x\n-\n", 3, "indented less than"},
+      {"%YAML:1.0\nx: 1\n   -x\n--x-\n", 3, glued},
+      {"%YAML:1.0\nx: 1\n   - y\n-  \r\n", 4, bare},
+      {"%YAML:1.0\nx:\n   -\n   - 1\n", 3, bare}};
+  for (const auto& c : cases) {
+    SCOPED_TRACE(c.text);
     const std::string path = (dir / "extrinsics.yaml").string();
-    write_text(path, text);
-    const std::string msg = expect_invalid_input([&] { io::read_extrinsics_yaml(path); }, path, line);
-    EXPECT_THAT(msg, HasSubstr("a '-' sequence entry must be '- value'"));
+    write_text(path, c.text);
+    const std::string msg = expect_invalid_input([&] { io::read_extrinsics_yaml(path); }, path, c.line);
+    EXPECT_THAT(msg, HasSubstr(c.says));
   }
   const std::string path = (dir / "camera.yaml").string();
   write_text(path, std::string(kCameraHead) +
@@ -154,6 +164,48 @@ TEST(IoFuzzRegression, MalformedSequenceEntriesAreRefusedNotAHang) {
                        "distortion_coefficients: !!opencv-matrix\n   rows: 5\n   cols: 1\n   dt: d\n"
                        "   data: [ 0.1,\n       -0.01, 0., 0., 0. ]\n");
   EXPECT_EQ(io::read_camera_yaml(path).k2, -0.01);
+}
+
+// OpenCV's parser loops forever on a line that dedents to no enclosing level (" x: 1" then
+// "y: -1"; found by fuzzing both YAML readers); the reader refuses it, naming the line. What
+// OpenCV's own writer produces (nested maps, sequences of maps and of sequences, matrices, the
+// calibration sample's extra keys) still reads.
+TEST(IoFuzzRegression, DedentToNoEnclosingLevelIsRefusedNotAHang) {
+  ScratchDir dir;
+  const std::pair<const char*, int> cases[] = {
+      {"%YAML:1.0\n x: 1\ny: -1\n", 3},                  // the fuzzer's, minimised
+      {"%YAML:1.0\n---\n }x: 0.25\ny: -0.02\n", 4},       // as found (extrinsics)
+      {"%YAML:1.0\n -   } %\n1.0\n-  }\"356\n", 3},        // as found (camera), shortened
+      {"%YAML:1.0\na:\n    b: 1\n  c: 2\n", 4}};           // between two levels
+  for (const auto& [text, line] : cases) {
+    SCOPED_TRACE(text);
+    const std::string path = (dir / "extrinsics.yaml").string();
+    write_text(path, text);
+    std::string msg = expect_invalid_input([&] { io::read_extrinsics_yaml(path); }, path, line);
+    EXPECT_THAT(msg, HasSubstr("indented less than"));
+    msg = expect_invalid_input([&] { io::read_camera_yaml(path); }, path, line);
+    EXPECT_THAT(msg, HasSubstr("indented less than"));
+  }
+
+  // A camera file written by OpenCV's FileStorage, with the structures its writer makes.
+  const std::string path = (dir / "camera.yaml").string();
+  {
+    cv::FileStorage fs(path, cv::FileStorage::WRITE);
+    fs << "calibration_time" << "Mon 23 Nov 2026";
+    fs << "image_width" << 640 << "image_height" << 480;
+    fs << "camera_matrix" << (cv::Mat_<double>(3, 3) << 500, 0, 320, 0, 500, 240, 0, 0, 1);
+    fs << "distortion_coefficients" << (cv::Mat_<double>(5, 1) << -0.1, 0.01, 0, 0, 0);
+    fs << "extrinsic_parameters" << cv::Mat(cv::Mat_<double>::ones(12, 6) * -0.5);
+    fs << "views" << "[";
+    for (int i = 0; i < 3; ++i) {
+      fs << "{" << "id" << i << "error" << -0.25 * i << "corners" << "[" << -1 << 2 << "]";
+      fs << "nested" << "{" << "a" << -1 << "b" << "[" << "[" << 1 << -2 << "]" << "]" << "}" << "}";
+    }
+    fs << "]";
+    fs << "flags" << "{:" << "fix_aspect" << 1 << "k3" << -0 << "}";
+    fs << "trailer" << -3;
+  }
+  EXPECT_EQ(io::read_camera_yaml(path).k1, -0.1);
 }
 
 // An empty key at the end of the file made OpenCV's parser throw std::length_error (not a
