@@ -9,7 +9,15 @@ install(TARGETS planarvo EXPORT planarvoTargets
   PUBLIC_HEADER DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/planarvo)
 # The vision module (src/capi/README.md), found by the library relative to itself.
 install(TARGETS planarvo_vision LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}/planarvo)
-set_target_properties(planarvo_cli PROPERTIES INSTALL_RPATH "$ORIGIN/../${CMAKE_INSTALL_LIBDIR}")
+# One RUNPATH for the build tree and the installed tool, both relative to the binary: the library
+# beside it (build tree) or in ../lib (install). Letting CMake rewrite a build-tree RUNPATH at
+# install instead leaves an empty entry in the build tree's (".../build:", room for the rewrite),
+# which the loader reads as the current directory: a build-tree `planarvo` looked for every
+# library in the working directory first (a dozen failed opens per library at start-up, and a
+# library planted there would be loaded).
+set_target_properties(planarvo_cli PROPERTIES
+  BUILD_WITH_INSTALL_RPATH ON
+  INSTALL_RPATH "$ORIGIN/../${CMAKE_INSTALL_LIBDIR}:$ORIGIN")
 install(TARGETS planarvo_cli RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
 # The licence and the user documentation (file formats, conventions, outputs) go where Debian
 # puts a package's: <prefix>/share/doc/planarvo.
