@@ -2,6 +2,7 @@
 // calibration sample writes it) and the extrinsics (docs/formats.md, "Extrinsics YAML").
 #include <algorithm>
 #include <array>
+#include <cctype>
 #include <cmath>
 #include <cstdint>
 #include <filesystem>
@@ -107,13 +108,59 @@ size_t block_indent(std::string_view line, int flow_depth) {
   return indent;
 }
 
+bool is_blank(char c) { return c == ' ' || c == '\t' || c == '\r'; }
+
+// A value's tag, if it has one, must be one of OpenCV's: "!!name" ("!!opencv-matrix").
+bool is_opencv_tag_or_untagged(std::string_view value) {
+  if (value.empty() || value[0] != '!') return true;
+  size_t i = 2;
+  if (value.size() < 3 || value[1] != '!') return false;
+  while (i < value.size() && (std::isalnum(static_cast<unsigned char>(value[i])) || value[i] == '-' ||
+                              value[i] == '_'))
+    ++i;
+  return i > 2 && (i == value.size() || is_blank(value[i]) || value[i] == '#');
+}
+
+// What may follow a block line's indentation and '- ' entries, as OpenCV writes and reads it:
+// "name: value" or "name:" (name: a letter or '_', then letters, digits, '_', '-'; OpenCV's writer
+// allows no other keys), a bracketed, quoted or tagged value under its key, and in a sequence
+// entry any value. Tags only as OpenCV's. The
+// parser loops forever on a tagged key line ("!f x:1" then "y: -"; found by fuzzing
+// extrinsics.yaml). Returns the problem, or empty.
+std::string block_content_problem(std::string_view rest, bool sequence_entry) {
+  while (!rest.empty() && is_blank(rest.back())) rest.remove_suffix(1);
+  if (rest.empty() || rest[0] == '#') return {};
+  size_t i = 0;
+  if (std::isalpha(static_cast<unsigned char>(rest[0])) || rest[0] == '_') {
+    while (i < rest.size() && (std::isalnum(static_cast<unsigned char>(rest[i])) || rest[i] == '_' ||
+                               rest[i] == '-'))
+      ++i;
+    size_t colon = i;
+    while (colon < rest.size() && (rest[colon] == ' ' || rest[colon] == '\t')) ++colon;
+    if (colon < rest.size() && rest[colon] == ':') {
+      std::string_view value = rest.substr(colon + 1);
+      while (!value.empty() && is_blank(value.front())) value.remove_prefix(1);
+      return is_opencv_tag_or_untagged(value) ? std::string()
+                                              : "a tag other than OpenCV's '!!name' is not supported";
+    }
+  }
+  // A value on the lines after its key ("estimated:" then "   []", as OpenCV writes an empty
+  // sequence): brackets, quotes or a tag; any value in a sequence entry.
+  const char c = rest[0];
+  if (!sequence_entry && c != '[' && c != '{' && c != '"' && c != '\'' && c != '!')
+    return "expected 'name: value' (a name of letters, digits, '_' and '-')";
+  return is_opencv_tag_or_untagged(rest) ? std::string()
+                                         : "a tag other than OpenCV's '!!name' is not supported";
+}
+
 // The block structure OpenCV's parser loops forever on (hangs found by fuzzing both YAML
 // readers), checked line by line:
 // - a '-' entry glued to its value ("   -x" then "--x-");
 // - a bare '-' (OpenCV writes one before a nested map or sequence) whose next line is not
 //   indented deeper ("   - x" then "-" at the end);
 // - a line indented less than the lines it belongs to but not as much as any line above it
-//   (" x: 1" then "y: -1"), which YAML does not allow either.
+//   (" x: 1" then "y: -1"), which YAML does not allow either;
+// - what block_content_problem refuses.
 class BlockShape {
  public:
   // The message for a line that breaks a rule, empty if none; line numbers from 1.
@@ -125,6 +172,15 @@ class BlockShape {
     if (bare_line_ > 0 && indent <= bare_indent_) return bare_dash_message();
     bare_line_ = dash == DashEntry::Bare ? number : 0;
     bare_indent_ = indent;
+    size_t p = indent;  // past the '- ' entries
+    bool entry = false;
+    while (p < line.size() && line[p] == '-' && (p + 1 == line.size() || is_blank(line[p + 1]))) {
+      entry = true;
+      ++p;
+      while (p < line.size() && (line[p] == ' ' || line[p] == '\t')) ++p;
+    }
+    std::string problem = block_content_problem(line.substr(p), entry);
+    if (!problem.empty()) return problem;
     if (levels_.empty() || indent > levels_.back()) {
       levels_.push_back(indent);
       return {};
