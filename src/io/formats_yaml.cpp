@@ -202,6 +202,68 @@ class BlockShape {
   size_t bare_indent_ = 0;
 };
 
+// A directive line: only OpenCV's "%YAML:1.x" (or "%YAML 1.x"), on the first line. OpenCV reads
+// the rest of a longer first line as part of the document ("%YAML:1.[" opened a bracket that
+// hid every following line from the checks; found by fuzzing camera.yaml).
+bool is_yaml_directive(std::string_view line) {
+  if (line.size() < 9 || line.substr(0, 5) != "%YAML" || (line[5] != ':' && line[5] != ' ') ||
+      line.substr(6, 2) != "1.")
+    return false;
+  size_t i = 8;
+  while (i < line.size() && std::isdigit(static_cast<unsigned char>(line[i]))) ++i;
+  while (i < line.size() && is_blank(line[i])) ++i;
+  return i == line.size() || line[i] == '#';
+}
+
+// Brackets as OpenCV writes them ("[ 1., 2. ]", "{ a: 1 }", "[]"), followed over lines: each
+// closes the kind it opened, none is left open at a document marker or the end of the file, an
+// entry inside them is not a bare '-', and a key inside braces is not empty ("{:" looped
+// OpenCV's parser forever with a bare '-' after it; found by fuzzing extrinsics.yaml).
+class FlowShape {
+ public:
+  std::string check(std::string_view line) {
+    if (!open_.empty() && (line.substr(0, 3) == "---" || line.substr(0, 3) == "..."))
+      return "a '" + std::string(1, open_.back()) + "' is not closed before the document marker";
+    char quote = 0;
+    for (size_t i = 0; i < line.size(); ++i) {
+      const char c = line[i];
+      if (quote) {
+        if (c == '\\' && quote == '"') ++i;
+        else if (c == quote) quote = 0;
+        continue;
+      }
+      if (c == '"' || c == '\'') {
+        quote = c;
+      } else if (c == '#' && (i == 0 || is_blank(line[i - 1]))) {
+        break;
+      } else if (c == '[' || c == '{') {
+        open_.push_back(c);
+        item_start_ = true;
+        continue;
+      } else if (c == ']' || c == '}') {
+        if (open_.empty()) return std::string("a '") + c + "' closes nothing";
+        if ((c == ']') != (open_.back() == '['))
+          return std::string("a '") + c + "' closes a '" + open_.back() + "'";
+        open_.pop_back();
+      } else if (!open_.empty() && item_start_ && c == ':' && open_.back() == '{') {
+        return "an empty key inside braces";
+      } else if (!open_.empty() && item_start_ && c == '-' &&
+                 (i + 1 == line.size() || is_blank(line[i + 1]))) {
+        return "a '-' entry inside brackets";
+      }
+      if (c == ',') item_start_ = true;
+      else if (!is_blank(c)) item_start_ = false;
+    }
+    return {};
+  }
+  // At the end of the file: the bracket left open, or 0.
+  char unclosed() const { return open_.empty() ? 0 : open_.back(); }
+
+ private:
+  std::string open_;         // the open brackets, innermost last
+  bool item_start_ = false;  // at the start of an item inside brackets
+};
+
 // Refuses what OpenCV's parser cannot take safely: more than kMaxYamlBytes, nesting deeper than
 // kMaxYamlNesting, and the shapes above on which it loops (reported with the line).
 void check_yaml_limits(const std::string& path) {
@@ -216,8 +278,15 @@ void check_yaml_limits(const std::string& path) {
   std::string line;
   int flow_depth = 0;
   BlockShape shape;
+  FlowShape flow;
   int number = 1;
   for (; std::getline(in, line); ++number) {
+    if (!line.empty() && line[0] == '%') {
+      if (number == 1 && is_yaml_directive(line)) continue;
+      fail(detail::where(path, number), "a directive other than '%YAML:1.0' on the first line");
+    }
+    const std::string wrong_flow = flow.check(line);
+    if (!wrong_flow.empty()) fail(detail::where(path, number), wrong_flow);
     const std::string wrong = shape.check(line, number, flow_depth);
     if (!wrong.empty()) {
       // A bare '-' is reported at its own line.
@@ -232,6 +301,8 @@ void check_yaml_limits(const std::string& path) {
   }
   if (shape.dangling_bare_dash() > 0)
     fail(detail::where(path, shape.dangling_bare_dash()), BlockShape::bare_dash_message());
+  if (flow.unclosed())
+    fail(path, std::string("a '") + flow.unclosed() + "' is not closed at the end of the file");
 }
 
 // Opens path for reading, with our own message for a missing file (OpenCV's is a log line).

@@ -163,7 +163,8 @@ TEST(IoCameraYaml, BadFilesNameTheFile) {
     const std::string msg = expect_invalid_input([&] { io::read_camera_yaml(path); }, path);
     EXPECT_THAT(msg, HasSubstr(says));
   };
-  bad("malformed.yaml", "%YAML:1.0\n---\nimage_width: [640\n  : : {\n", "valid OpenCV");
+  bad("malformed.yaml", "%YAML:1.0\n---\nimage_width: [640\n  : : {\n", "is not closed");
+  bad("unterminated.yaml", "%YAML:1.0\n---\nimage_width: \"640\n", "valid OpenCV");  // OpenCV's error
   bad("no_width.yaml", replace(kGoodCameraYaml, "image_width: 640\n", ""), "image_width");
   bad("no_height.yaml", replace(kGoodCameraYaml, "image_height: 480\n", ""), "image_height");
   bad("no_k.yaml", replace(kGoodCameraYaml, "camera_matrix:", "other_matrix:"), "camera_matrix");
@@ -264,7 +265,8 @@ TEST(IoExtrinsicsYaml, BadFilesNameTheFile) {
   bad("no_yaw.yaml", replace(six, "yaw: -1\n", ""), "yaw");
   bad("nan.yaml", replace(six, "z: 0.3", "z: .Nan"), "finite");
   bad("text.yaml", replace(six, "pitch: 0.05", "pitch: steep"), "pitch");
-  bad("malformed.yaml", "x: [1, 2\ny: {\n", "valid OpenCV");
+  bad("malformed.yaml", "x: [1, 2\ny: {\n", "is not closed");
+  bad("unterminated.yaml", "%YAML:1.0\n---\nx: \"0.1\n", "valid OpenCV");  // OpenCV's own error
   bad("estimated_unknown.yaml", six + "estimated: [x, height]\n", "height");
   bad("estimated_twice.yaml", six + "estimated: [x, x]\n", "twice");
   bad("estimated_scalar.yaml", six + "estimated: 3\n", "estimated");

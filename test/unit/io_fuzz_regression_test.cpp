@@ -145,7 +145,8 @@ TEST(IoFuzzRegression, MalformedSequenceEntriesAreRefusedNotAHang) {
     int line;
     const char* says;
   } cases[] = {
-      {"%YAML:1.-\n   -%YAML:1.0\n--x-\n      -9.537\n", 2, glued},  // the fuzzer's file
+      {"%YAML:1.-\n   -%YAML:1.0\n--x-\n      -9.537\n", 1, "a directive other than"},  // as found
+      {"%YAML:1.0\n   -%YAML:1.0\n--x-\n      -9.537\n", 2, glued},
       {"%YAML:1.0\n   - x\n-\n", 3, "indented less than"},
       {"%YAML:1.0\nx: 1\n   -x\n--x-\n", 3, glued},
       {"%YAML:1.0\nx: 1\n   - y\n-  \r\n", 4, bare},
@@ -183,9 +184,15 @@ TEST(IoFuzzRegression, DedentToNoEnclosingLevelIsRefusedNotAHang) {
   } cases[] = {
       {"%YAML:1.0\n x: 1\ny: -1\n", 3, dedent},                   // the fuzzer's, minimised
       {"%YAML:1.0\na:\n    b: 1\n  c: 2\n", 4, dedent},             // between two levels
-      {"%YAML:1.0\n---\n }x: 0.25\ny: -0.02\n", 3, no_key},        // as found (extrinsics)
-      {"%YAML:1.0\n -   } %\n1.0\n-  }\"356\n", 3, no_key},         // as found (camera), shortened
-      {"%YAML:1.\n---\n!f x:1\ny: -\n", 3, "a tag other than"},    // a tagged key (extrinsics)
+      {"%YAML:1.0\n---\n }x: 0.25\ny: -0.02\n", 3, "closes nothing"},  // as found (extrinsics)
+      {"%YAML:1.0\n -   } %\n1.0\n-  }\"356\n", 2, "closes nothing"},   // as found (camera), shortened
+      {"%YAML:1.0\n---\nx: 1\n1.0\n", 4, no_key},
+      {"%YAML:1.[\n - 0\na1\n-", 1, "a directive other than"},     // hid the file (camera)
+      {"%YAML:1.0\n_:0\n{:%\n...\n-", 3, "an empty key inside braces"},  // (extrinsics)
+      {"%YAML:1.0\nx: [ 1,\n - 2 ]\n", 3, "a '-' entry inside brackets"},
+      {"%YAML:1.0\nx: [ 1,\n...\n", 3, "is not closed before the document marker"},
+      {"%YAML:1.0\nx: [ 1 }\n", 2, "a '}' closes a '['"},
+      {"%YAML:1.0\n---\n!f x:1\ny: -\n", 3, "a tag other than"},    // a tagged key (extrinsics)
       {"%YAML:1.0\nx: !f 1\n", 2, "a tag other than OpenCV's"}};
   for (const auto& c : cases) {
     SCOPED_TRACE(c.text);
@@ -223,7 +230,7 @@ TEST(IoFuzzRegression, DedentToNoEnclosingLevelIsRefusedNotAHang) {
 TEST(IoFuzzRegression, OpenCVsLengthErrorIsInvalidInput) {
   ScratchDir dir;
   const std::string path = (dir / "camera.yaml").string();
-  write_text(path, "%YAML:1.\n   t:f\n   :");
+  write_text(path, "%YAML:1.0\n   t:f\n   :");
   // Refused by the line checks now, before OpenCV parses (the catch stays, for what they miss).
   const std::string msg = expect_invalid_input([&] { io::read_camera_yaml(path); }, path, 3);
   EXPECT_THAT(msg, HasSubstr("expected 'name: value'"));
