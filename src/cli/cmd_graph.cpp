@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "common.h"
+#include "heap.h"
 
 namespace planarvo::cli {
 namespace {
@@ -54,6 +55,7 @@ int cmd_posegraph(int argc, char** argv) {
     return kExitOk;
   }
   args.expect_positionals(1, "IN.g2o, the pose graph to optimise");
+  prepare_heap();  // a short, allocation-bound run (heap.h)
   planarvo_posegraph_options o;
   planarvo_posegraph_options_init(&o);
   o.max_iterations = args.get_int_in("max-iterations", o.max_iterations, 1, 1000000);
