@@ -1,11 +1,9 @@
 #include "graph/g2o.h"
 
-#include <cerrno>
 #include <charconv>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
-#include <cstdlib>
 #include <fstream>
 #include <string>
 #include <unordered_map>
@@ -22,31 +20,33 @@ namespace {
 // Reads whitespace-separated fields of one line, reporting errors with file and line.
 class LineReader {
  public:
-  LineReader(const std::filesystem::path& path, int line, const char* text)
-      : path_(path), line_(line), p_(text) {}
+  LineReader(const std::filesystem::path& path, int line, const char* text, const char* end)
+      : path_(path), line_(line), p_(text), end_(end) {}
 
   [[noreturn]] void fail(const std::string& what) const {
     throw_invalid_input(path_.string() + ":" + std::to_string(line_) + ": " + what);
   }
+  // std::from_chars: exact, independent of the C locale (strtod reads "1,5" in a German one);
+  // the one thing of strtod's it does not take, a leading '+', is skipped first.
   double number(const char* field) {
     skip_space();
-    char* end = nullptr;
-    errno = 0;
-    const double v = std::strtod(p_, &end);
-    if (end == p_ || errno == ERANGE || !is_end(*end))
+    const char* b = p_ + (*p_ == '+' && p_ + 1 < end_ && p_[1] != '-' && p_[1] != '+');
+    double v = 0.0;
+    const auto [end, ec] = std::from_chars(b, end_, v);
+    if (ec != std::errc() || end == b || !is_end(*end))
       fail(std::string("expected a number for ") + field);
     p_ = end;
     return v;
   }
   int integer(const char* field) {
     skip_space();
-    char* end = nullptr;
-    errno = 0;
-    const long v = std::strtol(p_, &end, 10);
-    if (end == p_ || errno == ERANGE || !is_end(*end) || v < INT32_MIN || v > INT32_MAX)
+    const char* b = p_ + (*p_ == '+' && p_ + 1 < end_ && p_[1] != '-' && p_[1] != '+');
+    int v = 0;
+    const auto [end, ec] = std::from_chars(b, end_, v);
+    if (ec != std::errc() || end == b || !is_end(*end))
       fail(std::string("expected an integer for ") + field);
     p_ = end;
-    return static_cast<int>(v);
+    return v;
   }
   void expect_end() {
     skip_space();
@@ -61,6 +61,7 @@ class LineReader {
   const std::filesystem::path& path_;
   int line_;
   const char* p_;
+  const char* end_;  // the line's terminating '\0'
 };
 
 }  // namespace
@@ -80,7 +81,7 @@ G2oFile read_g2o(const std::filesystem::path& path) {
     size_t b = line.find_first_of(" \t\r", a);
     if (b == std::string::npos) b = line.size();
     const std::string tag = line.substr(a, b - a);
-    LineReader r(path, line_no, line.c_str() + b);
+    LineReader r(path, line_no, line.c_str() + b, line.c_str() + line.size());
     if (tag == "VERTEX_SE2") {
       G2oVertex v;
       v.id = r.integer("the vertex id");

@@ -110,7 +110,7 @@ void NormalEquations::build_pattern(const FactorGraph& graph,
   slot_value_offset_.clear();
   slot_jac_offset_.clear();
   slot_body_frame_.clear();
-  int residual_total = 0, jac_total = 0, max_m = 0, max_slots = 0;
+  int max_jac = 0, max_m = 0, max_slots = 0;
   for (int f = 0; f < nf; ++f) {
     const Factor& fac = graph.factor(f);
     const auto& vars = fac.variables();
@@ -121,8 +121,7 @@ void NormalEquations::build_pattern(const FactorGraph& graph,
     info.residual_dim = fac.residual_dim();
     info.slot_begin = static_cast<int>(slot_var_.size());
     info.num_slots = static_cast<int>(vars.size());
-    info.residual_offset = residual_total;
-    residual_total += info.residual_dim;
+    int jac_total = 0;
     for (size_t k = 0; k < vars.size(); ++k) {
       const auto v = static_cast<size_t>(vars[k]);
       slot_var_.push_back(vars[k]);
@@ -141,6 +140,7 @@ void NormalEquations::build_pattern(const FactorGraph& graph,
         adjacency_[v].push_back(vars[l]);
       }
     }
+    max_jac = std::max(max_jac, jac_total);
     max_m = std::max(max_m, info.residual_dim);
     max_slots = std::max(max_slots, info.num_slots);
     factors_.push_back(info);
@@ -151,8 +151,7 @@ void NormalEquations::build_pattern(const FactorGraph& graph,
   }
 
   // Buffers.
-  r_.assign(static_cast<size_t>(residual_total), 0.0);
-  jac_.assign(static_cast<size_t>(jac_total), 0.0);
+  jac_.assign(static_cast<size_t>(max_jac), 0.0);
   ptr_scratch_.assign(static_cast<size_t>(max_slots), nullptr);
   jac_ptr_scratch_.assign(static_cast<size_t>(max_slots), nullptr);
   e_scratch_.assign(static_cast<size_t>(max_m), 0.0);
@@ -160,12 +159,7 @@ void NormalEquations::build_pattern(const FactorGraph& graph,
   g_ = Eigen::VectorXd::Zero(n_);
   h_diag_ = Eigen::VectorXd::Zero(n_);
   d_ = Eigen::VectorXd::Zero(n_);
-
-  // Columns in variable order to begin with; analyze() may renumber them.
-  std::vector<VariableId> order;
-  for (VariableId v = 0; v < nv; ++v)
-    if (num_free_[static_cast<size_t>(v)] > 0) order.push_back(v);
-  number_columns(order);
+  // Columns: analyze() numbers them in the elimination order.
 }
 
 void NormalEquations::number_columns(const std::vector<VariableId>& order) {

@@ -8,8 +8,9 @@
 // variables, the offset of its block inside the CSC value array, so refilling H is a pass over
 // the factors that adds small dense blocks in place — no triplets, no sort, no allocation.
 // The symbolic analysis (fill-reducing ordering, symbolic factor) runs once, in the
-// constructor; for a simplicial factor the variables' columns are then renumbered in the
-// elimination order, so that CHOLMOD factorises H as stored, without permuting copies.
+// constructor; the variables' columns are numbered in the elimination order (for a simplicial
+// factor), so that CHOLMOD factorises H as stored, without permuting copies. With the default
+// block AMD ordering the order is known before H's pattern is built, and CHOLMOD analyses once.
 // factorize() is a numeric factorisation only.
 #pragma once
 #include <cstdint>
@@ -76,8 +77,8 @@ struct LinearSolverOptions {
 
 // Time spent in each phase, seconds.
 struct PhaseTimes {
-  double linearize = 0.0;  // factor errors and Jacobians, whitening, robust weights
-  double build = 0.0;      // filling H and g
+  double linearize = 0.0;  // factor errors and Jacobians, whitening, robust weights, and
+                           // their blocks added into H and g (one pass, factor by factor)
   double factorize = 0.0;  // numeric Cholesky
   double solve = 0.0;      // triangular solves
   double evaluate = 0.0;   // cost at trial points
@@ -166,8 +167,13 @@ class NormalEquations {
   // Assigns columns to the free variables in `order` and builds H's CSC pattern and the
   // factors' block offsets for that numbering.
   void number_columns(const std::vector<VariableId>& order);
-  std::vector<int> block_amd_permutation();
+  // The free variables in the order of AMD on the variable graph.
+  std::vector<VariableId> block_amd_order();
+  // Numbers the columns and analyses H (the ordering, the symbolic factor).
   void analyze();
+  // cholmod_analyze of H as numbered (no fill-reducing permutation), with or without CHOLMOD's
+  // etree postorder; replaces L.
+  void analyze_natural(bool postorder);
   static std::string ordering_name(int cholmod_ordering);
   void release();
   void set_damping(double lambda, Damping damping);
@@ -175,10 +181,12 @@ class NormalEquations {
   void multiply(const double* x, double* y, bool damped) const;
   // y = (last factor)⁻¹·x (y may be x), allocation-free for a simplicial factor.
   bool factor_solve(const double* x, double* y);
-  void linearize_factor_into(int f, const double* values, double& cost);
+  // One factor's whitened, robust-weighted error and Jacobians into e_scratch_ and jac_; adds
+  // its cost; false when none of its variables is free.
+  bool linearize_factor_into(int f, const double* values, double& cost);
   struct FactorInfo;
-  // Adds a linearised factor's J̃ᵀJ̃ blocks to H and J̃ᵀr̃ to g; M: the residual size when fixed
-  // at compile time, 0 for any.
+  // Adds the factor just linearised (e_scratch_, jac_) to H (J̃ᵀJ̃ blocks) and g (J̃ᵀr̃); M: the
+  // residual size when fixed at compile time, 0 for any.
   template <int M>
   void accumulate_factor(const FactorInfo& info);
 
@@ -207,19 +215,19 @@ class NormalEquations {
     const double* sqrt_info;  // constant information; null when state dependent
     int residual_dim;
     int slot_begin, num_slots;
-    int residual_offset;  // into r_
     int pair_begin;       // into pair_offset_: num_slots·(num_slots+1)/2 entries
   };
   std::vector<FactorInfo> factors_;
   std::vector<int> slot_var_;        // variable of each slot
   std::vector<int> slot_value_offset_;
-  std::vector<int> slot_jac_offset_;  // into jac_, −1 when the variable has no free parameter
+  std::vector<int> slot_jac_offset_;  // into jac_ (from the factor's first slot), −1 when the
+                                      // variable has no free parameter
   std::vector<char> slot_body_frame_;  // body_frame_ of the slot's variable
   std::vector<int> pair_offset_;      // offset of the block within its CSC columns (see .cpp)
 
   // Buffers, allocated once.
-  std::vector<double> r_;    // whitened residuals
-  std::vector<double> jac_;  // whitened Jacobians (full variable dims), column-major per slot
+  std::vector<double> jac_;  // one factor's whitened Jacobians (full variable dims),
+                             // column-major per slot; sized for the largest factor
   std::vector<const double*> ptr_scratch_;
   std::vector<double*> jac_ptr_scratch_;
   std::vector<double> e_scratch_, sqrt_info_scratch_;

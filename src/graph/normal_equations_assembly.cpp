@@ -118,7 +118,7 @@ double NormalEquations::evaluate_cost(const double* values, PhaseTimes* times) {
   return cost;
 }
 
-void NormalEquations::linearize_factor_into(int f, const double* values, double& cost) {
+bool NormalEquations::linearize_factor_into(int f, const double* values, double& cost) {
   const FactorInfo& info = factors_[static_cast<size_t>(f)];
   const int m = info.residual_dim;
   bool any_free = false;
@@ -129,7 +129,7 @@ void NormalEquations::linearize_factor_into(int f, const double* values, double&
     jac_ptr_scratch_[static_cast<size_t>(k)] = jo >= 0 ? jac_.data() + jo : nullptr;
     any_free |= jo >= 0;
   }
-  double* e = r_.data() + info.residual_offset;
+  double* e = e_scratch_.data();
   info.factor->evaluate(ptr_scratch_.data(), e, any_free ? jac_ptr_scratch_.data() : nullptr);
   const double* L = info.sqrt_info;
   if (!L) {
@@ -149,7 +149,7 @@ void NormalEquations::linearize_factor_into(int f, const double* values, double&
   } else {
     cost += s;
   }
-  if (!any_free) return;
+  if (!any_free) return false;
   const auto& types = info.factor->types();
   for (int k = 0; k < info.num_slots; ++k) {
     double* J = jac_ptr_scratch_[static_cast<size_t>(k)];
@@ -164,6 +164,7 @@ void NormalEquations::linearize_factor_into(int f, const double* values, double&
       right_exp_jacobian(cs[0], cs[1], J, m);
     }
   }
+  return true;
 }
 
 template <int M>
@@ -172,7 +173,7 @@ void NormalEquations::accumulate_factor(const FactorInfo& info) {
   const int* Hp = static_cast<const int*>(H_->p);
   double* g = g_.data();
   const int m = info.residual_dim;
-  const double* r = r_.data() + info.residual_offset;
+  const double* r = e_scratch_.data();
   int pair = info.pair_begin;
   for (int k = 0; k < info.num_slots; ++k) {
     const auto sk = static_cast<size_t>(info.slot_begin + k);
@@ -222,7 +223,7 @@ void NormalEquations::accumulate_factor(const FactorInfo& info) {
 }
 
 double NormalEquations::linearize(const double* values, PhaseTimes* times) {
-  auto t0 = Clock::now();
+  const auto t0 = Clock::now();
   // cos, sin of each body-frame pose's heading, once per pose rather than once per factor.
   for (size_t v = 0; v < body_frame_.size(); ++v)
     if (body_frame_[v]) {
@@ -230,18 +231,17 @@ double NormalEquations::linearize(const double* values, PhaseTimes* times) {
       rotation_[2 * v] = std::cos(theta);
       rotation_[2 * v + 1] = std::sin(theta);
     }
-  double cost = 0.0;
-  const int nf = static_cast<int>(factors_.size());
-  for (int f = 0; f < nf; ++f) linearize_factor_into(f, values, cost);
-  if (times) times->linearize += seconds_since(t0);
-
-  t0 = Clock::now();
   double* Hx = static_cast<double*>(H_ ? H_->x : nullptr);
   if (H_) std::memset(Hx, 0, static_cast<size_t>(static_cast<const int*>(H_->p)[n_]) * sizeof(double));
   g_.setZero();
-  for (const FactorInfo& info : factors_) {
-    // Fixed-size dot products for the common residual sizes.
-    switch (info.residual_dim) {
+  // Factor by factor: its error and Jacobians, then at once its blocks into H and g, while they
+  // are in cache (no whole-graph Jacobian is stored).
+  double cost = 0.0;
+  const int nf = static_cast<int>(factors_.size());
+  for (int f = 0; f < nf; ++f) {
+    if (!linearize_factor_into(f, values, cost)) continue;
+    const FactorInfo& info = factors_[static_cast<size_t>(f)];
+    switch (info.residual_dim) {  // fixed-size dot products for the common residual sizes
       case 1: accumulate_factor<1>(info); break;
       case 2: accumulate_factor<2>(info); break;
       case 3: accumulate_factor<3>(info); break;
@@ -249,7 +249,7 @@ double NormalEquations::linearize(const double* values, PhaseTimes* times) {
     }
   }
   for (int c = 0; c < n_; ++c) h_diag_[c] = Hx[diag_pos_[static_cast<size_t>(c)]];
-  if (times) times->build += seconds_since(t0);
+  if (times) times->linearize += seconds_since(t0);
   return cost;
 }
 

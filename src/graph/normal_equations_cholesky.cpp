@@ -18,19 +18,21 @@ namespace planarvo::graph {
 using normal_equations_detail::Clock;
 using normal_equations_detail::seconds_since;
 
-std::vector<int> NormalEquations::block_amd_permutation() {
-  // AMD on the variable graph (upper pattern, one node per free variable), expanded to columns.
+std::vector<VariableId> NormalEquations::block_amd_order() {
+  // AMD on the variable graph (upper pattern, one node per free variable). AMD's permutation is
+  // postordered (amd_2 numbers its assembly tree in postorder), which is what a simplicial
+  // factorisation wants from an order; the variables in that order.
   const size_t nv = num_free_.size();
   std::vector<int> block_index(nv, -1);
-  std::vector<int> blocks;
+  std::vector<VariableId> blocks;
   for (size_t v = 0; v < nv; ++v)
     if (num_free_[v] > 0) {
       block_index[v] = static_cast<int>(blocks.size());
-      blocks.push_back(static_cast<int>(v));
+      blocks.push_back(static_cast<VariableId>(v));
     }
   const size_t nb = blocks.size();
   size_t bnnz = nb;
-  for (int v : blocks) bnnz += adjacency_[static_cast<size_t>(v)].size();
+  for (VariableId v : blocks) bnnz += adjacency_[static_cast<size_t>(v)].size();
   cholmod_sparse* A = cholmod_allocate_sparse(nb, nb, bnnz, 1, 1, 1, CHOLMOD_PATTERN, cc_);
   if (!A) throw Error(ErrorCode::Failed, "NormalEquations: out of memory for the block graph");
   int* Ap = static_cast<int*>(A->p);
@@ -48,66 +50,75 @@ std::vector<int> NormalEquations::block_amd_permutation() {
   const int ok = cholmod_amd(A, nullptr, 0, block_perm.data(), cc_);
   cholmod_free_sparse(&A, cc_);
   if (!ok) throw Error(ErrorCode::Failed, "NormalEquations: AMD on the block graph failed");
-  std::vector<int> perm;
-  perm.reserve(static_cast<size_t>(n_));
-  for (int b : block_perm) {
-    const auto v = static_cast<size_t>(blocks[static_cast<size_t>(b)]);
-    for (int j = 0; j < num_free_[v]; ++j) perm.push_back(col_start_[v] + j);
-  }
-  return perm;
+  std::vector<VariableId> order(nb);
+  for (size_t k = 0; k < nb; ++k) order[k] = blocks[static_cast<size_t>(block_perm[k])];
+  return order;
+}
+
+void NormalEquations::analyze_natural(bool postorder) {
+  if (L_) cholmod_free_factor(&L_, cc_);
+  cc_->nmethods = 1;
+  cc_->method[0].ordering = CHOLMOD_NATURAL;
+  cc_->postorder = postorder;
+  L_ = cholmod_analyze(H_, cc_);
+  if (!L_ || cc_->status < CHOLMOD_OK)
+    throw Error(ErrorCode::Failed, "NormalEquations: CHOLMOD's symbolic analysis failed (status " +
+                                       std::to_string(cc_->status) + ")");
 }
 
 void NormalEquations::analyze() {
   if (n_ == 0) return;
-  cc_->postorder = 1;
-  cc_->nmethods = 1;
-  switch (options_.ordering) {
-    case Ordering::Automatic: cc_->nmethods = 0; break;
-    case Ordering::AMD: cc_->method[0].ordering = CHOLMOD_AMD; break;
-    case Ordering::METIS: cc_->method[0].ordering = CHOLMOD_METIS; break;
-    case Ordering::Natural:
-      cc_->method[0].ordering = CHOLMOD_NATURAL;
-      cc_->postorder = 0;
-      break;
-    case Ordering::BlockAMD: cc_->method[0].ordering = CHOLMOD_GIVEN; break;
-  }
-  if (options_.ordering == Ordering::BlockAMD) {
-    std::vector<int> perm = block_amd_permutation();
-    L_ = cholmod_analyze_p(H_, perm.data(), nullptr, 0, cc_);
-  } else {
-    L_ = cholmod_analyze(H_, cc_);
-  }
-  if (!L_ || cc_->status < CHOLMOD_OK)
-    throw Error(ErrorCode::Failed, "NormalEquations: CHOLMOD's symbolic analysis failed (status " +
-                                       std::to_string(cc_->status) + ")");
-  ordering_name_ = ordering_name(L_->ordering);
-
   // A simplicial factorisation of an upper-stored matrix in its natural order reads H as it is;
   // with a permutation CHOLMOD transposes H twice per factorisation (cholmod_factorize.c), the
-  // largest single cost after the factorisation itself on sparse graphs. So number the columns
-  // in the (postordered) elimination order, variable by variable, and analyse again without a
+  // largest single cost after the factorisation itself on sparse graphs. So the columns are
+  // numbered in the elimination order, variable by variable, and CHOLMOD analyses H without a
   // permutation: the same factor, no copies.
-  if (!L_->is_super && L_->ordering != CHOLMOD_NATURAL) {
-    const int* P = static_cast<const int*>(L_->Perm);
+  if (options_.ordering == Ordering::BlockAMD) {
+    // The order is ours: number the columns in it and analyse once. A supernodal factor is
+    // analysed again with CHOLMOD's etree postorder, which finds the supernodes.
+    number_columns(block_amd_order());
+    analyze_natural(false);
+    if (L_->is_super) analyze_natural(true);
+    ordering_name_ = L_->is_super ? "block AMD, postordered" : "block AMD, columns pre-permuted";
+  } else {
     std::vector<VariableId> order;
-    std::vector<char> seen(num_free_.size(), 0);
-    for (int k = 0; k < n_; ++k) {
-      const VariableId v = block_of_column_[static_cast<size_t>(P[k])];
-      if (!seen[static_cast<size_t>(v)]) {
-        seen[static_cast<size_t>(v)] = 1;
-        order.push_back(v);
-      }
-    }
-    cholmod_free_factor(&L_, cc_);
+    for (size_t v = 0; v < num_free_.size(); ++v)
+      if (num_free_[v] > 0) order.push_back(static_cast<VariableId>(v));
     number_columns(order);
+    cc_->postorder = 1;
     cc_->nmethods = 1;
-    cc_->method[0].ordering = CHOLMOD_NATURAL;
-    cc_->postorder = 0;
+    switch (options_.ordering) {
+      case Ordering::Automatic: cc_->nmethods = 0; break;
+      case Ordering::AMD: cc_->method[0].ordering = CHOLMOD_AMD; break;
+      case Ordering::METIS: cc_->method[0].ordering = CHOLMOD_METIS; break;
+      case Ordering::Natural:
+      case Ordering::BlockAMD:
+        cc_->method[0].ordering = CHOLMOD_NATURAL;
+        cc_->postorder = 0;
+        break;
+    }
     L_ = cholmod_analyze(H_, cc_);
     if (!L_ || cc_->status < CHOLMOD_OK)
       throw Error(ErrorCode::Failed, "NormalEquations: CHOLMOD's symbolic analysis failed "
                                      "(status " + std::to_string(cc_->status) + ")");
-    ordering_name_ += ", columns pre-permuted";
+    ordering_name_ = ordering_name(L_->ordering);
+    if (!L_->is_super && L_->ordering != CHOLMOD_NATURAL) {
+      // CHOLMOD's ordering, as a variable order (parameter orderings keep a variable's
+      // parameters together here: the renumbering is by first appearance).
+      const int* P = static_cast<const int*>(L_->Perm);
+      order.clear();
+      std::vector<char> seen(num_free_.size(), 0);
+      for (int k = 0; k < n_; ++k) {
+        const VariableId v = block_of_column_[static_cast<size_t>(P[k])];
+        if (!seen[static_cast<size_t>(v)]) {
+          seen[static_cast<size_t>(v)] = 1;
+          order.push_back(v);
+        }
+      }
+      number_columns(order);
+      analyze_natural(false);
+      ordering_name_ += ", columns pre-permuted";
+    }
   }
   flops_ = cc_->fl;
   lnz_ = cc_->lnz;
@@ -128,7 +139,6 @@ double NormalEquations::cg_iteration_cost() const {
 std::string NormalEquations::ordering_name(int ordering) {
   switch (ordering) {
     case CHOLMOD_NATURAL: return "natural";
-    case CHOLMOD_GIVEN: return "block AMD";
     case CHOLMOD_AMD: return "AMD";
     case CHOLMOD_METIS: return "METIS";
     case CHOLMOD_NESDIS: return "NESDIS";

@@ -95,9 +95,9 @@ std::string SolverSummary::full_report() const {
                 num_factorizations);
   s << buf;
   std::snprintf(buf, sizeof buf,
-                "time (ms): analyze %.2f, linearize %.2f, build %.2f, factorize %.2f, "
+                "time (ms): analyze %.2f, linearize %.2f, factorize %.2f, "
                 "solve %.2f, evaluate %.2f, total %.2f\n",
-                times.analyze * 1e3, times.linearize * 1e3, times.build * 1e3,
+                times.analyze * 1e3, times.linearize * 1e3,
                 times.factorize * 1e3, times.solve * 1e3, times.evaluate * 1e3,
                 total_time_s * 1e3);
   s << buf;
