@@ -254,6 +254,20 @@ PLANARVO_API planarvo_status planarvo_posegraph_optimize(const char* in_path, co
     if (file.vertices.empty()) planarvo::throw_invalid_input(std::string(in_path) + ": no VERTEX_SE2 lines");
     planarvo::graph::FactorGraph graph = planarvo::graph::make_pose_graph(file);
     const double chi2_0 = graph.chi2();
+    // Every number in the file is finite (the reader checks), but an edge's error at the file's
+    // poses, or its information, can still be too large for double arithmetic: eᵀΩe overflows,
+    // and nothing measured from such a graph means anything. Bad input, naming the edge.
+    if (!std::isfinite(chi2_0)) {
+      const int k = graph.first_nonfinite_factor();
+      std::string where = "the sum of the edges' errors";
+      if (k >= 0) {
+        const planarvo::graph::G2oEdge& e = file.edges.at(static_cast<size_t>(k));
+        where = "the error of EDGE_SE2 " + std::to_string(e.from) + " " + std::to_string(e.to);
+      }
+      planarvo::throw_invalid_input(std::string(in_path) + ": " + where +
+                                    " at the file's poses overflows double arithmetic (eᵀΩe is not finite): a pose, "
+                                    "measurement or information value is far too large");
+    }
     if (o.init == PLANARVO_POSEGRAPH_INIT_ROTATION_FIRST) planarvo::graph::initialise_rotation_first(graph);
     planarvo::graph::SolverOptions so;
     so.max_iterations = o.max_iterations;

@@ -217,6 +217,15 @@ double FactorGraph::chi2() const {
   return sum_over_factors(*this, [](int, double s) { return s; });
 }
 
+int FactorGraph::first_nonfinite_factor() const {
+  int first = -1;
+  sum_over_factors(*this, [&first](int i, double s) {
+    if (first < 0 && !std::isfinite(s)) first = i;
+    return 0.0;
+  });
+  return first;
+}
+
 double FactorGraph::robust_cost() const {
   return sum_over_factors(*this, [this](int i, double s) {
     const RobustKernel* k = robust_kernel(i);

@@ -64,6 +64,9 @@ class FactorGraph {
   // the solver minimises (equal to χ² without kernels).
   double chi2() const;
   double robust_cost() const;
+  // The first factor whose eᵀΩe is not finite at the current values (finite inputs can still
+  // overflow), or -1.
+  int first_nonfinite_factor() const;
 
   // The solver's access to the values: one flat array, variable v's coordinates at offset(v).
   const std::vector<double>& values() const { return values_; }
