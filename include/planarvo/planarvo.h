@@ -457,8 +457,10 @@ typedef struct planarvo_motion_accuracy {
   double endpoint_heading;  /* radians */
 } planarvo_motion_accuracy;
 
-/* estimated[i], truth[i]: motion over interval i; dt[i] its duration; valid: NULL or per-interval
- * flags (0: left out of the per-interval figures). */
+/* estimated[i], truth[i]: motion over interval i; dt[i] its duration; valid: NULL to count every
+ * interval (what planarvo track reports first: a Lost frame's motion is the tracker's prediction
+ * and part of the trajectory), or per-interval flags (0: left out of the per-interval figures,
+ * e.g. to report one status apart; the end point always composes every interval). */
 PLANARVO_API planarvo_status planarvo_evaluate_motions(const planarvo_se2* estimated,
                                                        const planarvo_se2* truth, const double* dt,
                                                        const int32_t* valid, size_t count,

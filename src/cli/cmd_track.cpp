@@ -36,7 +36,7 @@ struct TrackerDeleter {
 struct Tracked {
   std::vector<double> t;
   std::vector<planarvo_se2> pose, motion, truth;
-  std::vector<int32_t> valid;  // the motion since the previous tracked frame is measured
+  std::vector<planarvo_track_status> status;
   bool all_truth = true;
 };
 
@@ -84,6 +84,38 @@ void count(const planarvo_track_result& r, TrackRun* run) {
   if (r.status == PLANARVO_TRACK_LOST) ++run->lost;
 }
 
+// Status group of an interval for the accuracy by status: 0 Ok (First cannot end one), 1
+// Degraded, 2 Lost.
+int status_group(planarvo_track_status s) {
+  return s == PLANARVO_TRACK_DEGRADED ? 1 : s == PLANARVO_TRACK_LOST ? 2 : 0;
+}
+
+// Lost frames in time: each Lost frame's interval since the previous tracked frame, and the
+// longest run of consecutive Lost frames.
+void account_lost(const Tracked& k, TrackRun* run) {
+  int64_t run_frames = 0;
+  double run_seconds = 0, run_start = 0;
+  for (size_t i = 0; i < k.t.size(); ++i) {
+    if (k.status[i] != PLANARVO_TRACK_LOST) {
+      run_frames = 0;
+      run_seconds = 0;
+      continue;
+    }
+    const double dt = i > 0 ? k.t[i] - k.t[i - 1] : 0.0;
+    run->lost_seconds += dt;
+    if (run_frames == 0) run_start = k.t[i];
+    ++run_frames;
+    run_seconds += dt;
+    if (run_frames > run->longest_lost_run) {
+      run->longest_lost_run = run_frames;
+      run->longest_lost_seconds = run_seconds;
+      run->longest_lost_start = run_start;
+    }
+  }
+}
+
+// The accuracy over every interval (whatever its status: a Lost interval's motion is the
+// tracker's prediction, and it is part of the trajectory), then per status.
 void evaluate(const Tracked& k, TrackRun* run) {
   const size_t n = k.t.size();
   if (!k.all_truth || n < 2) return;
@@ -95,8 +127,14 @@ void evaluate(const Tracked& k, TrackRun* run) {
     dt[i - 1] = k.t[i] - k.t[i - 1];
   }
   run->accuracy.struct_size = sizeof run->accuracy;
-  check(planarvo_evaluate_motions(est.data(), tru.data(), dt.data(), k.valid.data() + 1, n - 1, 1e-3,
-                                  &run->accuracy));
+  check(planarvo_evaluate_motions(est.data(), tru.data(), dt.data(), nullptr, n - 1, 1e-3, &run->accuracy));
+  std::vector<int32_t> in_group(n - 1);
+  for (int g = 0; g < 3; ++g) {
+    for (size_t i = 1; i < n; ++i) in_group[i - 1] = status_group(k.status[i]) == g;
+    run->by_status[g].struct_size = sizeof run->by_status[g];
+    check(planarvo_evaluate_motions(est.data(), tru.data(), dt.data(), in_group.data(), n - 1, 1e-3,
+                                    &run->by_status[g]));
+  }
   run->has_accuracy = true;
 }
 
@@ -155,7 +193,7 @@ TrackRun track_dataset(planarvo_context* ctx, planarvo_dataset* ds, const planar
     k.t.push_back(fd.timestamp);
     k.pose.push_back(r.pose);
     k.motion.push_back(r.motion);
-    k.valid.push_back(r.status == PLANARVO_TRACK_OK || r.status == PLANARVO_TRACK_DEGRADED);
+    k.status.push_back(r.status);
     k.truth.push_back(fd.groundtruth);
     k.all_truth = k.all_truth && fd.has_groundtruth;
     previous = fd;
@@ -165,6 +203,7 @@ TrackRun track_dataset(planarvo_context* ctx, planarvo_dataset* ds, const planar
   if (!outputs.trajectory.empty())
     check(planarvo_write_tum(outputs.trajectory.c_str(), k.t.data(), k.pose.data(), k.t.size()));
   if (!outputs.motions.empty()) check(planarvo_motion_pairs_save(outputs.motions.c_str(), pairs.data(), pairs.size()));
+  account_lost(k, &run);
   evaluate(k, &run);
   return run;
 }
@@ -176,6 +215,11 @@ void print_track_run(const TrackRun& run) {
   std::printf("frames %lld: %lld ok, %lld degraded, %lld lost; %lld keyframes\n", static_cast<long long>(run.frames),
               static_cast<long long>(run.ok), static_cast<long long>(run.degraded), static_cast<long long>(run.lost),
               static_cast<long long>(run.keyframes));
+  if (run.lost > 0)
+    std::printf("lost frames: %lld of %lld (%.1f%%), %.3f s in all; the longest run %lld frames (%.3f s) from t = %.3f s\n",
+                static_cast<long long>(run.lost), static_cast<long long>(run.frames),
+                100.0 * static_cast<double>(run.lost) / static_cast<double>(run.frames), run.lost_seconds,
+                static_cast<long long>(run.longest_lost_run), run.longest_lost_seconds, run.longest_lost_start);
   if (run.skipped > 0)
     std::printf("skipped %lld bad frames (missing or undecodable images; see the warnings)\n",
                 static_cast<long long>(run.skipped));
@@ -185,7 +229,9 @@ void print_track_run(const TrackRun& run) {
               median);
   if (!run.has_accuracy) return;
   const planarvo_motion_accuracy& a = run.accuracy;
-  std::printf("accuracy against ground truth over %d intervals, %.3f m travelled:\n", a.intervals, a.distance);
+  std::printf("accuracy against ground truth over %d intervals (all of them, degraded and lost included), %.3f m "
+              "travelled:\n",
+              a.intervals, a.distance);
   std::printf("  velocity slope (fit of estimated vs true)   linear %.4f   angular %.4f\n", a.slope_linear,
               a.slope_angular);
   std::printf("  per-frame translation error                 RMS %.4f mm   max %.4f mm   gross (> 1 mm) %d\n",
@@ -193,6 +239,14 @@ void print_track_run(const TrackRun& run) {
   std::printf("  per-frame rotation error                    RMS %.4f deg\n", a.rms_rotation / kDeg);
   std::printf("  end point                                   %.2f mm (%.3f%% of distance), heading %.3f deg\n",
               a.endpoint_error * 1e3, 100 * a.endpoint_drift, a.endpoint_heading / kDeg);
+  std::printf("  by the status of the interval's last frame (a lost interval's motion is the tracker's prediction):\n");
+  const char* names[3] = {"ok intervals", "degraded intervals", "lost intervals"};
+  for (int g = 0; g < 3; ++g) {
+    const planarvo_motion_accuracy& b = run.by_status[g];
+    if (b.intervals == 0) continue;
+    std::printf("    %-18s %6d   translation RMS %.4f mm   max %.4f mm   rotation RMS %.4f deg\n", names[g],
+                b.intervals, b.rms_translation * 1e3, b.max_translation * 1e3, b.rms_rotation / kDeg);
+  }
 }
 
 int cmd_track(int argc, char** argv) {
@@ -208,6 +262,8 @@ int cmd_track(int argc, char** argv) {
       {"video", "FILE", "a video file standing in for images/ and frames.txt", ""},
       {"skip-bad-frames", "", "a missing or undecodable image is a gap (a warning, a \"skipped\" statistics row, "
                               "counted in the summary) instead of an error", ""},
+      {"max-lost", "PERCENT", "exit 1 (after writing every output) when more than this share of the frames was "
+                              "lost", "5"},
       {"quiet", "", "no progress bar", ""},
       {"help", "", "show this help", ""}};
   for (auto& d : device_options()) specs.push_back(d);
@@ -228,6 +284,9 @@ int cmd_track(int argc, char** argv) {
   o.levels = args.get_int_in("levels", o.levels, 1, 8);
   if (args.has("finest-level")) o.finest_level = args.get_int_in("finest-level", 0, 0, o.levels - 1);
   o.max_iterations = args.get_int_in("max-iterations", 0, 1, 1000);
+  const double max_lost = args.get_double("max-lost", 5.0);
+  if (!(max_lost >= 0.0 && max_lost <= 100.0))
+    throw UsageError("--max-lost must be a percentage within 0..100, not " + args.get("max-lost"));
   std::string extr = args.get("extrinsics");
   if (extr.empty()) {
     extr = (std::filesystem::path(dir) / "extrinsics.yaml").string();
@@ -245,6 +304,14 @@ int cmd_track(int argc, char** argv) {
   print_track_run(run);
   if (run.lost == run.frames - 1 && run.frames > 1) {
     std::fprintf(stderr, "planarvo track: tracking was lost on every frame\n");
+    return kExitFailed;
+  }
+  const double lost_percent = run.frames > 0 ? 100.0 * static_cast<double>(run.lost) / static_cast<double>(run.frames) : 0.0;
+  if (lost_percent > max_lost) {
+    std::fprintf(stderr,
+                 "planarvo track: %lld of %lld frames (%.1f%%) were lost, more than --max-lost %g%%; every output asked "
+                 "for is written, with the tracker's predictions over the lost frames\n",
+                 static_cast<long long>(run.lost), static_cast<long long>(run.frames), lost_percent, max_lost);
     return kExitFailed;
   }
   return kExitOk;

@@ -65,8 +65,16 @@ struct TrackRun {
   int64_t skipped = 0;           // bad images skipped (TrackOutputs::skip_bad_frames); not in frames
   double engine_ms = 0;          // sum of the per-frame engine times
   std::vector<double> ms;        // per frame
+  // Lost frames in time: the intervals that end at a Lost frame, in all and the longest run of
+  // consecutive ones (its first frame's timestamp).
+  double lost_seconds = 0;
+  int64_t longest_lost_run = 0;
+  double longest_lost_seconds = 0, longest_lost_start = 0;
+  // Accuracy against ground truth over every interval (Lost and Degraded included), and per
+  // status of the interval's end frame: by_status[0] Ok, [1] Degraded, [2] Lost.
   bool has_accuracy = false;
   planarvo_motion_accuracy accuracy{};
+  planarvo_motion_accuracy by_status[3]{};
 };
 struct TrackOutputs {
   std::string trajectory, stats;  // "" for none

@@ -79,7 +79,10 @@ inline std::vector<TrackedFrame> track_through_api(const std::string& dir, const
 
 // The accuracy of tracked motions against the data set's ground truth, as `planarvo track`
 // defines it (intervals after frames that were tracked, gross above 1 mm).
-inline planarvo_motion_accuracy accuracy_of(const std::vector<TrackedFrame>& frames) {
+// The accuracy of the tracked motions against the data set's truth over every interval (what
+// `planarvo track` reports first), or, with `only`, over the intervals whose last frame has that
+// status.
+inline planarvo_motion_accuracy accuracy_of(const std::vector<TrackedFrame>& frames, int only = -1) {
   const size_t n = frames.size();
   std::vector<planarvo_se2> estimated, truth;
   std::vector<double> dt;
@@ -89,12 +92,12 @@ inline planarvo_motion_accuracy accuracy_of(const std::vector<TrackedFrame>& fra
     estimated.push_back(b.result.motion);
     truth.push_back(between(a.data.groundtruth, b.data.groundtruth));
     dt.push_back(b.data.timestamp - a.data.timestamp);
-    valid.push_back(b.result.status == PLANARVO_TRACK_OK || b.result.status == PLANARVO_TRACK_DEGRADED);
+    valid.push_back(only < 0 || static_cast<int>(b.result.status) == only);
   }
   planarvo_motion_accuracy a{};
   a.struct_size = sizeof a;
-  EXPECT_EQ(planarvo_evaluate_motions(estimated.data(), truth.data(), dt.data(), valid.data(), estimated.size(), 1e-3,
-                                      &a),
+  EXPECT_EQ(planarvo_evaluate_motions(estimated.data(), truth.data(), dt.data(), only < 0 ? nullptr : valid.data(),
+                                      estimated.size(), 1e-3, &a),
             PLANARVO_OK)
       << planarvo_last_error();
   return a;

@@ -1,7 +1,9 @@
 // Bad images in a data set (issue 9): without --skip-bad-frames a missing or undecodable image
 // stops `planarvo track` with exit 2 naming the frame's file, and nothing is written; with it,
 // the frames are gaps: no pose, a "skipped" statistics row, and the rest tracked, checked
-// against the simulator's ground truth.
+// against the simulator's ground truth. And good images of a floor without texture (issue 8):
+// Lost frames, counted in frames and seconds, and exit 1 over --max-lost.
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -10,7 +12,10 @@
 #include <vector>
 
 #include <gtest/gtest.h>
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
 
+#include "common/printed_values.h"
 #include "common/test_util.h"
 #include "io/formats.h"
 
@@ -80,6 +85,72 @@ TEST(CliBadFrames, AreAnErrorUnlessSkippedThenGaps) {
     EXPECT_NEAR(e.y, t.y, 2e-3) << "frame " << i;
     EXPECT_NEAR(e.theta, t.theta, 2e-3) << "frame " << i;
   }
+}
+
+// Two seconds of a textureless floor in the middle of a drive: a camera's image of flat grey
+// with its pixel noise (1 grey level), valid images, so no error. Every one of those frames is
+// Lost; so is the first textured frame after them when the robot has moved on from the keyframe
+// (its interval spans the gap: nothing measures it); no other frame is. The summary counts them
+// in frames and seconds; 33 % lost is over the default --max-lost 5 %: exit 1, with the
+// trajectory and the statistics complete. With --max-lost 50 the same run is exit 0.
+TEST(CliBadFrames, TwoTexturelessSecondsAreLostCountedAndExit1) {
+  test::ScratchDir d;
+  const fs::path seq = d / "seq";
+  auto r = run_cli("simulate --quiet --seconds 6 --width 160 --height 120 --seed 4 --out " + quoted(seq));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const std::vector<io::FrameEntry> frames = io::read_frames((seq / "frames.txt").string());
+  ASSERT_EQ(frames.size(), 180u);
+  std::vector<bool> flat(frames.size(), false);
+  cv::RNG rng(7);
+  for (size_t i = 0; i < frames.size(); ++i) {
+    if (!(frames[i].t >= 2.0 && frames[i].t < 4.0)) continue;
+    flat[i] = true;
+    cv::Mat noise(120, 160, CV_32F);
+    rng.fill(noise, cv::RNG::NORMAL, 128.0, 1.0);
+    cv::Mat image;
+    noise.convertTo(image, CV_8U);
+    ASSERT_TRUE(cv::imwrite((seq / frames[i].path).string(), image));
+  }
+  const size_t n_flat = static_cast<size_t>(std::count(flat.begin(), flat.end(), true));
+  ASSERT_EQ(n_flat, 60u);
+
+  const fs::path traj = d / "traj.txt", stats = d / "stats.csv";
+  const std::string cmd = "track --quiet " + quoted(seq) + " --extrinsics " + quoted(seq / "extrinsics_gt.yaml") +
+                          " -o " + quoted(traj) + " --stats " + quoted(stats);
+  r = run_cli(cmd);
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  // Complete outputs: a pose per frame, a statistics row per frame.
+  EXPECT_EQ(io::read_tum(traj.string()).size(), frames.size());
+  const std::vector<double> lost = stats_times(stats, "lost");
+  std::vector<bool> is_lost(frames.size(), false);
+  for (double t : lost)
+    for (size_t i = 0; i < frames.size(); ++i)
+      if (std::abs(frames[i].t - t) < 1e-6) is_lost[i] = true;
+  size_t first_after = 0;
+  while (first_after < frames.size() && !(first_after > 0 && flat[first_after - 1] && !flat[first_after])) ++first_after;
+  ASSERT_LT(first_after, frames.size());
+  for (size_t i = 0; i < frames.size(); ++i) {
+    if (flat[i]) {
+      EXPECT_TRUE(is_lost[i]) << "textureless frame " << i << " not lost";
+    } else if (i != first_after) {
+      EXPECT_FALSE(is_lost[i]) << "textured frame " << i << " lost";
+    }
+  }
+  ASSERT_TRUE(lost.size() == n_flat || lost.size() == n_flat + 1) << lost.size();
+  // The summary: the count, the share and the time, against the frames' own timestamps.
+  double seconds = 0;
+  for (size_t i = 1; i < frames.size(); ++i)
+    if (is_lost[i]) seconds += frames[i].t - frames[i - 1].t;
+  const std::vector<double> printed = test::numbers_after(r.output, "lost frames:");
+  ASSERT_GE(printed.size(), 4u) << r.output;
+  EXPECT_EQ(printed[0], static_cast<double>(lost.size()));
+  EXPECT_EQ(printed[1], static_cast<double>(frames.size()));
+  test::expect_printed(printed[2], 100.0 * static_cast<double>(lost.size()) / static_cast<double>(frames.size()), 1,
+                       "lost percentage");
+  test::expect_printed(printed[3], seconds, 3, "lost seconds");
+
+  r = run_cli(cmd + " --max-lost 50");
+  EXPECT_EQ(r.exit_code, 0) << r.output;
 }
 
 }  // namespace

@@ -5,6 +5,7 @@
 // usage.
 #include <filesystem>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -147,6 +148,23 @@ void expect_printed_summary(const std::string& output, const std::vector<Tracked
   expect_printed(end[0], a.endpoint_error * 1e3, 2, "end point");
   expect_printed(end[1], 100 * a.endpoint_drift, 3, "drift");
   expect_printed(end[2], a.endpoint_heading / kDeg, 3, "heading");
+
+  // By status: a line per status that ends an interval, with its own figures.
+  const std::pair<planarvo_track_status, const char*> groups[] = {
+      {PLANARVO_TRACK_OK, "ok "}, {PLANARVO_TRACK_DEGRADED, "degraded "}, {PLANARVO_TRACK_LOST, "lost "}};
+  for (const auto& [status, name] : groups) {
+    const planarvo_motion_accuracy b = test::accuracy_of(frames, status);
+    const auto printed = numbers_after(output, std::string(name) + "intervals");
+    if (b.intervals == 0) {
+      EXPECT_TRUE(printed.empty()) << name << output;
+      continue;
+    }
+    ASSERT_EQ(printed.size(), 4u) << name << output;
+    EXPECT_EQ(printed[0], b.intervals) << name;
+    expect_printed(printed[1], b.rms_translation * 1e3, 4, "RMS translation by status");
+    expect_printed(printed[2], b.max_translation * 1e3, 4, "max translation by status");
+    expect_printed(printed[3], b.rms_rotation / kDeg, 4, "RMS rotation by status");
+  }
 
   // And against the simulator's truth, independently of the tool: every interval within 1 mm,
   // the velocities unbiased.
