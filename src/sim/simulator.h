@@ -33,7 +33,12 @@ enum class MotionProfile {
   Straight,  // forwards and backwards along one line
   Circle,    // one constant-curvature circle
   Spin,      // turning in place
+  Car,       // a car: forward driving with turns no tighter than Options::min_turn_radius, stops,
+             // and slow reversing (parking); never turning in place
 };
+
+// "mixed", "straight", "circle", "spin", "car".
+const char* motion_profile_name(MotionProfile profile);
 
 // The paper's camera configuration 1: x 0.2441, y -0.0185, z 0.1787 m, roll 12.4, pitch 17.6,
 // yaw -9.2 degrees.
@@ -48,6 +53,16 @@ Extrinsics paper_configuration(int k);
 // k1 = -0.12, k2 = 0.03, principal point a little off the image centre as real lenses have.
 CameraModel default_camera(int width = 640, int height = 480, double fov_deg = 80.0);
 
+// How far the camera sees over the ground: the largest distance, along the ground from the
+// point below the camera, of a border pixel's ray (every pixel along the four edges), in camera
+// heights; +inf when a ray does not meet the ground (the camera sees the horizon). *pixel gets
+// that pixel. validate() refuses a camera that sees farther than kMaxGroundView heights: such
+// far field is foreshortened to a few pixels per metre, no floor texture survives it, and a
+// real camera there would see the horizon, walls or the car's own bumper.
+double farthest_ground_view(const CameraModel& camera, const Extrinsics& extrinsics,
+                            Eigen::Vector2d* pixel = nullptr);
+constexpr double kMaxGroundView = 25.0;
+
 struct Options {
   std::string texture;          // path of the ground photograph (any cv::imread format)
   double texel_size = 0.0004;   // metres per texture pixel
@@ -61,6 +76,8 @@ struct Options {
   double max_turn_rate = 1.5;       // peak |omega|, rad/s
   double max_acceleration = 1.5;    // bound on |dv/dt|, m/s^2
   double max_angular_acceleration = 4.0;  // bound on |domega/dt|, rad/s^2
+  double min_turn_radius = 0.0;     // Car: the tightest turn, |omega| <= |v| / radius (metres;
+                                    // 0: limited by max_turn_rate only)
   SE2 start_pose;                   // the robot's true pose at the first frame
   double pixel_noise = 1.0;         // standard deviation of additive noise, grey levels
   double gain_variation = 0.05;     // amplitude of the slow gain change, relative

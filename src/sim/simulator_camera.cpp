@@ -45,6 +45,33 @@ std::vector<Exposure> exposure_series(const Options& options, const std::vector<
   return out;
 }
 
+double farthest_ground_view(const CameraModel& camera, const Extrinsics& extrinsics, Eigen::Vector2d* pixel) {
+  const Eigen::Matrix3d R = extrinsics.R_vc();
+  double farthest = 0.0;
+  Eigen::Vector2d at(0.0, 0.0);
+  auto look = [&](double u, double v) {
+    const Eigen::Vector2d xn = camera.unproject(Eigen::Vector2d(u, v));
+    const Eigen::Vector3d d = R * Eigen::Vector3d(xn.x(), xn.y(), 1.0);
+    // The ray meets the ground (z = 0, the camera at height z > 0) when it points down.
+    const double reach = d.z() < 0.0 ? std::hypot(d.x(), d.y()) / -d.z() : HUGE_VAL;
+    if (!(reach <= farthest)) {
+      farthest = reach;
+      at = {u, v};
+    }
+  };
+  const int w = camera.width, h = camera.height;
+  for (int u = 0; u < w; ++u) {
+    look(u, 0);
+    look(u, h - 1);
+  }
+  for (int v = 0; v < h; ++v) {
+    look(0, v);
+    look(w - 1, v);
+  }
+  if (pixel) *pixel = at;
+  return farthest;
+}
+
 cv::Mat apply_camera(const cv::Mat& image, const Exposure& exposure, double sigma,
                      uint64_t frame_seed) {
   if (image.type() != CV_32FC1) throw_invalid_argument("apply_camera: needs a CV_32FC1 image");

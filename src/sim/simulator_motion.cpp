@@ -2,6 +2,7 @@
 // speed and acceleration limits, exact arc integration, wheel odometry with zero-mean errors.
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <string>
 
@@ -107,6 +108,30 @@ Profile make_profile(const Options& o, double duration, Random& rng) {
         p.add(0.0, -s * rng.uniform(0.5, 1.0) * wm, rng.uniform(0.8, 1.5));
       }
       break;
+    case MotionProfile::Car: {
+      // Curvature k with |k| <= 1/R; omega = k v, so blends between two levels of the same
+      // direction (v and omega blend alike) and through a stop keep |omega| <= |v| / R.
+      const double kmax = o.min_turn_radius > 0 ? 1.0 / o.min_turn_radius : HUGE_VAL;
+      auto turn = [&](double v, double k) { return std::clamp(k * v, -wm, wm); };
+      auto curvature = [&](double share) {
+        const double k = share * kmax;
+        return std::isfinite(k) ? k : share * 4.0;  // no radius given: up to 4 rad per metre
+      };
+      while (p.end() < duration) {
+        const int side = rng.sign();
+        p.add(0.0, 0.0, rng.uniform(0.3, 0.6));                                          // stop
+        double v = rng.uniform(0.6, 1.0) * vm;
+        p.add(v, turn(v, curvature(rng.uniform(-0.1, 0.1))), rng.uniform(1.0, 2.0));     // straight on
+        v = rng.uniform(0.4, 0.8) * vm;
+        p.add(v, turn(v, curvature(side * rng.uniform(0.6, 1.0))), rng.uniform(1.0, 2.0));  // a bend
+        v = rng.uniform(0.6, 1.0) * vm;
+        p.add(v, turn(v, curvature(-side * rng.uniform(0.3, 1.0))), rng.uniform(0.8, 1.5));
+        p.add(0.0, 0.0, rng.uniform(0.3, 0.6));                                          // stop
+        v = -rng.uniform(0.1, 0.25) * vm;                                                // reverse
+        p.add(v, turn(v, curvature(side * rng.uniform(0.5, 1.0))), rng.uniform(1.0, 2.0));
+      }
+      break;
+    }
   }
   return p;
 }
@@ -116,6 +141,17 @@ void require(bool ok, const std::string& what) {
 }
 
 }  // namespace
+
+const char* motion_profile_name(MotionProfile p) {
+  switch (p) {
+    case MotionProfile::Mixed: return "mixed";
+    case MotionProfile::Straight: return "straight";
+    case MotionProfile::Circle: return "circle";
+    case MotionProfile::Spin: return "spin";
+    case MotionProfile::Car: return "car";
+  }
+  return "?";
+}
 
 Extrinsics default_extrinsics() { return paper_configuration(1); }
 
@@ -180,6 +216,7 @@ void validate(const Options& o) {
           "max_acceleration must be positive");
   require(std::isfinite(o.max_angular_acceleration) && o.max_angular_acceleration > 0,
           "max_angular_acceleration must be positive");
+  require(std::isfinite(o.min_turn_radius) && o.min_turn_radius >= 0, "min_turn_radius must be >= 0");
   require(std::isfinite(o.pixel_noise) && o.pixel_noise >= 0, "pixel_noise must be >= 0");
   require(std::isfinite(o.gain_variation) && o.gain_variation >= 0 && o.gain_variation < 0.5,
           "gain_variation must be in [0, 0.5)");
@@ -188,6 +225,16 @@ void validate(const Options& o) {
           "odometry_noise_floor must be >= 0");
   require(std::isfinite(o.wheel_base) && o.wheel_base > 0, "wheel_base must be positive");
   require(o.supersampling >= 1 && o.supersampling <= 16, "supersampling must be 1 to 16");
+  Eigen::Vector2d px;
+  const double reach = farthest_ground_view(o.camera, o.extrinsics, &px);
+  const std::string at = "pixel (" + std::to_string(static_cast<int>(px.x())) + ", " +
+                         std::to_string(static_cast<int>(px.y())) + ")";
+  require(std::isfinite(reach), "the camera sees the horizon (the ray of " + at +
+                                    " does not meet the ground): tilt it down or narrow its field of view");
+  char far[160];
+  std::snprintf(far, sizeof far, "the camera sees ground %.0f camera heights away (%s), more than %.0f", reach,
+                at.c_str(), kMaxGroundView);
+  require(reach <= kMaxGroundView, std::string(far) + ": tilt it down or narrow its field of view");
   require(std::isfinite(o.start_pose.x) && std::isfinite(o.start_pose.y) &&
               std::isfinite(o.start_pose.theta),
           "start_pose contains NaN or inf");

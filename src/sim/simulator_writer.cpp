@@ -23,16 +23,6 @@ double seconds_since(Clock::time_point t0) {
   return std::chrono::duration<double>(Clock::now() - t0).count();
 }
 
-const char* profile_name(MotionProfile p) {
-  switch (p) {
-    case MotionProfile::Mixed: return "mixed";
-    case MotionProfile::Straight: return "straight";
-    case MotionProfile::Circle: return "circle";
-    case MotionProfile::Spin: return "spin";
-  }
-  return "?";
-}
-
 void report(const Options& o, double fraction, const char* stage) {
   if (o.progress && !o.progress(fraction, stage))
     throw Error(ErrorCode::Cancelled, std::string("simulation cancelled while ") + stage);
@@ -49,7 +39,7 @@ void write_simulation_yaml(const std::string& path, const Options& o, const Eige
     fs << "texel_size_u" << texel.x();
     fs << "texel_size_v" << texel.y();
     fs << "seed" << std::to_string(o.seed);
-    fs << "motion" << profile_name(o.motion);
+    fs << "motion" << motion_profile_name(o.motion);
     fs << "seconds" << o.seconds << "fps" << o.fps;
     fs << "max_speed" << o.max_speed << "max_turn_rate" << o.max_turn_rate;
     fs << "max_acceleration" << o.max_acceleration;

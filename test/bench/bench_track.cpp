@@ -7,7 +7,9 @@
 //       (seconds, w, h, seed, motion=mixed|straight|circle|spin, levels, finest, refine_kf, conv,
 //        huber, overlap, maxit=l0,l1,.., textures=a.png,b.png or textures=all,
 //        config=1|2|3 (the paper's camera configurations), perturb=1 (the tracker gets extrinsics
-//        off by +10,-10,+10 mm and +2.5,-2.5,+2.5 deg); see main())
+//        off by +10,-10,+10 mm and +2.5,-2.5,+2.5 deg), ext=x,y,z,roll,pitch,yaw (m, deg; instead
+//        of config), fov=deg, motion=...|car, speed=m/s, turn=rad/s, radius=m (car), noise=grey
+//        levels; see main())
 //   bench_track nees [key=value...]         NEES of the covariances (alignment and frame-to-frame
 //       motion) and the lag-1 correlation of the errors per texture x configuration x size x
 //       finest level (seconds=5, seed=1, textures=..|all, configs=1,2,3, sizes=640x480,320x240,
@@ -254,15 +256,31 @@ SequenceReport run_sequence(ocl::Runtime& rt, const sim::Options& so, const trac
   return rep;
 }
 
+// What a sequence of `bench_track accuracy` shows besides its texture: the camera on the robot,
+// its field of view, the drive's limits and the noise.
+struct Scene {
+  int config = 1;             // the paper's configuration, when `ext` is not given
+  bool has_ext = false;
+  Extrinsics ext;             // ext=x,y,z,roll,pitch,yaw (m, deg)
+  bool perturb = false;
+  double fov = 80.0, speed = 0.8, turn = 1.5, radius = 0.0, noise = 1.0;
+  sim::MotionProfile motion = sim::MotionProfile::Mixed;
+};
+
 int bench_accuracy(const std::vector<std::string>& textures, double seconds, int width, int height,
-                   uint64_t seed, sim::MotionProfile motion, const track::TrackerOptions& topt, bool verbose,
-                   int config, bool perturb) {
+                   uint64_t seed, const Scene& scene, const track::TrackerOptions& topt, bool verbose) {
   ocl::Runtime rt;
   std::printf("device: %s\n", rt.device_info().device_name.c_str());
-  const Extrinsics truth = paper_configuration(config), told = perturb ? perturbed(truth) : truth;
-  std::printf("%dx%d, %.0f s at 30 Hz per texture (seed %llu), mixed motion up to 0.8 m/s and 1.5 rad/s, noise 1 grey "
-              "level, gain/offset drift 5%%, lens distortion; tracker levels %d, finest %d (-1: auto)\n", width,
-              height, seconds, static_cast<unsigned long long>(seed), topt.levels, topt.finest_level);
+  const Extrinsics truth = scene.has_ext ? scene.ext : paper_configuration(scene.config);
+  const Extrinsics told = scene.perturb ? perturbed(truth) : truth;
+  const int config = scene.has_ext ? 0 : scene.config;
+  const bool perturb = scene.perturb;
+  std::printf("%dx%d, fov %.0f deg, %.0f s at 30 Hz per texture (seed %llu), %s motion up to %.2f m/s and %.2f rad/s"
+              "%s, noise %.1f grey levels, gain/offset drift 5%%, lens distortion; tracker levels %d, finest %d (-1: "
+              "auto)\n",
+              width, height, scene.fov, seconds, static_cast<unsigned long long>(seed), sim::motion_profile_name(scene.motion),
+              scene.speed, scene.turn, scene.radius > 0 ? (", turning radius >= " + std::to_string(scene.radius) + " m").c_str() : "",
+              scene.noise, topt.levels, topt.finest_level);
   std::printf("configuration %d: true extrinsics %s; tracker given %s%s\n", config, describe(truth).c_str(),
               describe(told).c_str(), perturb ? " (perturbed +10,-10,+10 mm, +2.5,-2.5,+2.5 deg)" : " (true)");
   std::printf("%-22s %4s %6s %4s %4s %4s %4s %8s %8s %7s %7s %8s %5s %7s %7s %7s %7s  %s\n", "texture", "cfg",
@@ -270,7 +288,12 @@ int bench_accuracy(const std::vector<std::string>& textures, double seconds, int
               "drift%", "ms/fr", "ms_pipe", "cpu/fr", "passes per frame, coarse to fine");
   for (const std::string& tex : textures) {
     sim::Options so = sequence_options(tex, seconds, width, height, seed);
-    so.motion = motion;
+    so.camera = sim::default_camera(width, height, scene.fov);
+    so.motion = scene.motion;
+    so.max_speed = scene.speed;
+    so.max_turn_rate = scene.turn;
+    so.min_turn_radius = scene.radius;
+    so.pixel_noise = scene.noise;
     so.extrinsics = truth;
     const SequenceReport r = run_sequence(rt, so, topt, verbose, &told);
     const double n = r.frames;
@@ -771,9 +794,7 @@ int main(int argc, char** argv) {
     double seconds = 10.0;
     int w = 640, h = 480;
     uint64_t seed = 1;
-    int config = 1;
-    bool perturb = false;
-    sim::MotionProfile motion = sim::MotionProfile::Mixed;
+    Scene scene;
     track::TrackerOptions topt;
     std::vector<std::string> tex = {"asphalt_01.png", "anti_skid_tiles.png", "brick_floor.png",
                                     "aerial_ground_rock.png"};
@@ -784,14 +805,30 @@ int main(int argc, char** argv) {
       if (k == "seconds") seconds = std::atof(v.c_str());
       else if (k == "w") w = std::atoi(v.c_str());
       else if (k == "h") h = std::atoi(v.c_str());
-      else if (k == "config") config = std::atoi(v.c_str());
-      else if (k == "perturb") perturb = std::atoi(v.c_str()) != 0;
+      else if (k == "config") scene.config = std::atoi(v.c_str());
+      else if (k == "perturb") scene.perturb = std::atoi(v.c_str()) != 0;
       else if (k == "seed") seed = std::strtoull(v.c_str(), nullptr, 10);
       else if (k == "motion")
-        motion = v == "straight" ? sim::MotionProfile::Straight
-                 : v == "circle" ? sim::MotionProfile::Circle
-                 : v == "spin"   ? sim::MotionProfile::Spin
-                                 : sim::MotionProfile::Mixed;
+        scene.motion = v == "straight" ? sim::MotionProfile::Straight
+                       : v == "circle" ? sim::MotionProfile::Circle
+                       : v == "spin"   ? sim::MotionProfile::Spin
+                       : v == "car"    ? sim::MotionProfile::Car
+                                       : sim::MotionProfile::Mixed;
+      else if (k == "ext") {
+        const auto e = split(v);
+        if (e.size() != 6) {
+          std::fprintf(stderr, "ext=x,y,z,roll,pitch,yaw (m, deg)\n");
+          return 2;
+        }
+        const double d = M_PI / 180.0;
+        scene.has_ext = true;
+        scene.ext = Extrinsics{std::atof(e[0].c_str()), std::atof(e[1].c_str()), std::atof(e[2].c_str()),
+                               std::atof(e[3].c_str()) * d, std::atof(e[4].c_str()) * d, std::atof(e[5].c_str()) * d};
+      } else if (k == "fov") scene.fov = std::atof(v.c_str());
+      else if (k == "speed") scene.speed = std::atof(v.c_str());
+      else if (k == "turn") scene.turn = std::atof(v.c_str());
+      else if (k == "radius") scene.radius = std::atof(v.c_str());
+      else if (k == "noise") scene.noise = std::atof(v.c_str());
       else if (k == "levels") topt.levels = std::atoi(v.c_str());
       else if (k == "finest") topt.finest_level = std::atoi(v.c_str());
       else if (k == "refine_kf") topt.refine_keyframes = std::atoi(v.c_str()) != 0;
@@ -808,12 +845,11 @@ int main(int argc, char** argv) {
       }
     }
     if (tex.size() == 1 && tex[0] == "all") tex = all_textures();
-    if (config < 1 || config > 3) {
+    if (scene.config < 1 || scene.config > 3) {
       std::fprintf(stderr, "config must be 1, 2 or 3\n");
       return 2;
     }
-    return bench_accuracy(tex, seconds, w, h, seed, motion, topt, std::getenv("BENCH_VERBOSE") != nullptr, config,
-                          perturb);
+    return bench_accuracy(tex, seconds, w, h, seed, scene, topt, std::getenv("BENCH_VERBOSE") != nullptr);
   }
   if (mode == "nees") {
     // bench_track nees [key=value ...]: seconds=5 textures=a.png,b.png|all configs=1,2,3

@@ -1,5 +1,6 @@
 // The simulator's motion: nonholonomic arcs, limits, the manoeuvres each profile promises,
 // unbiased wheel odometry of the requested size, determinism; and its random numbers.
+#include <algorithm>
 #include <cmath>
 #include <set>
 
@@ -19,8 +20,8 @@ Options motion_options(MotionProfile profile, uint64_t seed, double seconds = 10
   return o;
 }
 
-const MotionProfile kProfiles[] = {MotionProfile::Mixed, MotionProfile::Straight,
-                                   MotionProfile::Circle, MotionProfile::Spin};
+const MotionProfile kProfiles[] = {MotionProfile::Mixed, MotionProfile::Straight, MotionProfile::Circle,
+                                   MotionProfile::Spin, MotionProfile::Car};
 
 TEST(SimMotion, SizesAndTimes) {
   const Trajectory tr = generate_trajectory(motion_options(MotionProfile::Mixed, 1));
@@ -169,6 +170,70 @@ TEST(SimMotion, SpinTurnsInPlaceBothWays) {
     EXPECT_EQ(p.x, 0.0);
     EXPECT_EQ(p.y, 0.0);
   }
+}
+
+// A car at up to 3 m/s with a turning radius of at least 6 m: every interval's arc is no tighter
+// (|omega| <= |v| / R, never turning in place), it drives forwards most of the time, turns both
+// ways and reverses.
+TEST(SimMotion, CarKeepsItsTurningRadius) {
+  for (uint64_t seed = 1; seed <= 5; ++seed) {
+    Options o = motion_options(MotionProfile::Car, seed, 20.0);
+    o.max_speed = 3.0;
+    o.min_turn_radius = 6.0;
+    const Trajectory tr = generate_trajectory(o);
+    double forward = 0, backward = 0;
+    bool left = false, right = false;
+    for (size_t k = 0; k < tr.velocity.size(); ++k) {
+      const double v = tr.velocity[k].x(), w = tr.velocity[k].y();
+      ASSERT_LE(std::abs(w), std::abs(v) / o.min_turn_radius * (1 + 1e-12) + 1e-15) << seed << " " << k;
+      forward += v > 0 ? v / o.fps : 0;
+      backward += v < 0 ? -v / o.fps : 0;
+      left |= w > 0.1 && v > 0;
+      right |= w < -0.1 && v > 0;
+    }
+    EXPECT_GT(forward, 5 * backward) << seed;
+    EXPECT_GT(backward, 0.5) << seed;
+    EXPECT_TRUE(left && right) << seed;
+  }
+}
+
+// A camera that sees the horizon, or ground farther than kMaxGroundView heights, is refused
+// with the reason; its distance is that of the border pixel, computed here independently for
+// a pinhole camera tilted about the robot's y axis (a rear camera looking back).
+TEST(SimMotion, RefusesACameraThatSeesTheHorizon) {
+  Options o;
+  o.camera = default_camera(640, 480, 60.0);
+  o.camera.k1 = o.camera.k2 = 0.0;
+  o.extrinsics = Extrinsics{-1.0, 0.0, 0.9, 0.0, 40.0 * M_PI / 180.0, M_PI};
+  EXPECT_NO_THROW(validate(o));
+  // A pinhole camera tilted by phi about its x axis: the ray (a, b, 1) meets the ground at
+  // hypot(sin phi + b cos phi, a) / (cos phi - b sin phi) heights; the farthest border pixel is
+  // a corner of the far row. Which row is far depends on the direction of the tilt in the
+  // image, so both are computed and the function must give one of them.
+  const double phi = 40.0 * M_PI / 180.0;
+  const double as[2] = {-o.camera.cx / o.camera.fx, (o.camera.width - 1 - o.camera.cx) / o.camera.fx};
+  const double bs[2] = {-o.camera.cy / o.camera.fy, (o.camera.height - 1 - o.camera.cy) / o.camera.fy};
+  double expected[2] = {0, 0};
+  for (int sign = 0; sign < 2; ++sign)
+    for (double a : as)
+      for (double b0 : bs) {
+        const double b = sign ? -b0 : b0;
+        expected[sign] = std::max(expected[sign], std::hypot(std::sin(phi) + b * std::cos(phi), a) /
+                                                      (std::cos(phi) - b * std::sin(phi)));
+      }
+  const double reach = farthest_ground_view(o.camera, o.extrinsics);
+  EXPECT_TRUE(std::abs(reach - expected[0]) < 1e-9 * reach || std::abs(reach - expected[1]) < 1e-9 * reach)
+      << reach << " " << expected[0] << " " << expected[1];
+  for (double pitch_deg : {70.0, 95.0}) {
+    o.extrinsics.pitch = pitch_deg * M_PI / 180.0;
+    try {
+      validate(o);
+      ADD_FAILURE() << pitch_deg << " degrees from vertical was accepted";
+    } catch (const Error& e) {
+      EXPECT_EQ(e.code(), ErrorCode::InvalidArgument);
+    }
+  }
+  EXPECT_FALSE(std::isfinite(farthest_ground_view(o.camera, o.extrinsics)));
 }
 
 // The wheel travel recovered from the odometry poses has an unbiased relative error of the
