@@ -16,8 +16,7 @@
 //       finest=0,1; noise=1 grey level; tracker: conv, huber, brightness=0|1, maxit=l0,l1,..,
 //       step_fraction, rho);
 //       BENCH_NEES_CSV=file also writes one row per frame tracked ok
-//   bench_track ecc [w h] [pairs] [levels]   OpenCV's findTransformECC (homography) against the
-//       tracker on the same frame pairs, ECC's homography reduced to planar motion (see bench_ecc)
+// (OpenCV's findTransformECC against the tracker on the same pairs: bench_ecc.)
 #include <algorithm>
 #include <cmath>
 #include <chrono>
@@ -45,8 +44,14 @@
 #include "track/warp_model.h"
 #include "track/warp_reduce.h"
 #include "../unit/track_test_pyramid.h"
+#include "bench_scene.h"
 
 using namespace planarvo;
+using bench::Scene;
+using bench::all_textures;
+using bench::describe;
+using bench::split;
+using bench::texture_path;
 
 namespace {
 
@@ -69,23 +74,6 @@ double median(std::vector<double> v) {
 
 constexpr int kMaxLevelsBench = track::kMaxLevels;
 
-std::string texture_path(const std::string& name) {
-  return std::string(PLANARVO_SHARED_DIR) + "/data/textures/" + name;
-}
-
-// The paper's camera configurations (its Tables 1-3) as numbers in conventions.md's
-// convention: x, y, z metres, roll, pitch, yaw degrees. 1 is the simulator's default.
-Extrinsics paper_configuration(int config) {
-  const double d = M_PI / 180.0;
-  Extrinsics e;
-  switch (config) {
-    case 2: e.x = 0.1917; e.y = -0.1078; e.z = 0.2164; e.roll = 29.8 * d; e.pitch = -4.6 * d; e.yaw = 75.8 * d; break;
-    case 3: e.x = 0.2226; e.y = 0.0806; e.z = 0.1469; e.roll = -26.6 * d; e.pitch = 4.7 * d; e.yaw = -18.6 * d; break;
-    default: e = sim::default_extrinsics(); break;
-  }
-  return e;
-}
-
 // A calibration error of fixed signs: +10, -10, +10 mm in x, y, z and +2.5, -2.5, +2.5 degrees
 // in roll, pitch, yaw (the paper's Figure 7 perturbs by this much).
 Extrinsics perturbed(Extrinsics e) {
@@ -93,13 +81,6 @@ Extrinsics perturbed(Extrinsics e) {
   e.x += 0.010; e.y -= 0.010; e.z += 0.010;
   e.roll += 2.5 * d; e.pitch -= 2.5 * d; e.yaw += 2.5 * d;
   return e;
-}
-
-std::string describe(const Extrinsics& e) {
-  char b[160];
-  std::snprintf(b, sizeof b, "(%.4f, %.4f, %.4f m, %.1f, %.1f, %.1f deg)", e.x, e.y, e.z, e.roll * 180 / M_PI,
-                e.pitch * 180 / M_PI, e.yaw * 180 / M_PI);
-  return b;
 }
 
 struct KernelConfig { int wx, wy, pix, hist; bool fast; };
@@ -256,45 +237,24 @@ SequenceReport run_sequence(ocl::Runtime& rt, const sim::Options& so, const trac
   return rep;
 }
 
-// What a sequence of `bench_track accuracy` shows besides its texture: the camera on the robot,
-// its field of view, the drive's limits and the noise.
-struct Scene {
-  int config = 1;             // the paper's configuration, when `ext` is not given
-  bool has_ext = false;
-  Extrinsics ext;             // ext=x,y,z,roll,pitch,yaw (m, deg)
-  bool perturb = false;
-  double fov = 80.0, speed = 0.8, turn = 1.5, radius = 0.0, noise = 1.0;
-  sim::MotionProfile motion = sim::MotionProfile::Mixed;
-};
-
 int bench_accuracy(const std::vector<std::string>& textures, double seconds, int width, int height,
-                   uint64_t seed, const Scene& scene, const track::TrackerOptions& topt, bool verbose) {
+                   uint64_t seed, const Scene& scene, bool perturb, const track::TrackerOptions& topt, bool verbose) {
   ocl::Runtime rt;
   std::printf("device: %s\n", rt.device_info().device_name.c_str());
-  const Extrinsics truth = scene.has_ext ? scene.ext : paper_configuration(scene.config);
-  const Extrinsics told = scene.perturb ? perturbed(truth) : truth;
+  const Extrinsics truth = scene.extrinsics();
+  const Extrinsics told = perturb ? perturbed(truth) : truth;
   const int config = scene.has_ext ? 0 : scene.config;
-  const bool perturb = scene.perturb;
-  std::printf("%dx%d, fov %.0f deg, %.0f s at 30 Hz per texture (seed %llu), %s motion up to %.2f m/s and %.2f rad/s"
-              "%s, noise %.1f grey levels, gain/offset drift 5%%, lens distortion; tracker levels %d, finest %d (-1: "
-              "auto)\n",
-              width, height, scene.fov, seconds, static_cast<unsigned long long>(seed), sim::motion_profile_name(scene.motion),
-              scene.speed, scene.turn, scene.radius > 0 ? (", turning radius >= " + std::to_string(scene.radius) + " m").c_str() : "",
-              scene.noise, topt.levels, topt.finest_level);
-  std::printf("configuration %d: true extrinsics %s; tracker given %s%s\n", config, describe(truth).c_str(),
+  std::printf("%dx%d, %.0f s at 30 Hz per texture (seed %llu), %s, gain/offset drift 5%%, lens distortion; tracker "
+              "levels %d, finest %d (-1: auto)\n",
+              width, height, seconds, static_cast<unsigned long long>(seed), scene.summary().c_str(), topt.levels,
+              topt.finest_level);
+  std::printf("configuration %d (0: ext=): true extrinsics %s; tracker given %s%s\n", config, describe(truth).c_str(),
               describe(told).c_str(), perturb ? " (perturbed +10,-10,+10 mm, +2.5,-2.5,+2.5 deg)" : " (true)");
   std::printf("%-22s %4s %6s %4s %4s %4s %4s %8s %8s %7s %7s %8s %5s %7s %7s %7s %7s  %s\n", "texture", "cfg",
               "frames", "ok", "deg", "lost", "kf", "slope_v", "slope_w", "rms_mm", "max_mm", "rms_deg", "gross",
               "drift%", "ms/fr", "ms_pipe", "cpu/fr", "passes per frame, coarse to fine");
   for (const std::string& tex : textures) {
-    sim::Options so = sequence_options(tex, seconds, width, height, seed);
-    so.camera = sim::default_camera(width, height, scene.fov);
-    so.motion = scene.motion;
-    so.max_speed = scene.speed;
-    so.max_turn_rate = scene.turn;
-    so.min_turn_radius = scene.radius;
-    so.pixel_noise = scene.noise;
-    so.extrinsics = truth;
+    const sim::Options so = scene.options(tex, seconds, width, height, seed);
     const SequenceReport r = run_sequence(rt, so, topt, verbose, &told);
     const double n = r.frames;
     std::printf("%-22s %3d%s %6d %4d %4d %4d %4d %8.5f %8.5f %7.4f %7.4f %8.5f %5d %7.3f %7.2f %7.2f %7.2f ",
@@ -453,7 +413,7 @@ int bench_nees(const std::vector<std::string>& textures, const std::vector<int>&
     for (int config : configs)
       for (const std::string& tex : textures) {
         sim::Options so = sequence_options(tex, seconds, wh[0], wh[1], seed);
-        so.extrinsics = paper_configuration(config);
+        so.extrinsics = sim::paper_configuration(config);
         so.pixel_noise = noise;
         const sim::Trajectory traj = sim::generate_trajectory(so);
         const std::vector<sim::Exposure> exposure = sim::exposure_series(so, traj.t);
@@ -566,212 +526,6 @@ int bench_speed(int width, int height, double seconds, int rounds) {
   return 0;
 }
 
-// ECC against the tracker. ECC's homography maps undistorted reference pixels to live pixels;
-// it is reduced to the robot's planar motion with the true camera: a grid of reference pixels
-// and their images under H are back-projected onto the ground (robot frames k and k+1), and
-// the 2-D rigid motion between the two point sets is fitted (SE(2) Procrustes).
-Eigen::Vector2d ground_point(const Eigen::Matrix3d& Kinv, const Extrinsics& e, double u, double v) {
-  const Eigen::Vector3d ray = Kinv * Eigen::Vector3d(u, v, 1.0);
-  const Eigen::Vector3d n = e.plane_normal_camera();
-  const Eigen::Vector3d X = ray * (-e.z / n.dot(ray));
-  return (e.R_vc() * X + e.t_vc()).head<2>();
-}
-
-bool homography_to_motion(const cv::Mat& H32, const Eigen::Matrix3d& K, const Extrinsics& e, int w, int h,
-                          SE2* motion) {
-  Eigen::Matrix3d H;
-  for (int r = 0; r < 3; ++r)
-    for (int c = 0; c < 3; ++c) H(r, c) = H32.at<float>(r, c);
-  const Eigen::Matrix3d Kinv = K.inverse();
-  std::vector<Eigen::Vector2d> pr, pl;  // the same ground point in robot frames k and k+1
-  for (int v = 4; v < h; v += 8)
-    for (int u = 4; u < w; u += 8) {
-      const Eigen::Vector3d q = H * Eigen::Vector3d(u, v, 1.0);
-      if (q(2) <= 0) continue;
-      const double ul = q(0) / q(2), vl = q(1) / q(2);
-      if (ul < 0 || vl < 0 || ul > w - 1 || vl > h - 1) continue;
-      pr.push_back(ground_point(Kinv, e, u, v));
-      pl.push_back(ground_point(Kinv, e, ul, vl));
-    }
-  if (pr.size() < 10) return false;
-  // p_r = R p_l + t, motion = (t, angle of R) = T_k^-1 T_{k+1}.
-  Eigen::Vector2d cr = Eigen::Vector2d::Zero(), cl = Eigen::Vector2d::Zero();
-  for (size_t i = 0; i < pr.size(); ++i) { cr += pr[i]; cl += pl[i]; }
-  cr /= pr.size();
-  cl /= pl.size();
-  double sdot = 0, scross = 0;
-  for (size_t i = 0; i < pr.size(); ++i) {
-    const Eigen::Vector2d a = pl[i] - cl, b = pr[i] - cr;
-    sdot += a.dot(b);
-    scross += a.x() * b.y() - a.y() * b.x();
-  }
-  const double th = std::atan2(scross, sdot);
-  const Eigen::Vector2d t = cr - Eigen::Rotation2Dd(th) * cl;
-  *motion = SE2(t.x(), t.y(), th);
-  return true;
-}
-
-// ECC coarse to fine: levels - 1 halvings (cv::resize INTER_AREA, pixel u of level l+1 is at
-// 2u + 0.5 of level l), identity at the coarsest level, each level's result carried down. When
-// ECC gives up at a level (OpenCV throws StsNoConv), the estimate it started from is kept and
-// carried on to the next finer level; *failed_levels counts those. False when the finest fails.
-bool ecc_pair(const cv::Mat& ref, const cv::Mat& live, const cv::Mat& mask, int levels, int iterations,
-              double eps, cv::Mat* H, int* failed_levels) {
-  std::vector<cv::Mat> r{ref}, l{live}, m{mask};
-  for (int i = 1; i < levels; ++i) {
-    cv::Mat a, b, c;
-    cv::resize(r.back(), a, cv::Size(), 0.5, 0.5, cv::INTER_AREA);
-    cv::resize(l.back(), b, cv::Size(), 0.5, 0.5, cv::INTER_AREA);
-    cv::resize(m.back(), c, cv::Size(), 0.5, 0.5, cv::INTER_NEAREST);
-    r.push_back(a); l.push_back(b); m.push_back(c);
-  }
-  cv::Mat W = cv::Mat::eye(3, 3, CV_32F);
-  const cv::Matx33f S(2, 0, 0.5f, 0, 2, 0.5f, 0, 0, 1);  // level l+1 pixel -> level l pixel
-  bool finest_ok = true;
-  for (int i = levels - 1; i >= 0; --i) {
-    const cv::Mat start = W.clone();
-    try {
-      cv::findTransformECC(r[static_cast<size_t>(i)], l[static_cast<size_t>(i)], W, cv::MOTION_HOMOGRAPHY,
-                           cv::TermCriteria(cv::TermCriteria::COUNT + cv::TermCriteria::EPS, iterations, eps),
-                           m[static_cast<size_t>(i)], 5);
-    } catch (const cv::Exception& ex) {
-      if (std::getenv("BENCH_VERBOSE")) std::printf("  ECC level %d: %s\n", i, ex.what());
-      W = start;
-      ++*failed_levels;
-      if (i == 0) finest_ok = false;
-    }
-    if (i > 0) W = cv::Mat(S * cv::Matx33f(W) * S.inv());
-  }
-  *H = W;
-  return finest_ok;
-}
-
-struct ErrStats {
-  std::vector<double> t, r, ms;
-  int fail = 0, level_fail = 0;
-  void add(const SE2& est, const SE2& truth, double ms_) {
-    t.push_back(std::hypot(est.x - truth.x, est.y - truth.y));
-    r.push_back(std::abs(wrap_angle(est.theta - truth.theta)));
-    ms.push_back(ms_);
-  }
-  void print(const char* name) const {
-    double st = 0, sr = 0, mx = 0;
-    for (size_t i = 0; i < t.size(); ++i) { st += t[i] * t[i]; sr += r[i] * r[i]; mx = std::max(mx, t[i]); }
-    const double n = std::max<size_t>(1, t.size());
-    int gross = 0;
-    for (double e : t) gross += e > 1e-3;
-    std::printf("%-44s %5zu %5d %6d %9.2f %9.4f %9.3f %9.5f %6d\n", name, t.size(), fail, level_fail, median(ms),
-                1e3 * std::sqrt(st / n), 1e3 * mx, std::sqrt(sr / n) * 180 / M_PI, gross);
-  }
-};
-
-int bench_ecc(int width, int height, int pairs, int levels, int stride) {
-  ocl::Runtime rt;
-  std::printf("device: %s; OpenCV %s, %d threads\n", rt.device_info().device_name.c_str(), CV_VERSION,
-              cv::getNumThreads());
-  const int frames_needed = 1 + (pairs - 1) * stride + 1;
-  sim::Options so = sequence_options("asphalt_01.png", frames_needed / 30.0 + 0.05, width, height, 1);
-  const sim::Trajectory traj = sim::generate_trajectory(so);
-  const std::vector<sim::Exposure> exposure = sim::exposure_series(so, traj.t);
-  std::vector<cv::Mat> frames;
-  {
-    sim::Renderer renderer(rt, cv::imread(so.texture, cv::IMREAD_GRAYSCALE), so);
-    for (size_t k = 0; k < traj.t.size(); ++k)
-      frames.push_back(sim::apply_camera(renderer.render_float(traj.pose[k]), exposure[k], so.pixel_noise,
-                                         sim::derive_seed(so.seed, 1000 + k)));
-  }
-  const Eigen::Matrix3d K = so.camera.K();
-  const UndistortMap umap = compute_undistort_map(so.camera);
-  const cv::Mat map_x(height, width, CV_32F, const_cast<float*>(umap.map_x.data()));
-  const cv::Mat map_y(height, width, CV_32F, const_cast<float*>(umap.map_y.data()));
-  const cv::Mat mask = cv::Mat(height, width, CV_8U, const_cast<uint8_t*>(umap.valid.data())) * 255;
-  std::printf("%dx%d asphalt_01, configuration 1, mixed motion, %d pairs (k, k+1), k = 1, 1+%d, ..; ECC: "
-              "MOTION_HOMOGRAPHY, 50 iterations, eps 1e-6, Gaussian 5, masked to the valid undistorted pixels, "
-              "on cv::remap (bilinear) undistorted frames\n", width, height, pairs, stride);
-  std::printf("%-44s %5s %5s %6s %9s %9s %9s %9s %6s\n", "method", "pairs", "fail", "lvfail", "med_ms", "rms_mm", "max_mm",
-              "rms_deg", "gross");
-  auto undistort = [&](const cv::Mat& g) {
-    cv::Mat f, u;
-    g.convertTo(f, CV_32F);
-    cv::remap(f, u, map_x, map_y, cv::INTER_LINEAR, cv::BORDER_CONSTANT, 0);
-    return u;
-  };
-  std::vector<size_t> ks;
-  for (int i = 0; i < pairs; ++i) ks.push_back(1 + static_cast<size_t>(i) * stride);
-  auto truth_of = [&](size_t k) { return traj.pose[k].inverse() * traj.pose[k + 1]; };
-  std::vector<int> level_counts{levels};
-  if (levels != 1) level_counts.push_back(1);
-  for (int lv : level_counts) {
-    ErrStats st;
-    for (size_t k : ks) {
-      const double t0 = now_ms();
-      const cv::Mat a = undistort(frames[k]), b = undistort(frames[k + 1]);
-      cv::Mat H;
-      const bool ok = ecc_pair(a, b, mask, lv, 50, 1e-6, &H, &st.level_fail);
-      const double ms = now_ms() - t0;
-      st.fail += !ok;  // counted, but the estimate carried from the coarser levels is still its answer
-      SE2 m;
-      if (!homography_to_motion(H, K, so.extrinsics, width, height, &m)) m = SE2();
-      st.add(m, truth_of(k), ms);
-    }
-    char name[96];
-    std::snprintf(name, sizeof name, "ECC homography, %d level%s from identity", lv, lv > 1 ? "s" : "");
-    st.print(name);
-    std::fflush(stdout);
-  }
-  // planarvo, each pair fresh: reset, track frame k (keyframe), track frame k+1 from zero motion.
-  {
-    track::Tracker tracker(rt, so.camera, so.extrinsics);
-    tracker.track(frames[0].data, width, height, frames[0].step, traj.t[0]);  // builds the pipeline
-    ErrStats st;
-    for (size_t k : ks) {
-      tracker.reset();
-      const double t0 = now_ms();
-      tracker.track(frames[k].data, width, height, frames[k].step, traj.t[k]);
-      const track::FrameResult r = tracker.track(frames[k + 1].data, width, height, frames[k + 1].step, traj.t[k + 1]);
-      const double ms = now_ms() - t0;
-      if (r.status == track::FrameResult::Status::Lost) { ++st.fail; continue; }
-      st.add(r.motion.value, truth_of(k), ms);
-    }
-    st.print("planarvo, pair fresh (reset, k, k+1)");
-  }
-  // planarvo on the sequence: the frame-to-frame motion of the same intervals (keyframes,
-  // constant-velocity prediction); time: track() of frame k+1.
-  {
-    track::Tracker tracker(rt, so.camera, so.extrinsics);
-    std::vector<track::FrameResult> res;
-    std::vector<double> ms;
-    for (size_t k = 0; k < frames.size(); ++k) res.push_back(tracker.track(frames[k].data, width, height, frames[k].step, traj.t[k]));
-    ErrStats st;
-    for (size_t k : ks) {
-      const track::FrameResult& r = res[k + 1];
-      if (r.status == track::FrameResult::Status::Lost) { ++st.fail; continue; }
-      st.add(r.motion.value, truth_of(k), r.ms);
-    }
-    st.print("planarvo, sequence (frame-to-frame motion)");
-  }
-  return 0;
-}
-
-std::vector<std::string> split(const std::string& x) {
-  std::vector<std::string> out;
-  size_t p = 0;
-  while (p <= x.size()) {
-    const size_t c = x.find(',', p);
-    out.push_back(x.substr(p, c == std::string::npos ? std::string::npos : c - p));
-    if (c == std::string::npos) break;
-    p = c + 1;
-  }
-  return out;
-}
-
-std::vector<std::string> all_textures() {
-  return {"aerial_asphalt_01.png", "aerial_ground_rock.png", "anti_skid_tiles.png", "anti_slip_concrete.png",
-          "asphalt_01.png", "asphalt_02.png", "black_painted_planks.png", "blue_floor_tiles_01.png",
-          "brick_floor.png", "brown_mud_rocks_01.png", "brushed_concrete.png", "skimage_brick.png",
-          "skimage_grass.png", "skimage_gravel.png"};
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -795,6 +549,7 @@ int main(int argc, char** argv) {
     int w = 640, h = 480;
     uint64_t seed = 1;
     Scene scene;
+    bool perturb = false;
     track::TrackerOptions topt;
     std::vector<std::string> tex = {"asphalt_01.png", "anti_skid_tiles.png", "brick_floor.png",
                                     "aerial_ground_rock.png"};
@@ -805,30 +560,9 @@ int main(int argc, char** argv) {
       if (k == "seconds") seconds = std::atof(v.c_str());
       else if (k == "w") w = std::atoi(v.c_str());
       else if (k == "h") h = std::atoi(v.c_str());
-      else if (k == "config") scene.config = std::atoi(v.c_str());
-      else if (k == "perturb") scene.perturb = std::atoi(v.c_str()) != 0;
+      else if (k == "perturb") perturb = std::atoi(v.c_str()) != 0;
       else if (k == "seed") seed = std::strtoull(v.c_str(), nullptr, 10);
-      else if (k == "motion")
-        scene.motion = v == "straight" ? sim::MotionProfile::Straight
-                       : v == "circle" ? sim::MotionProfile::Circle
-                       : v == "spin"   ? sim::MotionProfile::Spin
-                       : v == "car"    ? sim::MotionProfile::Car
-                                       : sim::MotionProfile::Mixed;
-      else if (k == "ext") {
-        const auto e = split(v);
-        if (e.size() != 6) {
-          std::fprintf(stderr, "ext=x,y,z,roll,pitch,yaw (m, deg)\n");
-          return 2;
-        }
-        const double d = M_PI / 180.0;
-        scene.has_ext = true;
-        scene.ext = Extrinsics{std::atof(e[0].c_str()), std::atof(e[1].c_str()), std::atof(e[2].c_str()),
-                               std::atof(e[3].c_str()) * d, std::atof(e[4].c_str()) * d, std::atof(e[5].c_str()) * d};
-      } else if (k == "fov") scene.fov = std::atof(v.c_str());
-      else if (k == "speed") scene.speed = std::atof(v.c_str());
-      else if (k == "turn") scene.turn = std::atof(v.c_str());
-      else if (k == "radius") scene.radius = std::atof(v.c_str());
-      else if (k == "noise") scene.noise = std::atof(v.c_str());
+      else if (scene.parse(k, v)) continue;
       else if (k == "levels") topt.levels = std::atoi(v.c_str());
       else if (k == "finest") topt.finest_level = std::atoi(v.c_str());
       else if (k == "refine_kf") topt.refine_keyframes = std::atoi(v.c_str()) != 0;
@@ -845,11 +579,7 @@ int main(int argc, char** argv) {
       }
     }
     if (tex.size() == 1 && tex[0] == "all") tex = all_textures();
-    if (scene.config < 1 || scene.config > 3) {
-      std::fprintf(stderr, "config must be 1, 2 or 3\n");
-      return 2;
-    }
-    return bench_accuracy(tex, seconds, w, h, seed, scene, topt, std::getenv("BENCH_VERBOSE") != nullptr);
+    return bench_accuracy(tex, seconds, w, h, seed, scene, perturb, topt, std::getenv("BENCH_VERBOSE") != nullptr);
   }
   if (mode == "nees") {
     // bench_track nees [key=value ...]: seconds=5 textures=a.png,b.png|all configs=1,2,3
@@ -904,13 +634,7 @@ int main(int argc, char** argv) {
       }
     return bench_nees(tex, configs, sizes, finests, seconds, seed, noise, topt);
   }
-  if (mode == "ecc") {
-    // bench_track ecc [w h] [pairs] [levels] [stride]
-    const int w = argc > 3 ? std::atoi(argv[2]) : 640, h = argc > 3 ? std::atoi(argv[3]) : 480;
-    return bench_ecc(w, h, argc > 4 ? std::atoi(argv[4]) : 100, argc > 5 ? std::atoi(argv[5]) : 3,
-                     argc > 6 ? std::atoi(argv[6]) : 1);
-  }
   std::fprintf(stderr, "usage: bench_track kernel [w h [wx wy pix hist fast [rounds]]] | speed [w h [seconds [rounds]]]"
-                       " | accuracy [key=value...] | nees [key=value...] | ecc [w h [pairs [levels [stride]]]]\n");
+                       " | accuracy [key=value...] | nees [key=value...]\n");
   return 2;
 }

@@ -1,0 +1,114 @@
+// What the tracker benchmarks simulate: a texture seen by a camera on a robot that drives a
+// profile, as `key=value` arguments shared by bench_track accuracy and bench_ecc. Header-only
+// (each bench/*.cpp is its own program).
+#pragma once
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <string>
+#include <vector>
+
+#include "bench_args.h"
+#include "core/extrinsics.h"
+#include "sim/simulator.h"
+
+namespace planarvo::bench {
+
+inline double now_ms() {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+inline std::string texture_path(const std::string& name) {
+  return std::string(PLANARVO_SHARED_DIR) + "/data/textures/" + name;
+}
+
+inline std::vector<std::string> all_textures() {
+  return {"aerial_asphalt_01.png", "aerial_ground_rock.png", "anti_skid_tiles.png", "anti_slip_concrete.png",
+          "asphalt_01.png", "asphalt_02.png", "black_painted_planks.png", "blue_floor_tiles_01.png",
+          "brick_floor.png", "brown_mud_rocks_01.png", "brushed_concrete.png", "skimage_brick.png",
+          "skimage_grass.png", "skimage_gravel.png"};
+}
+
+inline std::string describe(const Extrinsics& e) {
+  char b[160];
+  std::snprintf(b, sizeof b, "(%.4f, %.4f, %.4f m, %.1f, %.1f, %.1f deg)", e.x, e.y, e.z, e.roll * 180 / M_PI,
+                e.pitch * 180 / M_PI, e.yaw * 180 / M_PI);
+  return b;
+}
+
+// The camera on the robot, its field of view, the drive's limits and the noise.
+struct Scene {
+  int config = 1;        // the paper's configuration (sim::paper_configuration), unless `ext`
+  bool has_ext = false;
+  Extrinsics ext;        // ext=x,y,z,roll,pitch,yaw (m, deg)
+  double fov = 80.0, speed = 0.8, turn = 1.5, radius = 0.0, noise = 1.0;
+  sim::MotionProfile motion = sim::MotionProfile::Mixed;
+
+  Extrinsics extrinsics() const { return has_ext ? ext : sim::paper_configuration(config); }
+
+  // Takes one key=value argument: config, ext, fov, motion, speed, turn, radius, noise. False
+  // for another key; exits with a message on a bad value.
+  bool parse(const std::string& k, const std::string& v) {
+    if (k == "config") {
+      config = std::atoi(v.c_str());
+      if (config < 1 || config > 3) fail("config must be 1, 2 or 3");
+    } else if (k == "ext") {
+      const std::vector<std::string> e = split(v);
+      if (e.size() != 6) fail("ext=x,y,z,roll,pitch,yaw (m, deg)");
+      const double d = M_PI / 180.0;
+      has_ext = true;
+      ext = Extrinsics{std::atof(e[0].c_str()), std::atof(e[1].c_str()), std::atof(e[2].c_str()),
+                       std::atof(e[3].c_str()) * d, std::atof(e[4].c_str()) * d, std::atof(e[5].c_str()) * d};
+    } else if (k == "motion") {
+      motion = v == "straight" ? sim::MotionProfile::Straight
+               : v == "circle" ? sim::MotionProfile::Circle
+               : v == "spin"   ? sim::MotionProfile::Spin
+               : v == "car"    ? sim::MotionProfile::Car
+                               : sim::MotionProfile::Mixed;
+    } else if (k == "fov") {
+      fov = std::atof(v.c_str());
+    } else if (k == "speed") {
+      speed = std::atof(v.c_str());
+    } else if (k == "turn") {
+      turn = std::atof(v.c_str());
+    } else if (k == "radius") {
+      radius = std::atof(v.c_str());
+    } else if (k == "noise") {
+      noise = std::atof(v.c_str());
+    } else {
+      return false;
+    }
+    return true;
+  }
+
+  sim::Options options(const std::string& texture, double seconds, int width, int height, uint64_t seed) const {
+    sim::Options so;
+    so.texture = texture_path(texture);
+    so.camera = sim::default_camera(width, height, fov);
+    so.seconds = seconds;
+    so.seed = seed;
+    so.motion = motion;
+    so.max_speed = speed;
+    so.max_turn_rate = turn;
+    so.min_turn_radius = radius;
+    so.pixel_noise = noise;
+    so.extrinsics = extrinsics();
+    return so;
+  }
+
+  std::string summary() const {
+    char b[320];
+    std::snprintf(b, sizeof b, "camera %s, fov %.0f deg; %s motion up to %.2f m/s and %.2f rad/s%s; noise %.1f grey levels",
+                  describe(extrinsics()).c_str(), fov, sim::motion_profile_name(motion), speed, turn,
+                  radius > 0 ? (", turning radius >= " + std::to_string(radius) + " m").c_str() : "", noise);
+    return b;
+  }
+
+  [[noreturn]] static void fail(const char* what) {
+    std::fprintf(stderr, "%s\n", what);
+    std::exit(2);
+  }
+};
+
+}  // namespace planarvo::bench
