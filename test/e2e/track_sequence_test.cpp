@@ -7,6 +7,8 @@
 
 #include <gtest/gtest.h>
 
+#include <opencv2/imgcodecs.hpp>
+
 #include "common/test_util.h"
 #include "io/dataset.h"
 #include "ocl/runtime.h"
@@ -61,6 +63,38 @@ TEST(TrackSequence, SimulatedDataSetIsTrackedAccurately) {
   for (const SE2& m : est) composed = composed * m;
   EXPECT_NEAR(tracker.pose().x, composed.x, 1e-12);
   EXPECT_NEAR(tracker.pose().theta, composed.theta, 1e-12);
+}
+
+// A rear parking camera (1.1 m up, 55 degrees from vertical, 60 degree field of view, looking
+// back) over fine tiles, a car at up to 3 m/s: the far field is foreshortened, and at the
+// coarsest level the grout lines average away (mean squared gradient 0.17, where a flat frame
+// of 1 grey level of noise has 0.01). The first frame becomes the keyframe and every frame
+// tracks within 0.2 mm of the truth (the tracker used to refuse every frame as "no texture").
+TEST(TrackSequence, RearCameraOverFineTilesStartsAndTracks) {
+  ocl::Runtime rt;
+  sim::Options so;
+  so.texture = test::texture("anti_skid_tiles.png").string();
+  so.camera = sim::default_camera(640, 480, 60.0);
+  so.extrinsics = Extrinsics{-1.0, 0.2, 1.1, 0.0, 55.0 * M_PI / 180.0, M_PI};
+  so.motion = sim::MotionProfile::Car;
+  so.max_speed = 3.0;
+  so.min_turn_radius = 6.0;
+  so.seconds = 0.5;
+  so.supersampling = 2;
+  const sim::Trajectory traj = sim::generate_trajectory(so);
+  sim::Renderer renderer(rt, cv::imread(so.texture, cv::IMREAD_GRAYSCALE), so);
+  Tracker tracker(rt, so.camera, so.extrinsics);
+  for (size_t k = 0; k < traj.t.size(); ++k) {
+    const cv::Mat f = sim::apply_camera(renderer.render_float(traj.pose[k]), {}, 1.0, 100 + k);
+    const FrameResult r = tracker.track(f.data, f.cols, f.rows, f.step, traj.t[k]);
+    if (k == 0) {
+      EXPECT_EQ(r.status, FrameResult::Status::First) << r.reason;
+      continue;
+    }
+    EXPECT_EQ(r.status, FrameResult::Status::Ok) << k << " " << r.reason;
+    const SE2 t = traj.pose[k - 1].inverse() * traj.pose[k];
+    EXPECT_LT(std::hypot(r.motion.value.x - t.x, r.motion.value.y - t.y), 0.2e-3) << k;
+  }
 }
 
 }  // namespace
