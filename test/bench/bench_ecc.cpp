@@ -3,7 +3,7 @@
 //
 //   bench_ecc [key=value...]
 //     textures=a.png,b.png|all (asphalt_01.png)  seconds=20  w=640 h=480  seed=1
-//     pairs=60 (spread evenly over the sequence)  levels=3 (ECC's pyramid)
+//     pairs=60 (spread evenly over the sequence)  levels=3 (ECC's pyramid)  finest=N (the tracker's)
 //     the scene: config=1|2|3 or ext=x,y,z,roll,pitch,yaw (m, deg), fov=deg,
 //     motion=mixed|straight|circle|spin|car, speed=m/s, turn=rad/s, radius=m, noise=grey levels
 //
@@ -174,6 +174,7 @@ int main(int argc, char** argv) {
   double seconds = 20.0;
   int w = 640, h = 480, pairs = 60, levels = 3;
   uint64_t seed = 1;
+  track::TrackerOptions topt;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     const size_t eq = a.find('=');
@@ -186,6 +187,7 @@ int main(int argc, char** argv) {
     else if (k == "seed") seed = std::strtoull(v.c_str(), nullptr, 10);
     else if (k == "pairs") pairs = std::max(1, std::atoi(v.c_str()));
     else if (k == "levels") levels = std::max(1, std::atoi(v.c_str()));
+    else if (k == "finest") topt.finest_level = std::atoi(v.c_str());
     else {
       std::fprintf(stderr, "unknown option %s (see the comment at the top of bench_ecc.cpp)\n", a.c_str());
       return 2;
@@ -197,7 +199,8 @@ int main(int argc, char** argv) {
   std::printf("%dx%d, %.0f s at 30 Hz, seed %llu; %s\n", w, h, seconds, static_cast<unsigned long long>(seed),
               scene.summary().c_str());
   std::printf("%d pairs (k, k+1) spread over each sequence; ECC: homography, %d levels from the identity, on "
-              "undistorted frames; planarvo: the sequence tracked with the default options\n", pairs, levels);
+              "undistorted frames; planarvo: the sequence tracked with the default options, finest level %d (-1: auto)\n",
+              pairs, levels, topt.finest_level);
   std::printf("%-24s %-28s %5s %5s %9s %9s %9s %9s %9s %9s\n", "texture", "method", "pairs", "fail", "med_ms",
               "mean_px", "max_px", "rms_mm", "max_mm", "rms_deg");
   for (const std::string& tex : textures) {
@@ -214,7 +217,7 @@ int main(int argc, char** argv) {
     const size_t n = frames.size();
     std::vector<track::FrameResult> res;
     {
-      track::Tracker tracker(rt, so.camera, so.extrinsics);
+      track::Tracker tracker(rt, so.camera, so.extrinsics, topt);
       for (size_t k = 0; k < n; ++k) res.push_back(tracker.track(frames[k].data, w, h, frames[k].step, traj.t[k]));
     }
     const Eigen::Matrix3d K = so.camera.K();
@@ -251,7 +254,7 @@ int main(int argc, char** argv) {
     }
     ecc.print(tex.c_str(), "ECC homography");
     vo.print(tex.c_str(), "planarvo (sequence)");
-    std::printf("%-24s %-28s px error %.2fx ECC's; %.0fx faster per pair (median)\n", tex.c_str(), "planarvo / ECC",
+    std::printf("%-24s %-28s px error %.3fx ECC's; %.0fx faster per pair (median)\n", tex.c_str(), "planarvo / ECC",
                 Method::mean(vo.px) / std::max(1e-12, Method::mean(ecc.px)), median(ecc.ms) / std::max(1e-9, median(vo.ms)));
     std::fflush(stdout);
   }

@@ -173,6 +173,7 @@ struct SequenceReport {
   int frames = 0, ok = 0, degraded = 0, lost = 0, keyframes = 0;
   track::MotionAccuracy acc;
   double ms_frame = 0, ms_pipeline = 0, cpu_frame = 0;
+  std::vector<double> ms;  // per frame after the first (which builds the programs and the first keyframe)
   double passes[kMaxLevelsBench] = {};
   double level_ms[kMaxLevelsBench] = {};
   double std_pos_median = 0, std_pos_max = 0, std_head_median = 0, nees = 0, aniso_max = 0;
@@ -198,6 +199,7 @@ SequenceReport run_sequence(ocl::Runtime& rt, const sim::Options& so, const trac
     const track::FrameResult r = tracker.track(img.data, img.cols, img.rows, img.step, traj.t[k]);
     rep.cpu_frame += cpu_ms() - c0;
     rep.ms_frame += r.ms;
+    if (k > 0) rep.ms.push_back(r.ms);
     rep.ms_pipeline += r.pipeline_ms;
     ++rep.frames;
     rep.keyframes += r.keyframe;
@@ -250,9 +252,9 @@ int bench_accuracy(const std::vector<std::string>& textures, double seconds, int
               topt.finest_level);
   std::printf("configuration %d (0: ext=): true extrinsics %s; tracker given %s%s\n", config, describe(truth).c_str(),
               describe(told).c_str(), perturb ? " (perturbed +10,-10,+10 mm, +2.5,-2.5,+2.5 deg)" : " (true)");
-  std::printf("%-22s %4s %6s %4s %4s %4s %4s %8s %8s %7s %7s %8s %5s %7s %7s %7s %7s  %s\n", "texture", "cfg",
+  std::printf("%-22s %4s %6s %4s %4s %4s %4s %8s %8s %7s %7s %8s %5s %7s %7s %7s %7s %6s %6s %6s  %s\n", "texture", "cfg",
               "frames", "ok", "deg", "lost", "kf", "slope_v", "slope_w", "rms_mm", "max_mm", "rms_deg", "gross",
-              "drift%", "ms/fr", "ms_pipe", "cpu/fr", "passes per frame, coarse to fine");
+              "drift%", "ms/fr", "ms_pipe", "cpu/fr", "med_ms", "p99/md", "max/md", "passes per frame, coarse to fine");
   for (const std::string& tex : textures) {
     const sim::Options so = scene.options(tex, seconds, width, height, seed);
     const SequenceReport r = run_sequence(rt, so, topt, verbose, &told);
@@ -261,6 +263,11 @@ int bench_accuracy(const std::vector<std::string>& textures, double seconds, int
                 tex.c_str(), config, perturb ? "p" : " ", r.frames, r.ok, r.degraded, r.lost, r.keyframes, r.acc.slope_linear, r.acc.slope_angular,
                 r.acc.rms_translation * 1e3, r.acc.max_translation * 1e3, r.acc.rms_rotation * 180 / M_PI,
                 r.acc.gross_errors, r.acc.endpoint_drift * 100, r.ms_frame / n, r.ms_pipeline / n, r.cpu_frame / n);
+    std::vector<double> ms = r.ms;
+    std::sort(ms.begin(), ms.end());
+    const double med = ms.empty() ? 0.0 : ms[ms.size() / 2];
+    const double p99 = ms.empty() ? 0.0 : ms[std::min(ms.size() - 1, static_cast<size_t>(0.99 * static_cast<double>(ms.size())))];
+    std::printf("%6.2f %6.2f %6.2f ", med, med > 0 ? p99 / med : 0.0, med > 0 && !ms.empty() ? ms.back() / med : 0.0);
     for (int l = topt.levels - 1; l >= 0; --l) std::printf(" %.2f", r.passes[l] / n);
     std::printf("\n");
     if (verbose)
