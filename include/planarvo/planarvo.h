@@ -341,7 +341,9 @@ typedef enum planarvo_motion_profile {
                                    place, stops: everything calibration needs */
   PLANARVO_MOTION_STRAIGHT = 1, /* forwards and backwards along one line */
   PLANARVO_MOTION_CIRCLE = 2,   /* one constant-curvature circle */
-  PLANARVO_MOTION_SPIN = 3      /* turning in place */
+  PLANARVO_MOTION_SPIN = 3,     /* turning in place */
+  PLANARVO_MOTION_CAR = 4       /* a car: forward driving with turns no tighter than
+                                   min_turn_radius, stops, slow reversing; never in place */
 } planarvo_motion_profile;
 
 typedef struct planarvo_sim_options {
@@ -365,6 +367,8 @@ typedef struct planarvo_sim_options {
   int32_t supersampling;      /* samples per pixel along each axis; default 3 */
   planarvo_progress_fn progress;
   void* progress_user_data;
+  double min_turn_radius;     /* PLANARVO_MOTION_CAR: the tightest turn, metres; default 0 (only
+                                 max_turn_rate limits it). Read only when struct_size covers it. */
 } planarvo_sim_options;
 
 PLANARVO_API void planarvo_sim_options_init(planarvo_sim_options* options);

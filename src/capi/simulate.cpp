@@ -32,6 +32,7 @@ PLANARVO_API void planarvo_sim_options_init(planarvo_sim_options* o) {
   o->gain_variation = d.gain_variation;
   o->odometry_noise = d.odometry_noise;
   o->supersampling = d.supersampling;
+  o->min_turn_radius = d.min_turn_radius;
 }
 
 PLANARVO_API planarvo_status planarvo_sim_default_camera(int32_t width, int32_t height, double fov_deg,
@@ -68,10 +69,13 @@ PLANARVO_API planarvo_status planarvo_simulate(planarvo_context* context, const 
       case PLANARVO_MOTION_STRAIGHT: s.motion = planarvo::sim::MotionProfile::Straight; break;
       case PLANARVO_MOTION_CIRCLE: s.motion = planarvo::sim::MotionProfile::Circle; break;
       case PLANARVO_MOTION_SPIN: s.motion = planarvo::sim::MotionProfile::Spin; break;
+      case PLANARVO_MOTION_CAR: s.motion = planarvo::sim::MotionProfile::Car; break;
       default: require(false, "planarvo_simulate: options.motion is not a planarvo_motion_profile");
     }
     s.max_speed = o->max_speed;
     s.max_turn_rate = o->max_turn_rate;
+    if (o->struct_size >= offsetof(planarvo_sim_options, min_turn_radius) + sizeof(double))
+      s.min_turn_radius = o->min_turn_radius;
     s.pixel_noise = o->pixel_noise;
     s.gain_variation = o->gain_variation;
     s.odometry_noise = o->odometry_noise;

@@ -44,7 +44,8 @@ std::vector<OptionSpec> simulate_options() {
       {"seconds", "S", "duration", "10"},
       {"fps", "F", "frame rate", "30"},
       {"seed", "N", "random seed (same seed, same data set)", "1"},
-      {"motion", "KIND", "mixed | straight | circle | spin", "mixed"},
+      {"motion", "KIND", "mixed | straight | circle | spin | car", "mixed"},
+      {"min-turn-radius", "M", "car: the tightest turn, metres (0: limited by --max-turn-rate only)", "0"},
       {"max-speed", "M/S", "peak linear speed", "0.8"},
       {"max-turn-rate", "RAD/S", "peak angular speed", "1.5"},
       {"noise", "SIGMA", "pixel noise standard deviation, grey levels", "1"},
@@ -81,7 +82,9 @@ void apply_simulate_args(const Args& a, planarvo_sim_options* o, std::string* te
   else if (motion == "straight") o->motion = PLANARVO_MOTION_STRAIGHT;
   else if (motion == "circle") o->motion = PLANARVO_MOTION_CIRCLE;
   else if (motion == "spin") o->motion = PLANARVO_MOTION_SPIN;
-  else throw UsageError("--motion must be mixed, straight, circle or spin, not \"" + motion + "\"");
+  else if (motion == "car") o->motion = PLANARVO_MOTION_CAR;
+  else throw UsageError("--motion must be mixed, straight, circle, spin or car, not \"" + motion + "\"");
+  o->min_turn_radius = a.get_double("min-turn-radius", o->min_turn_radius);
   o->max_speed = a.get_double("max-speed", o->max_speed);
   o->max_turn_rate = a.get_double("max-turn-rate", o->max_turn_rate);
   o->pixel_noise = a.get_double("noise", o->pixel_noise);

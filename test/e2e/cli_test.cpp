@@ -2,6 +2,7 @@
 // 3 no device) and messages that name the file and line, for each kind of bad input; a track
 // stopped by bad input writes nothing. (What the commands print and write is compared with the C
 // API in cli_data_test, cli_track_test and cli_graph_test.)
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -142,6 +143,36 @@ TEST(Cli, SimulateRejectsBadTexture) {
   auto r = run_cli("simulate --quiet --out " + (d / "sim").string() + " --texture /nonexistent/floor.png");
   EXPECT_EQ(r.exit_code, 2) << r.output;
   EXPECT_NE(r.output.find("/nonexistent/floor.png"), std::string::npos) << r.output;
+}
+
+// A car drive for a rear camera: every interval of the written ground truth is an arc no tighter
+// than --min-turn-radius (curvature from the true poses, independently of the simulator's
+// velocities). A camera tilted until it sees the horizon is refused, and no directory is made.
+TEST(Cli, SimulateDrivesACarAndRefusesTheHorizon) {
+  ScratchDir d;
+  const fs::path seq = d / "car";
+  auto r = run_cli("simulate --quiet --out " + seq.string() + " --seconds 3 --width 160 --height 120 --fov 60 "
+                   "--extrinsics=-1,0,0.9,0,40,180 --motion car --max-speed 3 --min-turn-radius 6");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const std::vector<io::StampedPose> gt = io::read_tum((seq / "groundtruth.txt").string());
+  ASSERT_EQ(gt.size(), 90u);
+  double travelled = 0;
+  for (size_t i = 1; i < gt.size(); ++i) {
+    const SE2 m = gt[i - 1].pose.inverse() * gt[i].pose;
+    const double chord = std::hypot(m.x, m.y);
+    travelled += chord;
+    // An arc of angle theta and chord c has radius c / (2 sin(theta / 2)).
+    if (std::abs(m.theta) > 1e-12) {
+      EXPECT_GE(chord / (2 * std::sin(std::abs(m.theta) / 2)), 6.0 * (1 - 1e-6)) << i;
+    }
+  }
+  EXPECT_GT(travelled, 1.0);
+
+  const fs::path bad = d / "horizon";
+  r = run_cli("simulate --quiet --out " + bad.string() + " --seconds 1 --width 160 --height 120 --fov 60 "
+              "--extrinsics=-1,0,0.9,0,80,180");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_FALSE(fs::exists(bad));
 }
 
 // A usage error says what was wrong (exit 2), in the tool's words: the option as typed, the
