@@ -206,14 +206,7 @@ int main(int argc, char** argv) {
   for (const std::string& tex : textures) {
     const sim::Options so = scene.options(tex, seconds, w, h, seed);
     const sim::Trajectory traj = sim::generate_trajectory(so);
-    const std::vector<sim::Exposure> exposure = sim::exposure_series(so, traj.t);
-    std::vector<cv::Mat> frames;
-    {
-      sim::Renderer renderer(rt, cv::imread(so.texture, cv::IMREAD_GRAYSCALE), so);
-      for (size_t k = 0; k < traj.t.size(); ++k)
-        frames.push_back(sim::apply_camera(renderer.render_float(traj.pose[k]), exposure[k], so.pixel_noise,
-                                           sim::derive_seed(so.seed, 1000 + k)));
-    }
+    const std::vector<cv::Mat> frames = bench::render_sequence(rt, so, traj);
     const size_t n = frames.size();
     std::vector<track::FrameResult> res;
     {

@@ -9,6 +9,8 @@
 #include <string>
 #include <vector>
 
+#include <opencv2/imgcodecs.hpp>
+
 #include "bench_args.h"
 #include "core/extrinsics.h"
 #include "sim/simulator.h"
@@ -98,10 +100,11 @@ struct Scene {
   }
 
   std::string summary() const {
+    char r[64] = "";
+    if (radius > 0) std::snprintf(r, sizeof r, ", turning radius >= %.1f m", radius);
     char b[320];
     std::snprintf(b, sizeof b, "camera %s, fov %.0f deg; %s motion up to %.2f m/s and %.2f rad/s%s; noise %.1f grey levels",
-                  describe(extrinsics()).c_str(), fov, sim::motion_profile_name(motion), speed, turn,
-                  radius > 0 ? (", turning radius >= " + std::to_string(radius) + " m").c_str() : "", noise);
+                  describe(extrinsics()).c_str(), fov, sim::motion_profile_name(motion), speed, turn, r, noise);
     return b;
   }
 
@@ -110,5 +113,22 @@ struct Scene {
     std::exit(2);
   }
 };
+
+// Frame k of a simulated sequence as the camera gives it: rendered at the true pose, then the
+// camera's gain, offset and noise, seeded per frame (every benchmark sees the same frames).
+inline cv::Mat camera_frame(sim::Renderer& renderer, const sim::Options& so, const sim::Trajectory& traj,
+                            const std::vector<sim::Exposure>& exposure, size_t k) {
+  return sim::apply_camera(renderer.render_float(traj.pose[k]), exposure[k], so.pixel_noise,
+                           sim::derive_seed(so.seed, 1000 + k));
+}
+
+// Every frame of a sequence, rendered once into memory.
+inline std::vector<cv::Mat> render_sequence(ocl::Runtime& rt, const sim::Options& so, const sim::Trajectory& traj) {
+  const std::vector<sim::Exposure> exposure = sim::exposure_series(so, traj.t);
+  sim::Renderer renderer(rt, cv::imread(so.texture, cv::IMREAD_GRAYSCALE), so);
+  std::vector<cv::Mat> frames;
+  for (size_t k = 0; k < traj.t.size(); ++k) frames.push_back(camera_frame(renderer, so, traj, exposure, k));
+  return frames;
+}
 
 }  // namespace planarvo::bench

@@ -154,21 +154,6 @@ int bench_kernel(int width, int height, const std::vector<KernelConfig>& only, i
 }
 
 // The simulator's frames of a sequence: 8-bit camera images, times and true poses.
-struct Sequence {
-  sim::Options options;
-  sim::Trajectory trajectory;
-  std::vector<cv::Mat> frames;  // rendered on demand when not kept
-};
-
-sim::Options sequence_options(const std::string& texture, double seconds, int width, int height, uint64_t seed) {
-  sim::Options so;
-  so.texture = texture_path(texture);
-  so.camera = sim::default_camera(width, height);
-  so.seconds = seconds;
-  so.seed = seed;
-  return so;
-}
-
 struct SequenceReport {
   int frames = 0, ok = 0, degraded = 0, lost = 0, keyframes = 0;
   track::MotionAccuracy acc;
@@ -193,8 +178,7 @@ SequenceReport run_sequence(ocl::Runtime& rt, const sim::Options& so, const trac
   double nees = 0;
   int nees_n = 0;
   for (size_t k = 0; k < traj.t.size(); ++k) {
-    const cv::Mat img = sim::apply_camera(renderer.render_float(traj.pose[k]), exposure[k], so.pixel_noise,
-                                          sim::derive_seed(so.seed, 1000 + k));
+    const cv::Mat img = bench::camera_frame(renderer, so, traj, exposure, k);
     const double c0 = cpu_ms();
     const track::FrameResult r = tracker.track(img.data, img.cols, img.rows, img.step, traj.t[k]);
     rep.cpu_frame += cpu_ms() - c0;
@@ -419,7 +403,7 @@ int bench_nees(const std::vector<std::string>& textures, const std::vector<int>&
   for (const auto& wh : sizes)
     for (int config : configs)
       for (const std::string& tex : textures) {
-        sim::Options so = sequence_options(tex, seconds, wh[0], wh[1], seed);
+        sim::Options so = Scene().options(tex, seconds, wh[0], wh[1], seed);
         so.extrinsics = sim::paper_configuration(config);
         so.pixel_noise = noise;
         const sim::Trajectory traj = sim::generate_trajectory(so);
@@ -434,8 +418,7 @@ int bench_nees(const std::vector<std::string>& textures, const std::vector<int>&
           runs.back()->tag = tex + "," + std::to_string(config) + "," + std::to_string(wh[0]) + "," + std::to_string(f);
         }
         for (size_t k = 0; k < traj.t.size(); ++k) {
-          const cv::Mat img = sim::apply_camera(renderer.render_float(traj.pose[k]), exposure[k], so.pixel_noise,
-                                                sim::derive_seed(so.seed, 1000 + k));
+          const cv::Mat img = bench::camera_frame(renderer, so, traj, exposure, k);
           for (auto& run : runs) run->frame(img, traj.t[k], traj.pose[k == 0 ? 0 : k - 1], traj.pose[k]);
         }
         for (size_t i = 0; i < runs.size(); ++i) {
@@ -470,16 +453,9 @@ int bench_nees(const std::vector<std::string>& textures, const std::vector<int>&
 int bench_speed(int width, int height, double seconds, int rounds) {
   ocl::Runtime rt;
   std::printf("device: %s\n", rt.device_info().device_name.c_str());
-  const sim::Options so = sequence_options("asphalt_01.png", seconds, width, height, 1);
+  const sim::Options so = Scene().options("asphalt_01.png", seconds, width, height, 1);
   const sim::Trajectory traj = sim::generate_trajectory(so);
-  const std::vector<sim::Exposure> exposure = sim::exposure_series(so, traj.t);
-  std::vector<cv::Mat> frames;
-  {
-    sim::Renderer renderer(rt, cv::imread(so.texture, cv::IMREAD_GRAYSCALE), so);
-    for (size_t k = 0; k < traj.t.size(); ++k)
-      frames.push_back(sim::apply_camera(renderer.render_float(traj.pose[k]), exposure[k], so.pixel_noise,
-                                         sim::derive_seed(so.seed, 1000 + k)));
-  }
+  const std::vector<cv::Mat> frames = bench::render_sequence(rt, so, traj);
   struct Config {
     const char* name;
     track::TrackerOptions opt;
