@@ -4,7 +4,7 @@ default device (or the one named by the first argument) and prints it.
 
     PLANARVO_LIBRARY=/path/to/libplanarvo.so python3 list_devices.py [DEVICE]
 
-Without PLANARVO_LIBRARY the system's library search path is used (libplanarvo.so.0).
+Without PLANARVO_LIBRARY the system's library search path is used (libplanarvo.so.0.2).
 """
 import ctypes
 import os
@@ -45,7 +45,7 @@ class PlanarvoError(RuntimeError):
 
 
 def load(path=None):
-    lib = ctypes.CDLL(path or os.environ.get("PLANARVO_LIBRARY") or "libplanarvo.so.0")
+    lib = ctypes.CDLL(path or os.environ.get("PLANARVO_LIBRARY") or "libplanarvo.so.0.2")
     lib.planarvo_version_string.restype = ctypes.c_char_p
     lib.planarvo_last_error.restype = ctypes.c_char_p
     lib.planarvo_status_name.restype = ctypes.c_char_p

@@ -7,7 +7,7 @@ as examples/c/track_and_calibrate.c.
     python3 track_and_calibrate.py DATASET EXTRINSICS.yaml TRAJECTORY.txt [CALIBRATED.yaml]
 
 The library: $PLANARVO_LIBRARY (a path to libplanarvo.so), else the one the system's search
-finds (ctypes.util.find_library, then libplanarvo.so.0). DATASET is a data set directory
+finds (ctypes.util.find_library, then libplanarvo.so.0.2). DATASET is a data set directory
 (docs/formats.md; `planarvo simulate --out DIR` makes one). The calibration uses the data set's
 wheel odometry when it has some, else the nonholonomic method with its direction labels and the
 camera height from EXTRINSICS.yaml. Exit status: 0 done; 1 a step ran but failed (no OpenCL
@@ -28,9 +28,13 @@ c_int32, c_int64, c_double, c_size_t = ctypes.c_int32, ctypes.c_int64, ctypes.c_
 c_enum = ctypes.c_int  # a C enum
 
 
+class Region(ctypes.Structure):
+    _fields_ = [(n, c_int32) for n in ("x", "y", "width", "height")]
+
+
 class Camera(ctypes.Structure):
     _fields_ = [("width", c_int32), ("height", c_int32)] + [
-        (n, c_double) for n in ("fx", "fy", "cx", "cy", "k1", "k2", "p1", "p2", "k3")]
+        (n, c_double) for n in ("fx", "fy", "cx", "cy", "k1", "k2", "p1", "p2", "k3")] + [("roi", Region)]
 
 
 class Extrinsics(ctypes.Structure):
@@ -117,7 +121,7 @@ VOID_P = ctypes.c_void_p
 
 
 def load_library():
-    path = os.environ.get("PLANARVO_LIBRARY") or ctypes.util.find_library("planarvo") or "libplanarvo.so.0"
+    path = os.environ.get("PLANARVO_LIBRARY") or ctypes.util.find_library("planarvo") or "libplanarvo.so.0.2"
     lib = ctypes.CDLL(path)
     signatures = {
         "planarvo_last_error": (ctypes.c_char_p, []),

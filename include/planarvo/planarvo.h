@@ -52,7 +52,7 @@ extern "C" {
 /* Version                                                                                     */
 
 #define PLANARVO_VERSION_MAJOR 0
-#define PLANARVO_VERSION_MINOR 1
+#define PLANARVO_VERSION_MINOR 2
 #define PLANARVO_VERSION_PATCH 0
 #define PLANARVO_VERSION_NUMBER \
   (PLANARVO_VERSION_MAJOR * 10000 + PLANARVO_VERSION_MINOR * 100 + PLANARVO_VERSION_PATCH)
@@ -91,12 +91,22 @@ typedef int (*planarvo_progress_fn)(void* user_data, double fraction, const char
 /* ------------------------------------------------------------------------------------------ */
 /* Plain data                                                                                  */
 
+/* A rectangle of image pixels: columns x .. x + width - 1, rows y .. y + height - 1. */
+typedef struct planarvo_region {
+  int32_t x, y, width, height;
+} planarvo_region;
+
 /* Pinhole camera with OpenCV's radial-tangential distortion (k1 k2 p1 p2 k3), pixel (0,0) the
- * centre of the top-left pixel. */
+ * centre of the top-left pixel. Zero-initialise it before filling it in (roi was added in 0.2). */
 typedef struct planarvo_camera {
   int32_t width, height;
   double fx, fy, cx, cy;
   double k1, k2, p1, p2, k3;
+  /* The region of interest: the only pixels of the image the engine uses, for a camera that
+   * also sees the horizon, the vehicle's bumper or the sidewalk (camera.yaml's
+   * region_of_interest). All zero: the whole image. Otherwise it must lie inside the image and be
+   * at least 16 pixels on a side (else PLANARVO_ERROR_INVALID_INPUT). */
+  planarvo_region roi;
 } planarvo_camera;
 
 /* Camera pose on the robot: centre (x, y, z) in metres, z the height above the ground;
@@ -299,6 +309,11 @@ PLANARVO_API planarvo_status planarvo_dataset_open(const char* directory,
 PLANARVO_API void planarvo_dataset_destroy(planarvo_dataset* dataset);
 PLANARVO_API planarvo_status planarvo_dataset_info_get(const planarvo_dataset* dataset,
                                                        planarvo_dataset_info* info);
+/* Replaces the data set camera's region of interest (camera.yaml's region_of_interest) for
+ * everything that reads the data set from now on (planarvo_dataset_info_get, the calibration);
+ * roi NULL or all zero: the whole image. PLANARVO_ERROR_INVALID_INPUT, changing nothing, when it
+ * does not lie inside the image or is smaller than 16 pixels on a side. */
+PLANARVO_API planarvo_status planarvo_dataset_set_roi(planarvo_dataset* dataset, const planarvo_region* roi);
 PLANARVO_API planarvo_status planarvo_dataset_frame_data(const planarvo_dataset* dataset,
                                                          int64_t index, planarvo_frame_data* data);
 /* Decodes frame index as 8-bit grey. *image points into memory owned by the data set, valid until

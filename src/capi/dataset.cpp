@@ -49,6 +49,15 @@ PLANARVO_API planarvo_status planarvo_dataset_open(const char* directory, const 
 
 PLANARVO_API void planarvo_dataset_destroy(planarvo_dataset* dataset) { delete dataset; }
 
+PLANARVO_API planarvo_status planarvo_dataset_set_roi(planarvo_dataset* dataset, const planarvo_region* roi) {
+  return guard([&] {
+    require(dataset != nullptr, "planarvo_dataset_set_roi: dataset is NULL");
+    planarvo::PixelRegion r;
+    if (roi) r = planarvo::PixelRegion{roi->x, roi->y, roi->width, roi->height};
+    dataset->dataset->set_region_of_interest(r);
+  });
+}
+
 PLANARVO_API planarvo_status planarvo_dataset_info_get(const planarvo_dataset* dataset, planarvo_dataset_info* info) {
   return guard([&] {
     require(dataset != nullptr && info != nullptr, "planarvo_dataset_info_get: NULL argument");

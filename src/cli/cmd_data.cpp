@@ -56,6 +56,8 @@ std::vector<OptionSpec> simulate_options() {
       {"fov", "DEG", "horizontal field of view", "80"},
       {"distortion", "k1,k2,p1,p2,k3", "lens distortion (OpenCV model)", "-0.12,0.03,0,0,0"},
       {"supersampling", "N", "N x N samples per pixel (plus mip-mapping)", "3"},
+      roi_option("the whole image; written to camera.yaml. A camera that sees the horizon needs one that leaves "
+                 "it out"),
       {"quiet", "", "no progress bar", ""},
       {"help", "", "show this help", ""},
   };
@@ -103,6 +105,7 @@ void apply_simulate_args(const Args& a, planarvo_sim_options* o, std::string* te
     const auto d = a.get_doubles("distortion", 5);
     c.k1 = d[0]; c.k2 = d[1]; c.p1 = d[2]; c.p2 = d[3]; c.k3 = d[4];
   }
+  if (const std::optional<planarvo_region> r = parse_roi(a)) c.roi = *r;
 }
 
 // What a trajectory and its wheel odometry look like against ground truth.
@@ -164,6 +167,11 @@ void print_dataset(planarvo_dataset* ds, const std::string& dir) {
               info.frame_count > 1 ? static_cast<double>(info.frame_count - 1) / span : 0.0);
   std::printf("  camera      %dx%d, fx %.2f fy %.2f cx %.2f cy %.2f, distortion %.4g %.4g %.4g %.4g %.4g\n",
               c.width, c.height, c.fx, c.fy, c.cx, c.cy, c.k1, c.k2, c.p1, c.p2, c.k3);
+  if (c.roi.width > 0)
+    std::printf("  region      x %d, y %d, %dx%d pixels (region of interest)\n", c.roi.x, c.roi.y, c.roi.width,
+                c.roi.height);
+  else
+    std::printf("  region      the whole image\n");
   std::printf("  odometry    %s\n  direction   %s\n  groundtruth %s\n", info.has_odometry ? "yes" : "no",
               info.has_direction ? "yes" : "no", info.has_groundtruth ? "yes" : "no");
   auto ext = [](const char* label, int has, const planarvo_extrinsics& e) {

@@ -89,6 +89,7 @@ int cmd_calibrate(int argc, char** argv) {
       {"frames", "N", "DATASET: frames for roll and pitch, counted from the first that moves", "until 12 keyframes"},
       {"initial-extrinsics", "FILE", "DATASET: start from these extrinsics (YAML)", "looking straight down"},
       {"video", "FILE", "DATASET: a video file standing in for images/ and frames.txt", ""},
+      roi_option("DATASET: camera.yaml's region_of_interest, else the whole image"),
       {"quiet", "", "no progress bar", ""},
       {"method", "KIND", "odometry | nonholonomic", "odometry"},
       {"fix-scale", "", "a metric sensor (e.g. a laser scan matcher): scale 1, z written as 0", ""},

@@ -260,6 +260,7 @@ int cmd_track(int argc, char** argv) {
       {"finest-level", "N", "finest pyramid level tracked (0 = full resolution)", "the coarsest at least 320 px wide"},
       {"max-iterations", "N", "cap on alignment steps per level", "per-level defaults"},
       {"video", "FILE", "a video file standing in for images/ and frames.txt", ""},
+      roi_option("camera.yaml's region_of_interest, else the whole image"),
       {"skip-bad-frames", "", "a missing or undecodable image is a gap (a warning, a \"skipped\" statistics row, "
                               "counted in the summary) instead of an error", ""},
       {"max-lost", "PERCENT", "exit 1 (after writing every output) when more than this share of the frames was "
@@ -284,6 +285,7 @@ int cmd_track(int argc, char** argv) {
   o.levels = args.get_int_in("levels", o.levels, 1, 8);
   if (args.has("finest-level")) o.finest_level = args.get_int_in("finest-level", 0, 0, o.levels - 1);
   o.max_iterations = args.get_int_in("max-iterations", 0, 1, 1000);
+  parse_roi(args);  // its form, before any file is read
   const double max_lost = args.get_double("max-lost", 5.0);
   if (!(max_lost >= 0.0 && max_lost <= 100.0))
     throw UsageError("--max-lost must be a percentage within 0..100, not " + args.get("max-lost"));
@@ -298,6 +300,7 @@ int cmd_track(int argc, char** argv) {
   ContextPtr ctx = make_context(args);
   Progress progress(!args.has("quiet"));
   DatasetPtr ds = open_dataset(dir, args.get("video"), false, &progress, args.has("skip-bad-frames"));
+  apply_roi(args, ds.get());
   const TrackRun run = track_dataset(ctx.get(), ds.get(), e, o, {args.get("output"), args.get("stats"), args.get("motions-out"), args.has("skip-bad-frames")}, &progress);
   progress.finish();
   std::printf("tracked %s on %s\n", dir.c_str(), device_name(ctx.get()).c_str());

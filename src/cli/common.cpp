@@ -61,6 +61,30 @@ std::string device_name(const planarvo_context* context) {
   return std::string(info.device_name) + " (" + info.platform_name + ")";
 }
 
+OptionSpec roi_option(const char* fallback) {
+  return {"roi", "x,y,w,h", "region of interest: the only pixels used (leave out the horizon, the bumper, the "
+                            "sidewalk); 0,0,0,0 = the whole image", fallback};
+}
+
+std::optional<planarvo_region> parse_roi(const Args& args) {
+  if (!args.has("roi")) return std::nullopt;
+  const std::vector<double> v = args.get_doubles("roi", 4);
+  for (double x : v)
+    if (x != std::floor(x) || x < 0 || x > 1e6)
+      throw UsageError("--roi needs four non-negative integers x,y,width,height, got \"" + args.get("roi") + "\"");
+  const planarvo_region r{static_cast<int32_t>(v[0]), static_cast<int32_t>(v[1]), static_cast<int32_t>(v[2]),
+                          static_cast<int32_t>(v[3])};
+  if ((r.width == 0) != (r.height == 0) || ((r.width == 0) && (r.x != 0 || r.y != 0)))
+    throw UsageError("--roi: give a width and a height, or 0,0,0,0 for the whole image, not \"" + args.get("roi") +
+                     "\"");
+  return r;
+}
+
+void apply_roi(const Args& args, planarvo_dataset* dataset) {
+  const std::optional<planarvo_region> r = parse_roi(args);
+  if (r) check(planarvo_dataset_set_roi(dataset, &*r));
+}
+
 DatasetPtr open_dataset(const std::string& dir, const std::string& video, bool verify, Progress* progress,
                         bool allow_missing) {
   planarvo_dataset_options o;

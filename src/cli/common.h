@@ -2,6 +2,7 @@
 // options every device-using command accepts, and the terminal progress bar.
 #pragma once
 #include <memory>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -55,6 +56,14 @@ struct DatasetDeleter {
   void operator()(planarvo_dataset* d) const { planarvo_dataset_destroy(d); }
 };
 using DatasetPtr = std::unique_ptr<planarvo_dataset, DatasetDeleter>;
+// --roi x,y,width,height: the camera's region of interest (integers; all zero: the whole image).
+OptionSpec roi_option(const char* fallback);
+// Parsed and checked for form (the image size is checked where the camera is known); nullopt
+// without the option.
+std::optional<planarvo_region> parse_roi(const Args& args);
+// Applies --roi, when given, to an open data set's camera.
+void apply_roi(const Args& args, planarvo_dataset* dataset);
+
 // allow_missing: a missing image is found when its frame is read, not at open (--skip-bad-frames).
 DatasetPtr open_dataset(const std::string& dir, const std::string& video, bool verify, Progress* progress,
                         bool allow_missing = false);

@@ -63,6 +63,16 @@ void CameraModel::validate(const char* what) const {
     if (!std::isfinite(v)) throw_invalid_input(where + ": camera parameters contain NaN or inf");
   if (!(fx > 0) || !(fy > 0))
     throw_invalid_input(where + ": focal lengths fx, fy must be positive");
+  if (roi.width != 0 || roi.height != 0) {
+    const std::string r = "region of interest [" + std::to_string(roi.x) + ", " + std::to_string(roi.y) + ", " +
+                          std::to_string(roi.width) + ", " + std::to_string(roi.height) + "] (x, y, width, height)";
+    if (roi.width < kMinRegionSide || roi.height < kMinRegionSide)
+      throw_invalid_input(where + ": the " + r + " must be at least " + std::to_string(kMinRegionSide) +
+                          " pixels on a side");
+    if (roi.x < 0 || roi.y < 0 || roi.width > width - roi.x || roi.height > height - roi.y)
+      throw_invalid_input(where + ": the " + r + " is not inside the " + std::to_string(width) + "x" +
+                          std::to_string(height) + " image");
+  }
 }
 
 }  // namespace planarvo

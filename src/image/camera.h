@@ -6,10 +6,30 @@
 
 namespace planarvo {
 
+// A rectangle of camera-image pixels: columns x .. x + width - 1, rows y .. y + height - 1.
+// Zero width or height: none given (the whole image).
+struct PixelRegion {
+  int x = 0, y = 0, width = 0, height = 0;
+  bool empty() const { return width <= 0 || height <= 0; }
+  bool operator==(const PixelRegion& o) const {
+    return x == o.x && y == o.y && width == o.width && height == o.height;
+  }
+};
+
+// The smallest region of interest a camera may have, pixels per side.
+inline constexpr int kMinRegionSide = 16;
+
 struct CameraModel {
   int width = 0, height = 0;
   double fx = 0, fy = 0, cx = 0, cy = 0;
   double k1 = 0, k2 = 0, p1 = 0, p2 = 0, k3 = 0;
+  // The region of interest: the pixels of the camera image that see the ground the engine may
+  // use (not the horizon, the vehicle's bumper, the sidewalk). Everything the engine computes
+  // from an image treats pixels outside it as having no value, through the undistortion map
+  // (image/undistort.h). Empty: the whole image.
+  PixelRegion roi;
+  // The region of interest, or the whole image when none is given.
+  PixelRegion region() const { return roi.empty() ? PixelRegion{0, 0, width, height} : roi; }
 
   Eigen::Matrix3d K() const;
   bool has_distortion() const { return k1 != 0 || k2 != 0 || p1 != 0 || p2 != 0 || k3 != 0; }
@@ -26,7 +46,8 @@ struct CameraModel {
   Eigen::Vector2d unproject(const Eigen::Vector2d& pixel) const;
 
   // Throws InvalidInput (naming `what`, e.g. the file) when sizes or focal lengths are not
-  // positive or a value is not finite.
+  // positive or a value is not finite, or the region of interest is not inside the image or is
+  // smaller than kMinRegionSide pixels on a side.
   void validate(const char* what) const;
 };
 

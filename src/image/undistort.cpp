@@ -25,7 +25,10 @@ UndistortMap compute_undistort_map(const CameraModel& camera) {
   m.map_x.resize(n);
   m.map_y.resize(n);
   m.valid.resize(n);
-  const float max_x = static_cast<float>(m.width - 1), max_y = static_cast<float>(m.height - 1);
+  // The bilinear footprint must lie inside the region of interest (the whole image by default).
+  const PixelRegion roi = camera.region();
+  const float min_x = static_cast<float>(roi.x), min_y = static_cast<float>(roi.y);
+  const float max_x = static_cast<float>(roi.x + roi.width - 1), max_y = static_cast<float>(roi.y + roi.height - 1);
   for (int v = 0; v < m.height; ++v) {
     const double yn = (v - camera.cy) / camera.fy;
     for (int u = 0; u < m.width; ++u) {
@@ -37,7 +40,7 @@ UndistortMap compute_undistort_map(const CameraModel& camera) {
       m.map_x[i] = sx;
       m.map_y[i] = sy;
       // Judged on the float values the sampler will see (false for NaN).
-      m.valid[i] = (sx >= 0.0f && sx <= max_x && sy >= 0.0f && sy <= max_y) ? 1 : 0;
+      m.valid[i] = (sx >= min_x && sx <= max_x && sy >= min_y && sy <= max_y) ? 1 : 0;
     }
   }
   return m;

@@ -17,8 +17,9 @@ struct UndistortMap {
   // Row-major, width * height each: the source (distorted) pixel coordinate of output pixel
   // (u, v) at index v * width + u.
   std::vector<float> map_x, map_y;
-  // 1 where the source lies inside the image so that bilinear sampling has all four
-  // neighbours: 0 <= map_x <= width - 1 and 0 <= map_y <= height - 1. 0 elsewhere.
+  // 1 where the source lies inside the camera's region of interest (the whole image by
+  // default) so that bilinear sampling has all four neighbours there: x <= map_x <= x + width - 1
+  // and y <= map_y <= y + height - 1 of CameraModel::region(). 0 elsewhere.
   std::vector<uint8_t> valid;
 
   size_t valid_count() const;

@@ -353,6 +353,13 @@ void Dataset::check_index(int64_t i, const char* what) const {
 
 const std::string& Dataset::directory() const { return impl_->directory; }
 const CameraModel& Dataset::camera() const { return impl_->camera; }
+
+void Dataset::set_region_of_interest(const PixelRegion& roi) {
+  CameraModel c = impl_->camera;
+  c.roi = roi;
+  c.validate("the data set's camera");
+  impl_->camera = c;
+}
 bool Dataset::is_video() const { return impl_->video != nullptr; }
 int64_t Dataset::frame_count() const { return static_cast<int64_t>(impl_->frames.size()); }
 const std::vector<FrameEntry>& Dataset::frames() const { return impl_->frames; }

@@ -57,6 +57,9 @@ class Dataset {
 
   const std::string& directory() const;
   const CameraModel& camera() const;
+  // Replaces the camera's region of interest (camera.yaml's region_of_interest; empty: the whole
+  // image). Throws InvalidInput, changing nothing, when it is not inside the image.
+  void set_region_of_interest(const PixelRegion& roi);
   bool is_video() const;
 
   int64_t frame_count() const;  // at least 1

@@ -446,6 +446,16 @@ CameraModel read_camera_yaml(const std::string& path) {
     cam.p1 = d[2];
     cam.p2 = d[3];
     cam.k3 = n >= 5 ? d[4] : 0.0;
+    const cv::FileNode roi = fs["region_of_interest"];
+    if (!roi.empty() && !roi.isNone()) {
+      if (!roi.isSeq() || roi.size() != 4)
+        fail(path, "'region_of_interest' is not a list of four integers [x, y, width, height]");
+      int v[4];
+      for (int i = 0; i < 4; ++i) v[i] = read_int(roi[i], path, "region_of_interest");
+      cam.roi = PixelRegion{v[0], v[1], v[2], v[3]};
+      if (cam.roi.empty())
+        fail(path, "'region_of_interest' has no pixels (width and height must be positive)");
+    }
     cam.validate(path.c_str());
     return cam;
   });
@@ -465,6 +475,8 @@ void write_camera_yaml(const std::string& path, const CameraModel& camera) {
   // 5x1, as calibrateCamera returns it and OpenCV's calibration sample writes it.
   cv::Mat D = (cv::Mat_<double>(5, 1) << camera.k1, camera.k2, camera.p1, camera.p2, camera.k3);
   fs << "distortion_coefficients" << D;
+  if (!camera.roi.empty())
+    fs << "region_of_interest" << "[:" << camera.roi.x << camera.roi.y << camera.roi.width << camera.roi.height << "]";
   write_storage_text(path, fs);
 }
 

@@ -54,9 +54,9 @@ Extrinsics paper_configuration(int k);
 CameraModel default_camera(int width = 640, int height = 480, double fov_deg = 80.0);
 
 // How far the camera sees over the ground: the largest distance, along the ground from the
-// point below the camera, of a border pixel's ray (every pixel along the four edges), in camera
-// heights; +inf when a ray does not meet the ground (the camera sees the horizon). *pixel gets
-// that pixel. validate() refuses a camera that sees farther than kMaxGroundView heights: such
+// point below the camera, of a border pixel's ray (every pixel along the four edges of the
+// camera's region of interest, the whole image by default), in camera heights; +inf when a ray
+// does not meet the ground (the region sees the horizon). *pixel gets that pixel. validate() refuses a camera that sees farther than kMaxGroundView heights: such
 // far field is foreshortened to a few pixels per metre, no floor texture survives it, and a
 // real camera there would see the horizon, walls or the car's own bumper.
 double farthest_ground_view(const CameraModel& camera, const Extrinsics& extrinsics,

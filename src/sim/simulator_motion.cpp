@@ -230,11 +230,14 @@ void validate(const Options& o) {
   const std::string at = "pixel (" + std::to_string(static_cast<int>(px.x())) + ", " +
                          std::to_string(static_cast<int>(px.y())) + ")";
   require(std::isfinite(reach), "the camera sees the horizon (the ray of " + at +
-                                    " does not meet the ground): tilt it down or narrow its field of view");
+                                    " does not meet the ground): tilt it down, narrow its field of view or give a region of "
+                                    "interest that leaves the horizon out");
   char far[160];
   std::snprintf(far, sizeof far, "the camera sees ground %.0f camera heights away (%s), more than %.0f", reach,
                 at.c_str(), kMaxGroundView);
-  require(reach <= kMaxGroundView, std::string(far) + ": tilt it down or narrow its field of view");
+  require(reach <= kMaxGroundView,
+          std::string(far) + ": tilt it down, narrow its field of view or give a region of interest that leaves "
+                             "the far ground out");
   require(std::isfinite(o.start_pose.x) && std::isfinite(o.start_pose.y) &&
               std::isfinite(o.start_pose.theta),
           "start_pose contains NaN or inf");

@@ -14,6 +14,7 @@
 #include "common/test_util.h"
 #include "core/error.h"
 #include "image/pipeline.h"
+#include "image/undistort.h"
 #include "ocl/runtime.h"
 
 namespace planarvo {
@@ -118,6 +119,33 @@ TEST(ImagePipeline, MatchesReferenceAtSizesNotAMultipleOfTheLevels) {
   expect_matches_reference(rt, camera(643, 479, -0.12, 0.03), 4);
   // Pincushion leaves the corners without a source; odd sizes down to a few pixels.
   expect_matches_reference(rt, camera(101, 37, 0.15, 0.02), 5);
+}
+
+// A region of interest: the pipeline still matches its reference, and no pixel of level 0 whose
+// source (in the whole image's undistortion map, computed without the region) lies outside the
+// region is valid, so nothing outside it reaches the tracker.
+TEST(ImagePipeline, NothingOutsideTheRegionOfInterestIsValid) {
+  ocl::Runtime rt;
+  CameraModel cam = camera(320, 240, -0.12, 0.03);
+  const UndistortMap whole = compute_undistort_map(cam);
+  cam.roi = PixelRegion{20, 0, 280, 190};
+  expect_matches_reference(rt, cam, 3);
+  ImagePipeline pipe(rt, cam, 3);
+  Pyramid out;
+  pipe.process(random_frame(cam.width, cam.height, 99), out);
+  const std::vector<cv::Mat> k = download_pyramid(rt, out);
+  size_t valid = 0, outside_valid = 0;
+  for (int v = 0; v < cam.height; ++v)
+    for (int u = 0; u < cam.width; ++u) {
+      const size_t i = static_cast<size_t>(v) * static_cast<size_t>(cam.width) + static_cast<size_t>(u);
+      const bool inside = whole.map_x[i] >= 20.0f && whole.map_x[i] <= 299.0f && whole.map_y[i] >= 0.0f &&
+                          whole.map_y[i] <= 189.0f;
+      const bool is_valid = k[0].at<cv::Vec4f>(v, u)[3] != 0.0f;
+      valid += is_valid;
+      outside_valid += is_valid && !inside;
+    }
+  EXPECT_EQ(outside_valid, 0u);
+  EXPECT_GT(valid, 250u * 130u);
 }
 
 TEST(ImagePipeline, FastRelaxedMathStaysWithinTolerance) {

@@ -14,7 +14,7 @@ namespace {
 
 TEST(CApi, VersionMatchesHeader) {
   EXPECT_EQ(planarvo_version_number(), PLANARVO_VERSION_NUMBER);
-  EXPECT_STREQ(planarvo_version_string(), "0.1.0");
+  EXPECT_STREQ(planarvo_version_string(), "0.2.0");
 }
 
 TEST(CApi, NullArgumentsAreStatusesNotCrashes) {
@@ -243,6 +243,43 @@ TEST(CApiData, SimulatedDatasetReadsBackThroughTheApi) {
   EXPECT_FALSE(f.has_direction);  // frame 0 has no interval before it
   EXPECT_DOUBLE_EQ(f.groundtruth.x, 0.0);
   EXPECT_EQ(planarvo_dataset_frame(d, 6, &img), PLANARVO_ERROR_INVALID_ARGUMENT);
+  planarvo_dataset_destroy(d);
+  planarvo_context_destroy(c);
+}
+
+// The region of interest through the C API: the simulator writes it into camera.yaml, the data
+// set and planarvo_camera_load read it back, planarvo_dataset_set_roi replaces it (and refuses,
+// changing nothing, a region outside the image).
+TEST(CApiData, RegionOfInterestTravelsWithTheCamera) {
+  planarvo_context* c = make_context();
+  ScratchDir dir;
+  planarvo_sim_options o = tiny_sim(planarvo::test::texture("skimage_gravel.png").string());
+  o.camera.roi = planarvo_region{4, 8, 80, 40};
+  ASSERT_EQ(planarvo_simulate(c, &o, dir.path().c_str()), PLANARVO_OK) << planarvo_last_error();
+  planarvo_camera cam{};
+  ASSERT_EQ(planarvo_camera_load((dir.path() / "camera.yaml").c_str(), &cam), PLANARVO_OK) << planarvo_last_error();
+  EXPECT_EQ(cam.roi.x, 4);
+  EXPECT_EQ(cam.roi.y, 8);
+  EXPECT_EQ(cam.roi.width, 80);
+  EXPECT_EQ(cam.roi.height, 40);
+  planarvo_dataset* d = nullptr;
+  ASSERT_EQ(planarvo_dataset_open(dir.path().c_str(), nullptr, &d), PLANARVO_OK) << planarvo_last_error();
+  planarvo_dataset_info info{};
+  info.struct_size = sizeof info;
+  ASSERT_EQ(planarvo_dataset_info_get(d, &info), PLANARVO_OK);
+  EXPECT_EQ(info.camera.roi.width, 80);
+  const planarvo_region outside{50, 8, 80, 40};  // 96 pixels wide: 50 + 80 > 96
+  EXPECT_EQ(planarvo_dataset_set_roi(d, &outside), PLANARVO_ERROR_INVALID_INPUT);
+  ASSERT_EQ(planarvo_dataset_info_get(d, &info), PLANARVO_OK);
+  EXPECT_EQ(info.camera.roi.x, 4);
+  const planarvo_region other{0, 0, 96, 32};
+  ASSERT_EQ(planarvo_dataset_set_roi(d, &other), PLANARVO_OK) << planarvo_last_error();
+  ASSERT_EQ(planarvo_dataset_info_get(d, &info), PLANARVO_OK);
+  EXPECT_EQ(info.camera.roi.height, 32);
+  ASSERT_EQ(planarvo_dataset_set_roi(d, nullptr), PLANARVO_OK);
+  ASSERT_EQ(planarvo_dataset_info_get(d, &info), PLANARVO_OK);
+  EXPECT_EQ(info.camera.roi.width, 0);
+  EXPECT_EQ(planarvo_dataset_set_roi(nullptr, &other), PLANARVO_ERROR_INVALID_ARGUMENT);
   planarvo_dataset_destroy(d);
   planarvo_context_destroy(c);
 }

@@ -199,5 +199,35 @@ TEST(ImageRemapBilinear, RejectsWrongTypeOrSize) {
   EXPECT_THROW(remap_bilinear(cv::Mat(12, 15, CV_8UC1), m), Error);
 }
 
+// The region of interest limits the map's valid pixels to those whose bilinear footprint lies
+// in it. Without distortion the map is the identity, so exactly the region's pixels are valid;
+// with distortion, a pixel is valid when it is in the whole image's map and its source lies in
+// the region, which is checked against the source coordinates directly.
+TEST(UndistortMap, RegionOfInterestLimitsTheValidPixels) {
+  for (const DistortionCase& d : kCases) {
+    SCOPED_TRACE(d.name);
+    CameraModel c = make_camera(d);
+    const UndistortMap whole = compute_undistort_map(c);
+    c.roi = PixelRegion{37, 101, 200, 150};
+    const UndistortMap m = compute_undistort_map(c);
+    size_t valid = 0;
+    for (int v = 0; v < c.height; ++v)
+      for (int u = 0; u < c.width; ++u) {
+        const size_t i = static_cast<size_t>(v) * static_cast<size_t>(c.width) + static_cast<size_t>(u);
+        const float sx = m.map_x[i], sy = m.map_y[i];
+        const bool inside = sx >= 37.0f && sx <= 236.0f && sy >= 101.0f && sy <= 250.0f;
+        ASSERT_EQ(m.valid[i] != 0, inside && whole.valid[i] != 0) << u << "," << v;
+        if (d.k1 == 0.0) {
+          ASSERT_EQ(m.valid[i] != 0, u >= 37 && u <= 236 && v >= 101 && v <= 250) << u << "," << v;
+        }
+        valid += m.valid[i];
+      }
+    EXPECT_GT(valid, 150u * 150u);
+  }
+  CameraModel c = make_camera(kCases[0]);
+  c.roi = PixelRegion{0, 0, 641, 100};
+  EXPECT_THROW(compute_undistort_map(c), Error);
+}
+
 }  // namespace
 }  // namespace planarvo

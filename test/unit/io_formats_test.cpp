@@ -188,6 +188,37 @@ TEST(IoCameraYaml, BadFilesNameTheFile) {
   expect_invalid_input([&] { io::read_camera_yaml(missing); }, missing);
 }
 
+// The region of interest: written when there is one, read back exactly, as a hand would write
+// it, and refused (naming the key or the region) when it is not four integers inside the image.
+TEST(IoCameraYaml, RegionOfInterestRoundTripsAndIsChecked) {
+  ScratchDir dir;
+  CameraModel c = test_camera();
+  c.roi = PixelRegion{8, 100, c.width - 8, 300};
+  const std::string path = (dir / "camera.yaml").string();
+  io::write_camera_yaml(path, c);
+  const CameraModel back = io::read_camera_yaml(path);
+  expect_same_camera(back, c);
+  EXPECT_EQ(back.roi, c.roi);
+  const std::string hand = (dir / "hand.yaml").string();
+  write_text(hand, kGoodCameraYaml + std::string("region_of_interest: [ 0, 120, 640, 360 ]\n"));
+  EXPECT_EQ(io::read_camera_yaml(hand).roi, (PixelRegion{0, 120, 640, 360}));
+  EXPECT_TRUE(io::read_camera_yaml((dir / "camera.yaml").string()).roi == c.roi);
+  const auto bad = [&](const std::string& name, const std::string& roi, const char* says) {
+    SCOPED_TRACE(name);
+    const std::string p = (dir / name).string();
+    write_text(p, kGoodCameraYaml + std::string("region_of_interest: ") + roi + "\n");
+    const std::string msg = expect_invalid_input([&] { io::read_camera_yaml(p); }, p);
+    EXPECT_THAT(msg, HasSubstr(says));
+  };
+  bad("three.yaml", "[ 0, 120, 640 ]", "region_of_interest");
+  bad("fraction.yaml", "[ 0, 120.5, 640, 300 ]", "region_of_interest");
+  bad("outside.yaml", "[ 0, 200, 640, 300 ]", "not inside");
+  bad("negative.yaml", "[ -1, 0, 100, 100 ]", "not inside");
+  bad("tiny.yaml", "[ 0, 0, 8, 100 ]", "at least 16");
+  bad("empty.yaml", "[ 0, 0, 0, 0 ]", "no pixels");
+  bad("scalar.yaml", "7", "region_of_interest");
+}
+
 // ---------------------------------------------------------------------------------------------
 // extrinsics.yaml
 

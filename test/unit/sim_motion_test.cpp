@@ -236,6 +236,42 @@ TEST(SimMotion, RefusesACameraThatSeesTheHorizon) {
   EXPECT_FALSE(std::isfinite(farthest_ground_view(o.camera, o.extrinsics)));
 }
 
+// A region of interest that leaves the horizon out admits a camera that sees it, and how far the
+// camera sees is then the farthest ground any pixel of the region sees (every pixel tried, not
+// only the border the function walks).
+TEST(SimMotion, ARegionOfInterestAdmitsACameraThatSeesTheHorizon) {
+  Options o;
+  o.camera = default_camera(320, 240, 60.0);
+  o.extrinsics = Extrinsics{-1.0, 0.0, 0.9, 0.0, 66.0 * M_PI / 180.0, M_PI};
+  EXPECT_THROW(validate(o), Error);
+  EXPECT_FALSE(farthest_ground_view(o.camera, o.extrinsics) <= kMaxGroundView);
+  int accepted = 0;
+  for (const PixelRegion& roi : {PixelRegion{0, 0, 320, 150}, PixelRegion{0, 90, 320, 150}}) {
+    o.camera.roi = roi;
+    double brute = 0.0;
+    const Eigen::Matrix3d R = o.extrinsics.R_vc();
+    for (int v = roi.y; v < roi.y + roi.height; ++v)
+      for (int u = roi.x; u < roi.x + roi.width; ++u) {
+        const Eigen::Vector2d xn = o.camera.unproject(Eigen::Vector2d(u, v));
+        const Eigen::Vector3d dir = R * Eigen::Vector3d(xn.x(), xn.y(), 1.0);
+        brute = std::max(brute, dir.z() < 0.0 ? std::hypot(dir.x(), dir.y()) / -dir.z() : HUGE_VAL);
+      }
+    const double reach = farthest_ground_view(o.camera, o.extrinsics);
+    if (std::isfinite(brute)) {
+      EXPECT_NEAR(reach, brute, 1e-9 * brute);
+    } else {
+      EXPECT_FALSE(std::isfinite(reach));
+    }
+    if (reach <= kMaxGroundView) {
+      EXPECT_NO_THROW(validate(o));
+      ++accepted;
+    } else {
+      EXPECT_THROW(validate(o), Error);
+    }
+  }
+  EXPECT_EQ(accepted, 1) << "one of the two halves sees the near ground only";
+}
+
 // The wheel travel recovered from the odometry poses has an unbiased relative error of the
 // requested size, and the odometry itself moves along arcs (it is a differential drive too).
 TEST(SimMotion, OdometryErrorIsZeroMeanAndOfTheRequestedSize) {

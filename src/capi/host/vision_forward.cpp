@@ -110,6 +110,11 @@ PLANARVO_API planarvo_status planarvo_dataset_info_get(const planarvo_dataset* d
   return fn ? fn(dataset, info) : PLANARVO_ERROR_INTERNAL;
 }
 
+PLANARVO_API planarvo_status planarvo_dataset_set_roi(planarvo_dataset* dataset, const planarvo_region* roi) {
+  PLANARVO_FORWARD(planarvo_dataset_set_roi);
+  return fn ? fn(dataset, roi) : PLANARVO_ERROR_INTERNAL;
+}
+
 PLANARVO_API planarvo_status planarvo_dataset_frame_data(const planarvo_dataset* dataset, int64_t index, planarvo_frame_data* data) {
   PLANARVO_FORWARD(planarvo_dataset_frame_data);
   return fn ? fn(dataset, index, data) : PLANARVO_ERROR_INTERNAL;
