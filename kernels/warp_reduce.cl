@@ -27,8 +27,16 @@
 //
 // Build options (-D): NPARAM (3), WG_X (16), WG_Y (1), PIX (8), STATS (0: 1 adds the
 // statistics below, a histogram of HIST_BINS (16) bins of |r| and J^T J over the inliers),
-// DEBUG_OUTPUT (off: when defined, a last argument receives per reference pixel
-// (r, weight, valid, rho); not for the fast path).
+// SELECT (0: see below), DEBUG_OUTPUT (off: when defined, a last argument receives per
+// reference pixel (r, weight, valid, rho); not for the fast path).
+//
+// With SELECT = 1 the reference is not a level but its subsampled pixels
+// (kernels/select_pixels.cl) and an argument select_block = B follows huber_k: a grid of
+// ref_w x ref_h entries, one per B x B block of the level, each (I_r, dI_r/du, dI_r/dv, code) of
+// the block's pixel, code = 1 + oy B + ox for the pixel (bx B + ox, by B + oy) of block (bx, by),
+// 0 for none. Everything above then applies to that pixel; the work distribution, the partials
+// and the clusters are those of the grid. B is an argument, not a build option, so that one
+// program serves every block size.
 #ifndef NPARAM
 #define NPARAM 3
 #endif
@@ -46,6 +54,9 @@
 #endif
 #ifndef HIST_BINS
 #define HIST_BINS 16
+#endif
+#ifndef SELECT
+#define SELECT 0
 #endif
 
 #if (WG_X * WG_Y) & (WG_X * WG_Y - 1)
@@ -90,6 +101,9 @@ void warp_reduce(__global const float4* ref, const int ref_stride, const int ref
                  const int live_w, const int live_h,
                  __constant float* params,  // H (9, row-major), then G_0 .. G_{NPARAM-1} (9 each)
                  const float gain, const float bias, const float huber_k,
+#if SELECT
+                 const int select_block,
+#endif
                  __global float* partials
 #ifdef DEBUG_OUTPUT
                  , __global float4* debug
@@ -112,7 +126,6 @@ void warp_reduce(__global const float4* ref, const int ref_stride, const int ref
   const float h0 = params[0], h1 = params[1], h2 = params[2];
   const float h3 = params[3], h4 = params[4], h5 = params[5];
   const float h6 = params[6], h7 = params[7], h8 = params[8];
-  const float fv = (float)y;
 
 #pragma unroll
   for (int k = 0; k < PIX; ++k) {
@@ -120,8 +133,18 @@ void warp_reduce(__global const float4* ref, const int ref_stride, const int ref
     const int in_ref = (x < ref_w) & (y < ref_h);
     const int ri = in_ref ? 4 * (y * ref_stride + x) : 0;
     const float rI = refp[ri], rGu = refp[ri + 1], rGv = refp[ri + 2];
+#if SELECT
+    // The block's pixel (its code is a small integer, exact in float).
+    const int code = in_ref ? (int)refp[ri + 3] : 0;
+    const float mref = code > 0 ? 1.0f : 0.0f;
+    const int off = code > 0 ? code - 1 : 0;
+    const float fu = (float)(x * select_block + off % select_block);
+    const float fv = (float)(y * select_block + off / select_block);
+#else
     const float mref = in_ref ? refp[ri + 3] : 0.0f;
     const float fu = (float)x;
+    const float fv = (float)y;
+#endif
 
     // Warp (eq. 5): q = H p.
     const float qx = h0 * fu + h1 * fv + h2;

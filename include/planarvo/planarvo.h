@@ -416,6 +416,11 @@ typedef struct planarvo_tracker_options {
   int32_t max_iterations;     /* cap on alignment steps per level; 0 = the per-level defaults */
   double keyframe_overlap;    /* a new keyframe when the overlap falls below this; default 0.7 */
   int32_t estimate_brightness;/* non-zero: estimate gain and offset per frame; default 1 */
+  /* With finest_level 0: align full resolution on one pixel per B x B block only (a jittered
+   * grid chosen per keyframe), solved together with the half-resolution level's estimate, for
+   * full-resolution accuracy at a fraction of its cost. 0 or 1: every pixel (default 0); 2..8.
+   * Read only when struct_size covers it. */
+  int32_t level0_subsample;
 } planarvo_tracker_options;
 
 typedef enum planarvo_track_status {

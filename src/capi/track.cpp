@@ -88,6 +88,11 @@ planarvo::track::TrackerOptions tracker_options_from_c(const planarvo_tracker_op
       for (int& n : o.max_iterations) n = std::min(n, static_cast<int>(options->max_iterations));
     o.keyframe_overlap = options->keyframe_overlap;
     o.estimate_brightness = options->estimate_brightness != 0;
+    if (options->struct_size >= offsetof(planarvo_tracker_options, level0_subsample) + sizeof(int32_t)) {
+      require(options->level0_subsample >= 0 && options->level0_subsample <= 8,
+              "planarvo_tracker_options.level0_subsample must be 0..8");
+      o.select_blocks[0] = options->level0_subsample >= 2 ? options->level0_subsample : 0;
+    }
   }
   return o;
 }

@@ -47,6 +47,13 @@ const bool kDefaultVariantsRegistered = [] {
       ocl::Runtime::register_build_options(
           "warp_reduce", WarpReduce::build_options(nparam, kernel_options(AlignerOptions(), stats)), uses);
   }
+  // The tracker's pass over a subsampled level (planarvo_tracker_options.level0_subsample; one
+  // program for every block size).
+  for (bool stats : {false, true}) {
+    WarpReduceOptions k = kernel_options(AlignerOptions(), stats);
+    k.select_block = 2;
+    ocl::Runtime::register_build_options("warp_reduce", WarpReduce::build_options(kMotionParams, k), {ocl::kUseTrack});
+  }
   return true;
 }();
 
@@ -104,11 +111,22 @@ void damp(M* A, int n, double lambda) {
 
 Aligner::Aligner(ocl::Runtime& runtime, const Eigen::Matrix3d& K, const AlignerOptions& options,
                  bool with_orientation)
-    : K_(K), options_(options), with_orientation_(with_orientation),
+    : K_(K), options_(options), with_orientation_(with_orientation), runtime_(runtime),
       pass_(runtime, with_orientation ? kMotionParams + kOrientationParams : kMotionParams,
             kernel_options(options, false)),
       stats_pass_(runtime, with_orientation ? kMotionParams + kOrientationParams : kMotionParams,
-                  kernel_options(options, true)) {}
+                  kernel_options(options, true)) {
+  // The selected-pixel passes the options ask for, built now rather than at the first frame
+  // that reaches their level.
+  for (int b : options.select_blocks)
+    if (b >= 2 && !select_passes_[b][0])
+      for (int st : {0, 1}) {
+        WarpReduceOptions k = kernel_options(options, st == 1);
+        k.select_block = b;
+        select_passes_[b][static_cast<size_t>(st)] = std::make_unique<WarpReduce>(
+            runtime, with_orientation ? kMotionParams + kOrientationParams : kMotionParams, k);
+      }
+}
 
 AlignmentLevels Aligner::levels(const Pyramid& reference, const Pyramid& live) const {
   AlignmentLevels r;
@@ -151,7 +169,32 @@ void Aligner::evaluate(const AlignmentPair& pair, const Extrinsics& e, int level
   in.gain = std::exp(pair.log_gain);
   in.bias = pair.bias;
   in.huber_k = options_.huber_factor * pair.sigma[static_cast<size_t>(level)];
-  (stats ? stats_pass_ : pass_).run(R.data, R.width, R.height, L.data, L.width, L.height, in, out);
+  const SelectedPixels* sel = selection_at(pair, level);
+  if (!sel) {
+    (stats ? stats_pass_ : pass_).run(R.data, R.width, R.height, L.data, L.width, L.height, in, out);
+    return;
+  }
+  std::array<std::unique_ptr<WarpReduce>, 2>& passes = select_passes_[sel->block];
+  if (!passes[0])
+    for (int st : {0, 1}) {
+      WarpReduceOptions k = kernel_options(options_, st == 1);
+      k.select_block = sel->block;
+      passes[static_cast<size_t>(st)] = std::make_unique<WarpReduce>(runtime_, mh.nparam, k);
+    }
+  passes[stats ? 1 : 0]->run(sel->data, sel->grid_w, sel->grid_h, L.data, L.width, L.height, in, out);
+}
+
+const SelectedPixels* Aligner::selection_at(const AlignmentPair& pair, int level) {
+  if (!pair.selection) return nullptr;
+  const SelectedPixels& sel = (*pair.selection)[static_cast<size_t>(level)];
+  return sel.level == level && sel.block >= 2 ? &sel : nullptr;
+}
+
+double Aligner::reference_size(const AlignmentPair& pair, int level) {
+  const SelectedPixels* sel = selection_at(pair, level);
+  if (sel) return static_cast<double>(sel->grid_w) * sel->grid_h;
+  const PyramidLevel& R = pair.reference->levels[static_cast<size_t>(level)];
+  return static_cast<double>(R.width) * R.height;
 }
 
 // The damped Gauss-Newton step of the whole system: each pair's own block eliminated onto the
@@ -230,6 +273,7 @@ AlignmentReport Aligner::align(std::vector<AlignmentPair>& pairs, Extrinsics* ex
   for (AlignmentPair& pair : pairs)
     for (double& s : pair.sigma)
       if (!(s > 0.0)) s = options_.initial_sigma;
+  have_prev_ = false;
 
   for (int level = levels.coarsest; level >= levels.finest; --level) {
     ++report.levels_used;
@@ -239,10 +283,9 @@ AlignmentReport Aligner::align(std::vector<AlignmentPair>& pairs, Extrinsics* ex
     int& passes = report.passes[L];
     for (size_t p = 0; p < P; ++p) {
       AlignmentPair& pair = pairs[p];
-      const PyramidLevel& R = pair.reference->levels[L];
       evaluate(pair, ext, level, true, &cur_[p]);
       ++passes;
-      if (!(cur_[p].valid >= options_.min_valid_fraction * R.width * R.height)) return fail(kAlignFewValid, p);
+      if (!(cur_[p].valid >= options_.min_valid_fraction * reference_size(pair, level))) return fail(kAlignFewValid, p);
       if (!(cur_[p].glive >= options_.min_texture_ratio * cur_[p].gref)) return fail(kAlignNoLiveTexture, p);
       // The level's robust scale from this pass's residuals. The threshold in use came with the
       // pair (a tracker's previous frame); when the scale has moved by more than rescale_ratio
@@ -261,6 +304,37 @@ AlignmentReport Aligner::align(std::vector<AlignmentPair>& pairs, Extrinsics* ex
       report.finest_stats = cur_;
       report.finest_sigma = measured;
     }
+    if (level == std::max(levels.finest, std::min(1, levels.coarsest))) report.match_stats = cur_;
+    // A subsampled level is solved together with what the level before it found: that level's
+    // estimate as a Gaussian prior with its J^T W J (in this level's noise units, (sigma_here /
+    // sigma_there)^2), so that the subsample adds the fine texture's information to the coarser
+    // level's instead of replacing it.
+    const bool with_prior = options_.subsample_prior && have_prev_ && !with_orientation_;
+    std::vector<bool> prior_on(P, false);
+    auto apply_prior = [&](size_t p, const AlignmentPair& state, ReduceSums* sums) {
+      if (!prior_on[p]) return;
+      const int nl = local_size();
+      const int np = sums->JtWr.size() - 2;
+      const int idx[5] = {0, 1, 2, np, np + 1};
+      Vector5d e = Vector5d::Zero();
+      e.head<3>() = (prev_state_[p].motion.inverse() * state.motion).log();
+      e(3) = state.log_gain - prev_state_[p].log_gain;
+      e(4) = state.bias - prev_state_[p].bias;
+      const double scale = std::pow(measured[p] / prev_sigma_[p], 2);
+      const PairBlock b = pair_block(prev_sums_[p], nl, false);
+      const MatrixL H = scale * b.A_ll.topLeftCorner(nl, nl);
+      const VectorL He = H * e.head(nl);
+      for (int i = 0; i < nl; ++i) {
+        for (int j = 0; j < nl; ++j) sums->JtWJ(idx[i], idx[j]) += H(i, j);
+        sums->JtWr(idx[i]) += He(i);
+      }
+      sums->cost += 0.5 * e.head(nl).dot(He);
+    };
+    if (with_prior)
+      for (size_t p = 0; p < P; ++p) {
+        prior_on[p] = selection_at(pairs[p], level) != nullptr && prev_sigma_[p] > 0.0;
+        apply_prior(p, pairs[p], &cur_[p]);
+      }
 
     double lambda = 0.0;
     int steps = 0;
@@ -301,9 +375,9 @@ AlignmentReport Aligner::align(std::vector<AlignmentPair>& pairs, Extrinsics* ex
       bool valid = true;
       for (size_t p = 0; p < P; ++p) {
         evaluate(cand[p], cand_ext, level, false, &next_[p]);
+        apply_prior(p, cand[p], &next_[p]);
         ++passes;
-        const PyramidLevel& R = pairs[p].reference->levels[L];
-        valid = valid && next_[p].valid >= options_.min_valid_fraction * R.width * R.height;
+        valid = valid && next_[p].valid >= options_.min_valid_fraction * reference_size(pairs[p], level);
       }
       if (valid && mean_cost(next_) <= mean_cost(cur_)) {
         std::copy(cand.begin(), cand.end(), pairs.begin());  // elements, not buffers: callers keep references
@@ -315,6 +389,10 @@ AlignmentReport Aligner::align(std::vector<AlignmentPair>& pairs, Extrinsics* ex
       }
     }
     for (size_t p = 0; p < P; ++p) pairs[p].sigma[L] = measured[p];
+    prev_sums_ = cur_;
+    prev_state_ = pairs;
+    prev_sigma_ = measured;
+    have_prev_ = true;
     report.level_ms[L] =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - level_start).count();
     for (size_t p = 0; p < P; ++p)

@@ -12,13 +12,17 @@
 // robust cost; robust scale per pair and level from the STATS pass's histogram.
 #pragma once
 #include <array>
+#include <map>
 #include <vector>
 
 #include <Eigen/Core>
 
 #include "core/extrinsics.h"
 #include "core/se2.h"
+#include <memory>
+
 #include "image/pyramid.h"
+#include "track/pixel_selection.h"
 #include "track/warp_reduce.h"
 
 namespace planarvo::ocl {
@@ -54,6 +58,11 @@ struct AlignerOptions {
   double huber_factor = 2.0;
   double initial_sigma = 8.0, min_sigma = 0.5, max_sigma = 40.0;  // grey levels
   double rescale_ratio = 1.25;
+  // Subsampled levels (pixel_selection.h): at level l with select_blocks[l] = B >= 2, a tracker
+  // aligns one pixel per B x B block of its keyframe's level (a jittered grid, chosen once per
+  // keyframe); 0 or 1: every pixel of the level.
+  std::array<int, kMaxLevels> select_blocks = {0, 0, 0, 0, 0, 0, 0, 0};
+  bool subsample_prior = true;
   // Estimate the affine brightness change (r = e^a I_l + b - I_r) jointly with the motion.
   bool estimate_brightness = true;
   // Levenberg damping: H + lambda diag(H); lambda starts at 0 (Gauss-Newton) and grows by
@@ -74,6 +83,9 @@ struct AlignerOptions {
 struct AlignmentPair {
   const Pyramid* reference = nullptr;
   const Pyramid* live = nullptr;
+  // The reference's selected pixels per level (pixel_selection.h), which stand for the
+  // reference at their level; nullptr, or an entry whose level is -1: every pixel of that level.
+  const std::array<SelectedPixels, kMaxLevels>* selection = nullptr;
   SE2 motion;
   double log_gain = 0.0, bias = 0.0;
   // The robust scale per level (grey levels): brought in (a tracker keeps it from frame to
@@ -96,6 +108,10 @@ struct AlignmentReport {
   // the covariance), the STATS pass that opened the level, and the robust scale measured there.
   std::vector<ReduceSums> finest;
   std::vector<ReduceSums> finest_stats;
+  // Per pair, the STATS pass that opened the finest level at half resolution or coarser (the
+  // finest level itself when that is level 1 or coarser, or the only level): where pixel noise
+  // does not yet mask the texture, so a residual measured there says whether the images match.
+  std::vector<ReduceSums> match_stats;
   std::vector<double> finest_sigma;
   // With the orientation: its information (Schur complement of the whole system at the finest
   // level, undamped, unscaled: J^T W J in grey levels^-2 units) and sum of w r^2 and valid pixels
@@ -157,11 +173,22 @@ class Aligner {
 
  private:
   void evaluate(const AlignmentPair& pair, const Extrinsics& e, int level, bool stats, ReduceSums* out);
+  // The reference's size at `level` as the pass sees it: the level's pixels, or its selection's grid.
+  static double reference_size(const AlignmentPair& pair, int level);
 
   Eigen::Matrix3d K_;
   AlignerOptions options_;
   bool with_orientation_;
+  ocl::Runtime& runtime_;
   WarpReduce pass_, stats_pass_;
+  // The passes over selected pixels (plain, STATS) per block size, made when first needed.
+  std::map<int, std::array<std::unique_ptr<WarpReduce>, 2>> select_passes_;
+  static const SelectedPixels* selection_at(const AlignmentPair& pair, int level);
+  // The level just aligned: its last sums, the pairs' estimates and robust scales.
+  std::vector<ReduceSums> prev_sums_;
+  std::vector<AlignmentPair> prev_state_;
+  std::vector<double> prev_sigma_;
+  bool have_prev_ = false;
   std::vector<ReduceSums> cur_, next_;
   std::vector<AlignmentPair> cand_;
   std::vector<double> measured_;

@@ -57,6 +57,9 @@ CameraModel validated(const CameraModel& c, const Extrinsics& e, const TrackerOp
   if (o.levels < 1 || o.levels > kMaxLevels)
     throw_invalid_argument("TrackerOptions::levels must be 1.." + std::to_string(kMaxLevels));
   if (!(e.z > 0.0)) throw_invalid_argument("Tracker: the camera height z must be positive");
+  for (int b : o.select_blocks)
+    if (b < 0 || b > 16) throw_invalid_argument("TrackerOptions::select_blocks must be 0..16");
+
   if (!(o.covariance_step_fraction >= 0.0))
     throw_invalid_argument("the tracker's covariance step fraction must be 0 or more");
   if (!(o.consecutive_alignment_correlation >= 0.0 && o.consecutive_alignment_correlation <= 0.5))
@@ -91,6 +94,9 @@ struct Tracker::Impl {
 
   Pyramid keyframe;
   bool has_keyframe = false;
+  // The keyframe's selected pixels per level (AlignerOptions::select_blocks).
+  PixelSelector selector;
+  std::array<SelectedPixels, kMaxLevels> selection;
   // The camera-frame path: the pipeline and two pyramids, one the keyframe's (aliased by
   // `keyframe`), the other filled with each live frame.
   std::unique_ptr<ImagePipeline> pipeline;
@@ -110,7 +116,7 @@ struct Tracker::Impl {
   AlignmentReport report;
 
   Impl(ocl::Runtime& r, const CameraModel& c, const Extrinsics& e, const TrackerOptions& o)
-      : rt(r), camera(validated(c, e, o)), ext(e), opt(o), aligner(r, c.K(), o, false) {
+      : rt(r), camera(validated(c, e, o)), ext(e), opt(o), aligner(r, c.K(), o, false), selector(r) {
     reset();
   }
 
@@ -133,6 +139,7 @@ struct Tracker::Impl {
     AlignmentPair& pair = pairs[0];
     pair.reference = &keyframe;
     pair.live = &live;
+    pair.selection = &selection;
     pair.motion = init.T;
     pair.log_gain = init.a;
     pair.bias = init.b;
@@ -234,7 +241,9 @@ struct Tracker::Impl {
     res->alignment_covariance = alignment_covariance(s, report.finest_stats[0], n, floor_s2, A, ldlt);
     if (!res->alignment_covariance.allFinite()) res->alignment_covariance = lost_covariance();
 
-    const ReduceSums& st = report.finest_stats[0];
+    // The images' match from the half-resolution level (or the finest, when coarser): at full
+    // resolution a noisy, weakly textured view's residual is mostly pixel noise.
+    const ReduceSums& st = report.match_stats[0];
     const double var_ref = st.valid > 0 ? st.iref2 / st.valid - std::pow(st.iref / st.valid, 2) : 0.0;
     const double ratio = st.valid > 0 && var_ref > 0 ? (st.rr / st.valid) / var_ref : HUGE_VAL;
     if (!(ratio <= opt.lost_residual_ratio)) {
@@ -280,6 +289,11 @@ struct Tracker::Impl {
         }
         rt.queue().enqueueCopyBuffer(src.data, dst.data, 0, 0, bytes);
       }
+    }
+    for (int l = 0; l < keyframe.num_levels() && l < kMaxLevels; ++l) {
+      const auto L = static_cast<size_t>(l);
+      if (opt.select_blocks[L] >= 2)
+        selector.run(keyframe.levels[L], l, opt.select_blocks[L], &selection[L]);
     }
     has_keyframe = true;
     prev = Estimate();

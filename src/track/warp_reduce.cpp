@@ -155,7 +155,14 @@ ReduceSums warp_reduce_reference(const LevelView& ref, const LevelView& live,
       const float* R = at(ref, x, y);
       if (R[3] == 0.0f) continue;
       row[static_cast<size_t>(L.ref())] += 1.0;
-      const float fu = static_cast<float>(x), fv = static_cast<float>(y);
+      // The pixel: this one, or the block's chosen one (its code, kernels/select_pixels.cl).
+      int px = x, py = y;
+      if (o.select_block > 0) {
+        const int off = static_cast<int>(R[3]) - 1;
+        px = x * o.select_block + off % o.select_block;
+        py = y * o.select_block + off / o.select_block;
+      }
+      const float fu = static_cast<float>(px), fv = static_cast<float>(py);
       // The warp in float, in the kernel's order.
       const float qx = h[0] * fu + h[1] * fv + h[2];
       const float qy = h[3] * fu + h[4] * fv + h[5];
@@ -182,7 +189,7 @@ ReduceSums warp_reduce_reference(const LevelView& ref, const LevelView& live,
       const double d10 = dz * (h[3] - wv * h[6]), d11 = dz * (h[4] - wv * h[7]);
       const double gu = 0.5 * (R[1] + gain * (Ls[1] * d00 + Ls[2] * d10));
       const double gv = 0.5 * (R[2] + gain * (Ls[1] * d01 + Ls[2] * d11));
-      const double u = x, v = y;
+      const double u = px, v = py;
       for (int i = 0; i < L.nparam; ++i) {
         const Eigen::Matrix3d& G = in.G[static_cast<size_t>(i)];
         const double mx = G(0, 0) * u + G(0, 1) * v + G(0, 2);
@@ -238,6 +245,7 @@ std::string WarpReduce::build_options(int nparam, const WarpReduceOptions& o) {
   s << "-D NPARAM=" << nparam << " -D WG_X=" << o.wg_x << " -D WG_Y=" << o.wg_y
     << " -D PIX=" << o.pixels_per_item;
   if (o.stats) s << " -D STATS=1 -D HIST_BINS=" << o.hist_bins;
+  if (o.select_block > 0) s << " -D SELECT=1";  // the block size is an argument
   if (o.debug_output) s << " -D DEBUG_OUTPUT";
   if (o.fast_math) s << " -cl-fast-relaxed-math";
   return s.str();
@@ -252,6 +260,8 @@ WarpReduce::WarpReduce(ocl::Runtime& runtime, int nparam, const WarpReduceOption
     throw_invalid_argument("WarpReduce: the work-group size wg_x * wg_y must be a power of two");
   if (options.pixels_per_item < 1 || options.pixels_per_item > 64)
     throw_invalid_argument("WarpReduce: pixels_per_item must be 1..64");
+  if (options.select_block < 0 || options.select_block > 64)
+    throw_invalid_argument("WarpReduce: select_block must be 0..64");
   if (options.hist_bins < 0 || options.hist_bins > kMaxHistBins)
     throw_invalid_argument("WarpReduce: hist_bins must be 0.." + std::to_string(kMaxHistBins));
   layout_.nparam = nparam;
@@ -306,6 +316,7 @@ void WarpReduce::run(const cl::Buffer& ref, int ref_w, int ref_h, const cl::Buff
   kernel_.setArg(a++, static_cast<float>(in.gain));
   kernel_.setArg(a++, static_cast<float>(in.bias));
   kernel_.setArg(a++, static_cast<float>(in.huber_k));
+  if (options_.select_block > 0) kernel_.setArg(a++, static_cast<cl_int>(options_.select_block));
   kernel_.setArg(a++, partials_);
   if (debug) kernel_.setArg(a++, *debug);
   q.enqueueNDRangeKernel(kernel_, cl::NullRange, cl::NDRange(groups_x * wx, groups_y * wy),

@@ -132,6 +132,10 @@ struct WarpReduceOptions {
   int hist_bins = 16;        // and a histogram of |r| for the robust scale (with stats only)
   bool fast_math = false;    // -cl-fast-relaxed-math (no faster on PoCL: src/track/README.md)
   bool debug_output = false; // per-pixel (r, weight, valid, rho) into a debug buffer
+  // 0: the reference is a level; B > 0: it is a level's subsampled pixels, one per B x B block
+  // (pixel_selection.h), and ref_w x ref_h is their grid's size (the SELECT variant, one
+  // program for every B, which is its argument).
+  int select_block = 0;
   // The clusters of ReduceSums::score_outer: whole work-groups, as many side by side as come
   // nearest cluster_width pixels, and as many rows of them as come nearest 1 / cluster_bands of
   // the level's height (a fixed share of the view, so a fixed patch of ground at every level and

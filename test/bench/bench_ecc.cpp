@@ -4,6 +4,7 @@
 //   bench_ecc [key=value...]
 //     textures=a.png,b.png|all (asphalt_01.png)  seconds=20  w=640 h=480  seed=1
 //     pairs=60 (spread evenly over the sequence)  levels=3 (ECC's pyramid)  finest=N (the tracker's)
+//     select=B (the tracker's level 0 on one pixel per B x B block)  prior=0|1
 //     the scene: config=1|2|3 or ext=x,y,z,roll,pitch,yaw (m, deg), fov=deg,
 //     motion=mixed|straight|circle|spin|car, speed=m/s, turn=rad/s, radius=m, noise=grey levels
 //
@@ -188,6 +189,8 @@ int main(int argc, char** argv) {
     else if (k == "pairs") pairs = std::max(1, std::atoi(v.c_str()));
     else if (k == "levels") levels = std::max(1, std::atoi(v.c_str()));
     else if (k == "finest") topt.finest_level = std::atoi(v.c_str());
+    else if (k == "select") topt.select_blocks[0] = std::atoi(v.c_str());  // level 0 at 1 / select^2
+    else if (k == "prior") topt.subsample_prior = std::atoi(v.c_str()) != 0;
     else {
       std::fprintf(stderr, "unknown option %s (see the comment at the top of bench_ecc.cpp)\n", a.c_str());
       return 2;

@@ -9,7 +9,9 @@
 //        config=1|2|3 (the paper's camera configurations), perturb=1 (the tracker gets extrinsics
 //        off by +10,-10,+10 mm and +2.5,-2.5,+2.5 deg), ext=x,y,z,roll,pitch,yaw (m, deg; instead
 //        of config), fov=deg, motion=...|car, speed=m/s, turn=rad/s, radius=m (car), noise=grey
-//        levels; see main())
+//        levels, select=B0,B1,.. (level l on one pixel per Bl x Bl block), prior=0|1 (a
+//        subsampled level joined with the level before it); BENCH_VERBOSE=1 adds per-level
+//        times, the slowest frames and the frames not tracked ok; see main())
 //   bench_track nees [key=value...]         NEES of the covariances (alignment and frame-to-frame
 //       motion) and the lag-1 correlation of the errors per texture x configuration x size x
 //       finest level (seconds=5, seed=1, textures=..|all, configs=1,2,3, sizes=640x480,320x240,
@@ -18,6 +20,7 @@
 //       BENCH_NEES_CSV=file also writes one row per frame tracked ok
 // (OpenCV's findTransformECC against the tracker on the same pairs: bench_ecc.)
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <chrono>
 #include <cstdio>
@@ -159,6 +162,7 @@ struct SequenceReport {
   track::MotionAccuracy acc;
   double ms_frame = 0, ms_pipeline = 0, cpu_frame = 0;
   std::vector<double> ms;  // per frame after the first (which builds the programs and the first keyframe)
+  std::vector<std::array<double, 5>> slow;  // verbose: (ms, frame, keyframe, passes, pipeline ms) per frame
   double passes[kMaxLevelsBench] = {};
   double level_ms[kMaxLevelsBench] = {};
   double std_pos_median = 0, std_pos_max = 0, std_head_median = 0, nees = 0, aniso_max = 0;
@@ -184,6 +188,12 @@ SequenceReport run_sequence(ocl::Runtime& rt, const sim::Options& so, const trac
     rep.cpu_frame += cpu_ms() - c0;
     rep.ms_frame += r.ms;
     if (k > 0) rep.ms.push_back(r.ms);
+    if (verbose && k > 0) {
+      int np = 0;
+      for (int l = 0; l < kMaxLevelsBench; ++l) np += r.iterations[static_cast<size_t>(l)];
+      rep.slow.push_back({r.ms, static_cast<double>(k), static_cast<double>(r.keyframe), static_cast<double>(np),
+                          r.pipeline_ms});
+    }
     rep.ms_pipeline += r.pipeline_ms;
     ++rep.frames;
     rep.keyframes += r.keyframe;
@@ -258,6 +268,17 @@ int bench_accuracy(const std::vector<std::string>& textures, double seconds, int
       std::printf("  covariance: position std median %.2g m (max %.2g), heading std median %.2g rad; "
                   "mean NEES %.1f (3 if calibrated); largest std ratio of the position axes %.1f\n", r.std_pos_median,
                   r.std_pos_max, r.std_head_median, r.nees, r.aniso_max);
+    if (verbose) {
+      std::vector<std::array<double, 5>> slow = r.slow;
+      std::sort(slow.begin(), slow.end(), [](const auto& a, const auto& b) { return a[0] > b[0]; });
+      std::printf("  slowest frames (ms, frame, keyframe, passes, pipeline ms):");
+      for (size_t i = 0; i < slow.size() && i < 6; ++i)
+        std::printf(" (%.2f %.0f %.0f %.0f %.2f)", slow[i][0], slow[i][1], slow[i][2], slow[i][3], slow[i][4]);
+      std::printf("\n");
+      std::printf("  mean ms per level, coarse to fine:");
+      for (int l = topt.levels - 1; l >= 0; --l) std::printf(" %.2f", r.level_ms[l] / n);
+      std::printf("\n");
+    }
     std::fflush(stdout);
   }
   return 0;
@@ -466,6 +487,11 @@ int bench_speed(int width, int height, double seconds, int rounds) {
     configs.push_back({"default (finest auto)", o});
     o.finest_level = 0;
     configs.push_back({"finest level 0", o});
+    o.select_blocks[0] = 4;
+    configs.push_back({"level 0 at 1/16 + prior", o});
+    o.select_blocks[0] = 2;
+    configs.push_back({"level 0 at 1/4 + prior", o});
+    o.select_blocks[0] = 0;
     o.finest_level = -1;
     o.refine_keyframes = true;
     configs.push_back({"auto + refine keyframes", o});
@@ -549,6 +575,11 @@ int main(int argc, char** argv) {
       else if (k == "levels") topt.levels = std::atoi(v.c_str());
       else if (k == "finest") topt.finest_level = std::atoi(v.c_str());
       else if (k == "refine_kf") topt.refine_keyframes = std::atoi(v.c_str()) != 0;
+      else if (k == "select") {  // per level, finest first: select=4,2
+        const auto b = split(v);
+        for (size_t l = 0; l < b.size() && l < topt.select_blocks.size(); ++l) topt.select_blocks[l] = std::atoi(b[l].c_str());
+      }
+      else if (k == "prior") topt.subsample_prior = std::atoi(v.c_str()) != 0;
       else if (k == "conv") topt.convergence_px = std::atof(v.c_str());
       else if (k == "huber") topt.huber_factor = std::atof(v.c_str());
       else if (k == "overlap") topt.keyframe_overlap = std::atof(v.c_str());
@@ -582,6 +613,7 @@ int main(int argc, char** argv) {
       if (k == "seconds") seconds = std::atof(v.c_str());
       else if (k == "seed") seed = std::strtoull(v.c_str(), nullptr, 10);
       else if (k == "noise") noise = std::atof(v.c_str());
+      else if (k == "prior") topt.subsample_prior = std::atoi(v.c_str()) != 0;
       else if (k == "conv") topt.convergence_px = std::atof(v.c_str());
       else if (k == "huber") topt.huber_factor = std::atof(v.c_str());
       else if (k == "brightness") topt.estimate_brightness = std::atoi(v.c_str()) != 0;

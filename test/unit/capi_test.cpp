@@ -1,6 +1,7 @@
 // The C API's contract: statuses and messages instead of exceptions, NULL safety, struct_size
 // checks, thread-local error messages, buffer sizing.
 #include <cmath>
+#include <cstddef>
 #include <cstring>
 #include <string>
 #include <thread>
@@ -374,6 +375,47 @@ TEST(CApiTracker, TracksFramesWithStatusesNotErrors) {
 
   planarvo_tracker_destroy(t);
   planarvo_dataset_destroy(d);
+  planarvo_context_destroy(c);
+}
+
+// level0_subsample: checked when struct_size covers it, not read when it does not (a caller
+// built against 0.1's struct), and a subsampling tracker tracks.
+TEST(CApiTracker, Level0SubsampleIsCheckedOnlyWhenTheStructHasIt) {
+  planarvo_context* c = make_context();
+  ScratchDir dir;
+  planarvo_sim_options so = tiny_sim(planarvo::test::texture("skimage_gravel.png").string());
+  ASSERT_EQ(planarvo_simulate(c, &so, dir.path().c_str()), PLANARVO_OK) << planarvo_last_error();
+  planarvo_tracker_options o;
+  planarvo_tracker_options_init(&o);
+  EXPECT_EQ(o.level0_subsample, 0);
+  o.finest_level = 0;
+  o.level0_subsample = 9;
+  planarvo_tracker* t = nullptr;
+  EXPECT_EQ(planarvo_tracker_create(c, &so.camera, &so.extrinsics, &o, &t), PLANARVO_ERROR_INVALID_ARGUMENT);
+  EXPECT_EQ(t, nullptr);
+  o.struct_size = offsetof(planarvo_tracker_options, level0_subsample);
+  ASSERT_EQ(planarvo_tracker_create(c, &so.camera, &so.extrinsics, &o, &t), PLANARVO_OK) << planarvo_last_error();
+  planarvo_tracker_destroy(t);
+  t = nullptr;
+  o.struct_size = sizeof o;
+  o.level0_subsample = 2;
+  ASSERT_EQ(planarvo_tracker_create(c, &so.camera, &so.extrinsics, &o, &t), PLANARVO_OK) << planarvo_last_error();
+  planarvo_dataset* d = nullptr;
+  ASSERT_EQ(planarvo_dataset_open(dir.path().c_str(), nullptr, &d), PLANARVO_OK);
+  planarvo_track_result r{};
+  r.struct_size = sizeof r;
+  planarvo_image img{};
+  planarvo_frame_data f{};
+  for (int64_t i = 0; i < 6; ++i) {
+    ASSERT_EQ(planarvo_dataset_frame(d, i, &img), PLANARVO_OK);
+    ASSERT_EQ(planarvo_dataset_frame_data(d, i, &f), PLANARVO_OK);
+    ASSERT_EQ(planarvo_tracker_track(t, &img, f.timestamp, &r), PLANARVO_OK) << planarvo_last_error();
+    EXPECT_EQ(r.status, i == 0 ? PLANARVO_TRACK_FIRST : PLANARVO_TRACK_OK) << i << " " << r.reason;
+  }
+  EXPECT_NEAR(r.pose.x, f.groundtruth.x, 1e-4);
+  EXPECT_NEAR(r.pose.y, f.groundtruth.y, 1e-4);
+  planarvo_dataset_destroy(d);
+  planarvo_tracker_destroy(t);
   planarvo_context_destroy(c);
 }
 
