@@ -260,7 +260,7 @@ int cmd_track(int argc, char** argv) {
       {"finest-level", "N", "finest pyramid level tracked (0 = full resolution)", "the coarsest at least 320 px wide"},
       {"max-iterations", "N", "cap on alignment steps per level", "per-level defaults"},
       {"level0-subsample", "B", "with --finest-level 0: full resolution on one pixel per BxB block, joined with "
-                                "half resolution (2: about ECC's accuracy at a third of full resolution's cost)", "0"},
+                                "half resolution (2: about ECC's accuracy at about half of full resolution's cost)", "0"},
       {"video", "FILE", "a video file standing in for images/ and frames.txt", ""},
       roi_option("camera.yaml's region_of_interest, else the whole image"),
       {"skip-bad-frames", "", "a missing or undecodable image is a gap (a warning, a \"skipped\" statistics row, "
@@ -288,6 +288,8 @@ int cmd_track(int argc, char** argv) {
   if (args.has("finest-level")) o.finest_level = args.get_int_in("finest-level", 0, 0, o.levels - 1);
   o.max_iterations = args.get_int_in("max-iterations", 0, 1, 1000);
   o.level0_subsample = args.get_int_in("level0-subsample", 0, 0, 8);
+  if (o.level0_subsample > 1 && o.finest_level != 0)
+    throw UsageError("--level0-subsample subsamples full resolution: it needs --finest-level 0");
   parse_roi(args);  // its form, before any file is read
   const double max_lost = args.get_double("max-lost", 5.0);
   if (!(max_lost >= 0.0 && max_lost <= 100.0))
