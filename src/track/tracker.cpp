@@ -60,6 +60,8 @@ CameraModel validated(const CameraModel& c, const Extrinsics& e, const TrackerOp
   for (int b : o.select_blocks)
     if (b < 0 || b > 16) throw_invalid_argument("TrackerOptions::select_blocks must be 0..16");
 
+  if (!(o.keyframe_scale_change > 0.0))
+    throw_invalid_argument("TrackerOptions::keyframe_scale_change must be positive");
   if (!(o.covariance_step_fraction >= 0.0))
     throw_invalid_argument("the tracker's covariance step fraction must be 0 or more");
   if (!(o.consecutive_alignment_correlation >= 0.0 && o.consecutive_alignment_correlation <= 0.5))
@@ -172,6 +174,30 @@ struct Tracker::Impl {
     out->a = pair.log_gain;
     out->b = pair.bias;
     return true;
+  }
+
+  // How much the ground's scale in the image has changed from the keyframe to the live frame:
+  // the largest |log| of the warp's linear scale (the square root of its Jacobian's determinant)
+  // at the centre and the corners of the region of interest. Moving along a perspective
+  // camera's viewing direction keeps the overlap high while the fine texture's appearance changes.
+  double scale_change(const SE2& motion) const {
+    const Eigen::Matrix3d H = motion_homography(camera.K(), ext, motion).H;
+    const PixelRegion r = camera.region();
+    double worst = 0.0;
+    const double xs[3] = {static_cast<double>(r.x), r.x + 0.5 * (r.width - 1), static_cast<double>(r.x + r.width - 1)};
+    const double ys[3] = {static_cast<double>(r.y), r.y + 0.5 * (r.height - 1), static_cast<double>(r.y + r.height - 1)};
+    for (double u : xs)
+      for (double v : ys) {
+        const Eigen::Vector3d q = H * Eigen::Vector3d(u, v, 1.0);
+        if (!(q.z() > 0.0)) return HUGE_VAL;
+        const double wu = q.x() / q.z(), wv = q.y() / q.z();
+        const double d00 = (H(0, 0) - wu * H(2, 0)) / q.z(), d01 = (H(0, 1) - wu * H(2, 1)) / q.z();
+        const double d10 = (H(1, 0) - wv * H(2, 0)) / q.z(), d11 = (H(1, 1) - wv * H(2, 1)) / q.z();
+        const double det = d00 * d11 - d01 * d10;
+        if (!(det > 0.0)) return HUGE_VAL;
+        worst = std::max(worst, std::abs(0.5 * std::log(det)));
+      }
+    return worst;
   }
 
   // The position covariance too large, or much longer along one axis than the other (texture
@@ -443,7 +469,7 @@ struct Tracker::Impl {
     pose = pose * res.motion.value;
     if (dt > 0.0) velocity = res.motion.value.log() / dt;
     since_good = 0.0;
-    if (res.overlap < opt.keyframe_overlap) {
+    if (res.overlap < opt.keyframe_overlap || scale_change(est.T) > opt.keyframe_scale_change) {
       make_keyframe(live);
       res.keyframe = true;
     } else {

@@ -33,6 +33,10 @@ struct TrackerOptions : AlignerOptions {
   // Keyframes: the live frame becomes the keyframe when the fraction of valid keyframe pixels
   // that land inside the live image, on valid pixels, falls below keyframe_overlap.
   double keyframe_overlap = 0.7;
+  // ... or when the ground's linear scale in the image has changed by more than this (|log| of
+  // it, anywhere in the region of interest's centre and corners; 0.1 is 10.5 %), which driving
+  // along a perspective camera's viewing direction does while the overlap stays high.
+  double keyframe_scale_change = 0.1;
   // Bad input. A frame interval longer than max_gap_factor times the usual interval is a gap
   // (status at best Degraded); longer than max_gap_seconds, the constant-velocity prediction is
   // not used (zero motion is). Live texture below min_texture_ratio of the keyframe's (mean

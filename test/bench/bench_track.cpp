@@ -582,6 +582,7 @@ int main(int argc, char** argv) {
       else if (k == "prior") topt.subsample_prior = std::atoi(v.c_str()) != 0;
       else if (k == "conv") topt.convergence_px = std::atof(v.c_str());
       else if (k == "huber") topt.huber_factor = std::atof(v.c_str());
+      else if (k == "kf_scale") topt.keyframe_scale_change = std::atof(v.c_str());
       else if (k == "overlap") topt.keyframe_overlap = std::atof(v.c_str());
       else if (k == "maxit") {
         const auto it = split(v);

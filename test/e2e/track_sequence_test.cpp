@@ -10,6 +10,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "common/test_util.h"
+#include "core/extrinsics.h"
 #include "io/dataset.h"
 #include "ocl/runtime.h"
 #include "sim/simulator.h"
@@ -95,6 +96,77 @@ TEST(TrackSequence, RearCameraOverFineTilesStartsAndTracks) {
     const SE2 t = traj.pose[k - 1].inverse() * traj.pose[k];
     EXPECT_LT(std::hypot(r.motion.value.x - t.x, r.motion.value.y - t.y), 0.2e-3) << k;
   }
+}
+
+// A rear camera on a car driving along its viewing direction: the overlap with the keyframe stays
+// high while the ground's scale in the image changes, so the tracker also makes a new keyframe
+// when the scale has changed by more than keyframe_scale_change. Checked against the truth: no
+// frame is aligned with a keyframe whose ground it sees more than 12 % larger or smaller (the
+// scale from the true motion's homography, core's ground_homography, differentiated
+// numerically at the image's centre and corners), and every frame is Ok.
+TEST(TrackSequence, APerspectiveViewGetsANewKeyframeWhenTheScaleChanges) {
+  ocl::Runtime rt;
+  sim::Options so;
+  so.texture = test::texture("asphalt_01.png").string();
+  so.camera = sim::default_camera(320, 240, 60.0);
+  so.extrinsics = Extrinsics{-1.0, 0.0, 0.8, 0.0, 35.0 * M_PI / 180.0, M_PI};
+  so.motion = sim::MotionProfile::Car;
+  so.max_speed = 3.0;
+  so.min_turn_radius = 6.0;
+  so.seconds = 3.0;
+  so.supersampling = 2;
+  const sim::Trajectory traj = sim::generate_trajectory(so);
+  sim::Renderer renderer(rt, cv::imread(so.texture, cv::IMREAD_GRAYSCALE), so);
+  const Eigen::Matrix3d K = so.camera.K();
+  // The largest |log linear scale| of the true warp from frame a to frame b.
+  auto true_scale_change = [&](size_t a, size_t b) {
+    const Eigen::Matrix3d H = ground_homography(K, so.extrinsics, (traj.pose[a].inverse() * traj.pose[b]).matrix3d());
+    auto warp = [&](double u, double v) {
+      const Eigen::Vector3d q = H * Eigen::Vector3d(u, v, 1.0);
+      return Eigen::Vector2d(q.x() / q.z(), q.y() / q.z());
+    };
+    double worst = 0.0;
+    for (double u : {0.0, 159.5, 319.0})
+      for (double v : {0.0, 119.5, 239.0}) {
+        const double h = 1e-3;
+        const Eigen::Vector2d du = (warp(u + h, v) - warp(u - h, v)) / (2 * h);
+        const Eigen::Vector2d dv = (warp(u, v + h) - warp(u, v - h)) / (2 * h);
+        worst = std::max(worst, std::abs(0.5 * std::log(du.x() * dv.y() - du.y() * dv.x())));
+      }
+    return worst;
+  };
+  // With the rule, and without it (to show that the drive needs it): the largest scale change
+  // from its keyframe of a frame after which the keyframe was kept, so that the next frame was
+  // aligned with it.
+  double kept_largest[2] = {0.0, 0.0};
+  for (int with_rule = 1; with_rule >= 0; --with_rule) {
+    TrackerOptions o;
+    if (!with_rule) o.keyframe_scale_change = 100.0;
+    Tracker tracker(rt, so.camera, so.extrinsics, o);
+    size_t keyframe = 0;
+    int keyframes = 0;
+    double travelled = 0.0;
+    for (size_t k = 0; k < traj.t.size(); ++k) {
+      const cv::Mat f = sim::apply_camera(renderer.render_float(traj.pose[k]), {}, 1.0, 300 + k);
+      const FrameResult r = tracker.track(f.data, f.cols, f.rows, f.step, traj.t[k]);
+      if (k > 0) {
+        EXPECT_EQ(r.status, FrameResult::Status::Ok) << k << " " << r.reason;
+        const SE2 m = traj.pose[k - 1].inverse() * traj.pose[k];
+        travelled += std::hypot(m.x, m.y);
+      }
+      if (r.keyframe) {
+        keyframe = k;
+        ++keyframes;
+      } else {
+        kept_largest[with_rule] = std::max(kept_largest[with_rule], true_scale_change(keyframe, k));
+      }
+    }
+    std::printf("rule %s: %d keyframes over %.2f m; largest scale change of a frame that kept its keyframe %.3f\n",
+                with_rule ? "on" : "off", keyframes, travelled, kept_largest[with_rule]);
+    EXPECT_GT(travelled, 1.0);
+  }
+  EXPECT_LT(kept_largest[1], std::log(1.12));
+  EXPECT_GT(kept_largest[0], std::log(1.12)) << "the drive should need the rule";
 }
 
 // Full resolution from one pixel per 4x4 block (TrackerOptions::select_blocks[0], the C API's
