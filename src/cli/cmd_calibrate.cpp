@@ -75,12 +75,12 @@ int cmd_calibrate_dataset(const Args& args, const planarvo_calibration_options& 
     o.has_initial = 1;
   }
   args.expect_output_files({"output"});
-  parse_roi(args);  // its form, before any file is read
+  const std::optional<planarvo_region> roi = parse_roi(args);  // before any file is read
   const std::string out = args.get("output");
   ContextPtr ctx = make_context(args);
   Progress progress(!args.has("quiet"));
   DatasetPtr ds = open_dataset(dir, args.get("video"), false, &progress);
-  apply_roi(args, ds.get());
+  apply_roi(roi, ds.get());
   planarvo_dataset_info info{};
   info.struct_size = sizeof info;
   check(planarvo_dataset_info_get(ds.get(), &info));

@@ -290,7 +290,7 @@ int cmd_track(int argc, char** argv) {
   o.level0_subsample = args.get_int_in("level0-subsample", 0, 0, 8);
   if (o.level0_subsample > 1 && o.finest_level != 0)
     throw UsageError("--level0-subsample subsamples full resolution: it needs --finest-level 0");
-  parse_roi(args);  // its form, before any file is read
+  const std::optional<planarvo_region> roi = parse_roi(args);  // before any file is read
   const double max_lost = args.get_double("max-lost", 5.0);
   if (!(max_lost >= 0.0 && max_lost <= 100.0))
     throw UsageError("--max-lost must be a percentage within 0..100, not " + args.get("max-lost"));
@@ -305,7 +305,7 @@ int cmd_track(int argc, char** argv) {
   ContextPtr ctx = make_context(args);
   Progress progress(!args.has("quiet"));
   DatasetPtr ds = open_dataset(dir, args.get("video"), false, &progress, args.has("skip-bad-frames"));
-  apply_roi(args, ds.get());
+  apply_roi(roi, ds.get());
   const TrackRun run = track_dataset(ctx.get(), ds.get(), e, o, {args.get("output"), args.get("stats"), args.get("motions-out"), args.has("skip-bad-frames")}, &progress);
   progress.finish();
   std::printf("tracked %s on %s\n", dir.c_str(), device_name(ctx.get()).c_str());

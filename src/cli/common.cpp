@@ -80,9 +80,8 @@ std::optional<planarvo_region> parse_roi(const Args& args) {
   return r;
 }
 
-void apply_roi(const Args& args, planarvo_dataset* dataset) {
-  const std::optional<planarvo_region> r = parse_roi(args);
-  if (r) check(planarvo_dataset_set_roi(dataset, &*r));
+void apply_roi(const std::optional<planarvo_region>& roi, planarvo_dataset* dataset) {
+  if (roi) check(planarvo_dataset_set_roi(dataset, &*roi));
 }
 
 DatasetPtr open_dataset(const std::string& dir, const std::string& video, bool verify, Progress* progress,

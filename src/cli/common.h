@@ -61,8 +61,8 @@ OptionSpec roi_option(const char* fallback);
 // Parsed and checked for form (the image size is checked where the camera is known); nullopt
 // without the option.
 std::optional<planarvo_region> parse_roi(const Args& args);
-// Applies --roi, when given, to an open data set's camera.
-void apply_roi(const Args& args, planarvo_dataset* dataset);
+// Applies a parsed --roi, when given, to an open data set's camera.
+void apply_roi(const std::optional<planarvo_region>& roi, planarvo_dataset* dataset);
 
 // allow_missing: a missing image is found when its frame is read, not at open (--skip-bad-frames).
 DatasetPtr open_dataset(const std::string& dir, const std::string& video, bool verify, Progress* progress,

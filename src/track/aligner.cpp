@@ -116,16 +116,22 @@ Aligner::Aligner(ocl::Runtime& runtime, const Eigen::Matrix3d& K, const AlignerO
             kernel_options(options, false)),
       stats_pass_(runtime, with_orientation ? kMotionParams + kOrientationParams : kMotionParams,
                   kernel_options(options, true)) {
-  // The selected-pixel passes the options ask for, built now rather than at the first frame
-  // that reaches their level.
+  // The subsampled passes the options ask for, built now rather than at the first frame that
+  // reaches their level.
   for (int b : options.select_blocks)
-    if (b >= 2 && !select_passes_[b][0])
-      for (int st : {0, 1}) {
-        WarpReduceOptions k = kernel_options(options, st == 1);
-        k.select_block = b;
-        select_passes_[b][static_cast<size_t>(st)] = std::make_unique<WarpReduce>(
-            runtime, with_orientation ? kMotionParams + kOrientationParams : kMotionParams, k);
-      }
+    if (b >= 2) select_passes(b);
+}
+
+std::array<std::unique_ptr<WarpReduce>, 2>& Aligner::select_passes(int block) {
+  std::array<std::unique_ptr<WarpReduce>, 2>& passes = select_passes_[block];
+  if (!passes[0])
+    for (int st : {0, 1}) {
+      WarpReduceOptions k = kernel_options(options_, st == 1);
+      k.select_block = block;
+      passes[static_cast<size_t>(st)] = std::make_unique<WarpReduce>(
+          runtime_, with_orientation_ ? kMotionParams + kOrientationParams : kMotionParams, k);
+    }
+  return passes;
 }
 
 AlignmentLevels Aligner::levels(const Pyramid& reference, const Pyramid& live) const {
@@ -174,14 +180,7 @@ void Aligner::evaluate(const AlignmentPair& pair, const Extrinsics& e, int level
     (stats ? stats_pass_ : pass_).run(R.data, R.width, R.height, L.data, L.width, L.height, in, out);
     return;
   }
-  std::array<std::unique_ptr<WarpReduce>, 2>& passes = select_passes_[sel->block];
-  if (!passes[0])
-    for (int st : {0, 1}) {
-      WarpReduceOptions k = kernel_options(options_, st == 1);
-      k.select_block = sel->block;
-      passes[static_cast<size_t>(st)] = std::make_unique<WarpReduce>(runtime_, mh.nparam, k);
-    }
-  passes[stats ? 1 : 0]->run(sel->data, sel->grid_w, sel->grid_h, L.data, L.width, L.height, in, out);
+  select_passes(sel->block)[stats ? 1 : 0]->run(sel->data, sel->grid_w, sel->grid_h, L.data, L.width, L.height, in, out);
 }
 
 const SelectedPixels* Aligner::selection_at(const AlignmentPair& pair, int level) {
@@ -309,20 +308,24 @@ AlignmentReport Aligner::align(std::vector<AlignmentPair>& pairs, Extrinsics* ex
     // estimate as a Gaussian prior with its J^T W J (in this level's noise units, (sigma_here /
     // sigma_there)^2), so that the subsample adds the fine texture's information to the coarser
     // level's instead of replacing it.
-    const bool with_prior = options_.subsample_prior && have_prev_ && !with_orientation_;
-    std::vector<bool> prior_on(P, false);
+    // The prior's information per pair (empty: none), formed once for the level.
+    const int nl = local_size();
+    std::vector<MatrixL>& prior_H = prior_H_;
+    prior_H.assign(P, MatrixL());
+    if (options_.subsample_prior && have_prev_ && !with_orientation_)
+      for (size_t p = 0; p < P; ++p)
+        if (selection_at(pairs[p], level) != nullptr && prev_sigma_[p] > 0.0)
+          prior_H[p] = std::pow(measured[p] / prev_sigma_[p], 2) *
+                       pair_block(prev_sums_[p], nl, false).A_ll.topLeftCorner(nl, nl);
     auto apply_prior = [&](size_t p, const AlignmentPair& state, ReduceSums* sums) {
-      if (!prior_on[p]) return;
-      const int nl = local_size();
-      const int np = sums->JtWr.size() - 2;
+      const MatrixL& H = prior_H[p];
+      if (H.rows() == 0) return;
+      const int np = static_cast<int>(sums->JtWr.size()) - 2;
       const int idx[5] = {0, 1, 2, np, np + 1};
       Vector5d e = Vector5d::Zero();
       e.head<3>() = (prev_state_[p].motion.inverse() * state.motion).log();
       e(3) = state.log_gain - prev_state_[p].log_gain;
       e(4) = state.bias - prev_state_[p].bias;
-      const double scale = std::pow(measured[p] / prev_sigma_[p], 2);
-      const PairBlock b = pair_block(prev_sums_[p], nl, false);
-      const MatrixL H = scale * b.A_ll.topLeftCorner(nl, nl);
       const VectorL He = H * e.head(nl);
       for (int i = 0; i < nl; ++i) {
         for (int j = 0; j < nl; ++j) sums->JtWJ(idx[i], idx[j]) += H(i, j);
@@ -330,11 +333,7 @@ AlignmentReport Aligner::align(std::vector<AlignmentPair>& pairs, Extrinsics* ex
       }
       sums->cost += 0.5 * e.head(nl).dot(He);
     };
-    if (with_prior)
-      for (size_t p = 0; p < P; ++p) {
-        prior_on[p] = selection_at(pairs[p], level) != nullptr && prev_sigma_[p] > 0.0;
-        apply_prior(p, pairs[p], &cur_[p]);
-      }
+    for (size_t p = 0; p < P; ++p) apply_prior(p, pairs[p], &cur_[p]);
 
     double lambda = 0.0;
     int steps = 0;

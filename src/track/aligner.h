@@ -183,12 +183,15 @@ class Aligner {
   WarpReduce pass_, stats_pass_;
   // The passes over selected pixels (plain, STATS) per block size, made when first needed.
   std::map<int, std::array<std::unique_ptr<WarpReduce>, 2>> select_passes_;
+  std::array<std::unique_ptr<WarpReduce>, 2>& select_passes(int block);
   static const SelectedPixels* selection_at(const AlignmentPair& pair, int level);
   // The level just aligned: its last sums, the pairs' estimates and robust scales.
   std::vector<ReduceSums> prev_sums_;
   std::vector<AlignmentPair> prev_state_;
   std::vector<double> prev_sigma_;
   bool have_prev_ = false;
+  // Per pair, the prior's J^T W J at a subsampled level (aligner.cpp's MatrixL, at most 5x5).
+  std::vector<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 5, 5>> prior_H_;
   std::vector<ReduceSums> cur_, next_;
   std::vector<AlignmentPair> cand_;
   std::vector<double> measured_;

@@ -8,6 +8,7 @@
 #include <Eigen/Eigenvalues>
 
 #include "core/error.h"
+#include "core/extrinsics.h"
 #include "image/pipeline.h"
 #include "ocl/runtime.h"
 #include "track/warp_model.h"
@@ -59,7 +60,6 @@ CameraModel validated(const CameraModel& c, const Extrinsics& e, const TrackerOp
   if (!(e.z > 0.0)) throw_invalid_argument("Tracker: the camera height z must be positive");
   for (int b : o.select_blocks)
     if (b < 0 || b > 16) throw_invalid_argument("TrackerOptions::select_blocks must be 0..16");
-
   if (!(o.keyframe_scale_change > 0.0))
     throw_invalid_argument("TrackerOptions::keyframe_scale_change must be positive");
   if (!(o.covariance_step_fraction >= 0.0))
@@ -181,7 +181,7 @@ struct Tracker::Impl {
   // at the centre and the corners of the region of interest. Moving along a perspective
   // camera's viewing direction keeps the overlap high while the fine texture's appearance changes.
   double scale_change(const SE2& motion) const {
-    const Eigen::Matrix3d H = motion_homography(camera.K(), ext, motion).H;
+    const Eigen::Matrix3d H = ground_homography(camera.K(), ext, motion.matrix3d());
     const PixelRegion r = camera.region();
     double worst = 0.0;
     const double xs[3] = {static_cast<double>(r.x), r.x + 0.5 * (r.width - 1), static_cast<double>(r.x + r.width - 1)};
