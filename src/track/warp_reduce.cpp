@@ -243,7 +243,7 @@ ReduceSums warp_reduce_reference(const LevelView& ref, const LevelView& live,
 std::string WarpReduce::build_options(int nparam, const WarpReduceOptions& o) {
   std::ostringstream s;
   s << "-D NPARAM=" << nparam << " -D WG_X=" << o.wg_x << " -D WG_Y=" << o.wg_y
-    << " -D PIX=" << o.pixels_per_item;
+    << " -D PIX=" << o.pixels_per_item << " -D LANES=" << o.lanes;
   if (o.stats) s << " -D STATS=1 -D HIST_BINS=" << o.hist_bins;
   if (o.select_block > 0) s << " -D SELECT=1";  // the block size is an argument
   if (o.debug_output) s << " -D DEBUG_OUTPUT";
@@ -260,6 +260,8 @@ WarpReduce::WarpReduce(ocl::Runtime& runtime, int nparam, const WarpReduceOption
     throw_invalid_argument("WarpReduce: the work-group size wg_x * wg_y must be a power of two");
   if (options.pixels_per_item < 1 || options.pixels_per_item > 64)
     throw_invalid_argument("WarpReduce: pixels_per_item must be 1..64");
+  if ((options.lanes != 1 && options.lanes != 8) || options.pixels_per_item % options.lanes != 0)
+    throw_invalid_argument("WarpReduce: lanes must be 1 or 8, and divide pixels_per_item");
   if (options.select_block < 0 || options.select_block > 64)
     throw_invalid_argument("WarpReduce: select_block must be 0..64");
   if (options.hist_bins < 0 || options.hist_bins > kMaxHistBins)

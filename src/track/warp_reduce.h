@@ -128,6 +128,7 @@ ReduceSums warp_reduce_reference(const LevelView& ref, const LevelView& live,
 struct WarpReduceOptions {
   int wg_x = 16, wg_y = 1;   // work-group shape (WG_X x WG_Y must be a power of two)
   int pixels_per_item = 8;   // PIX: pixels per work-item along a row, WG_X apart
+  int lanes = 8;             // LANES: 8 pixels at a time as float8 (pixels_per_item a multiple of 8), or 1
   bool stats = false;        // the STATS variant: residual, intensity and gradient statistics
   int hist_bins = 16;        // and a histogram of |r| for the robust scale (with stats only)
   bool fast_math = false;    // -cl-fast-relaxed-math (no faster on PoCL: src/track/README.md)

@@ -45,11 +45,13 @@ struct Scene {
   bool has_ext = false;
   Extrinsics ext;        // ext=x,y,z,roll,pitch,yaw (m, deg)
   double fov = 80.0, speed = 0.8, turn = 1.5, radius = 0.0, noise = 1.0;
+  int supersampling = 3;  // ss=N: the renderer's subsamples per pixel along each axis
+  bool mipmap = true;     // mip=0: no prefiltered texture (only the subsamples average)
   sim::MotionProfile motion = sim::MotionProfile::Mixed;
 
   Extrinsics extrinsics() const { return has_ext ? ext : sim::paper_configuration(config); }
 
-  // Takes one key=value argument: config, ext, fov, motion, speed, turn, radius, noise. False
+  // Takes one key=value argument: config, ext, fov, motion, speed, turn, radius, noise, ss, mip. False
   // for another key; exits with a message on a bad value.
   bool parse(const std::string& k, const std::string& v) {
     if (k == "config") {
@@ -78,6 +80,10 @@ struct Scene {
       radius = std::atof(v.c_str());
     } else if (k == "noise") {
       noise = std::atof(v.c_str());
+    } else if (k == "ss") {
+      supersampling = std::atoi(v.c_str());
+    } else if (k == "mip") {
+      mipmap = std::atoi(v.c_str()) != 0;
     } else {
       return false;
     }
@@ -96,6 +102,8 @@ struct Scene {
     so.min_turn_radius = radius;
     so.pixel_noise = noise;
     so.extrinsics = extrinsics();
+    so.supersampling = supersampling;
+    so.mipmap = mipmap;
     return so;
   }
 

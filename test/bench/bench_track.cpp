@@ -1,7 +1,7 @@
 // Benchmark and evaluation of the tracker. Prints tables, asserts nothing.
 //   bench_track kernel   [width height]   the fused pass per work-group shape / pixels per
-//                                          work-item / fast math, median ms per pass
-//   bench_track kernel w h wx wy pix hist fast [rounds]   one configuration
+//                                          work-item / lanes / fast math, median ms per pass
+//   bench_track kernel w h wx wy pix hist fast lanes [rounds]   one configuration
 //   bench_track speed [w h] [seconds] [rounds]   ms per frame through the camera-frame API
 //   bench_track accuracy [key=value...]     simulated sequences tracked against ground truth
 //       (seconds, w, h, seed, motion=mixed|straight|circle|spin, levels, finest, refine_kf, conv,
@@ -10,7 +10,8 @@
 //        off by +10,-10,+10 mm and +2.5,-2.5,+2.5 deg), ext=x,y,z,roll,pitch,yaw (m, deg; instead
 //        of config), fov=deg, motion=...|car, speed=m/s, turn=rad/s, radius=m (car), noise=grey
 //        levels, select=B0,B1,.. (level l on one pixel per Bl x Bl block), prior=0|1 (a
-//        subsampled level joined with the level before it); BENCH_VERBOSE=1 adds per-level
+//        subsampled level joined with the level before it), the fused pass's lanes=1|8, pix=N,
+//        wg=XxY; scene extras ss=N (the renderer's supersampling), mip=0|1; BENCH_VERBOSE=1 adds per-level
 //        times, the slowest frames and the frames not tracked ok; see main())
 //   bench_track nees [key=value...]         NEES of the covariances (alignment and frame-to-frame
 //       motion) and the lag-1 correlation of the errors per texture x configuration x size x
@@ -86,7 +87,7 @@ Extrinsics perturbed(Extrinsics e) {
   return e;
 }
 
-struct KernelConfig { int wx, wy, pix, hist; bool fast; };
+struct KernelConfig { int wx, wy, pix, hist; bool fast; int lanes; };
 
 int bench_kernel(int width, int height, const std::vector<KernelConfig>& only, int reps) {
   ocl::Runtime rt;
@@ -108,14 +109,16 @@ int bench_kernel(int width, int height, const std::vector<KernelConfig>& only, i
   using Row = KernelConfig;
   std::vector<Row> rows = only;
   if (rows.empty()) {
-  for (int fast = 1; fast >= 0; --fast)
-    for (const auto& s : std::vector<std::array<int, 2>>{{16, 1}, {32, 1}, {64, 1}, {128, 1}, {16, 4}, {32, 2}})
-      for (int pix : {1, 2, 4, 8}) rows.push_back({s[0], s[1], pix, 16, fast != 0});
-  rows.push_back({64, 1, 4, 0, true});
-  rows.push_back({64, 1, 8, 0, true});
+    for (const auto& s : std::vector<std::array<int, 2>>{{8, 1}, {16, 1}, {32, 1}, {64, 1}, {16, 4}, {32, 2}}) {
+      for (int pix : {8, 16, 32}) rows.push_back({s[0], s[1], pix, 0, false, 8});
+      for (int pix : {4, 8}) rows.push_back({s[0], s[1], pix, 0, false, 1});
+    }
+    rows.push_back({16, 1, 8, 16, false, 8});
+    rows.push_back({16, 1, 8, 16, false, 1});
+    rows.push_back({16, 1, 8, 0, true, 8});
   }
   std::printf("%dx%d, one fused pass (enqueue, kernel, read-back of the partials, host sum)\n", width, height);
-  std::printf("%6s %4s %4s %5s %5s %9s %9s %9s\n", "wg_x", "wg_y", "pix", "hist", "fast", "median_ms", "min_ms", "cpu_ms");
+  std::printf("%6s %4s %4s %5s %5s %5s %9s %9s %9s\n", "wg_x", "wg_y", "pix", "lanes", "hist", "fast", "median_ms", "min_ms", "cpu_ms");
   // Rounds over all configurations, so that load from other processes spreads over all of them.
   std::vector<std::vector<double>> times(rows.size());
   std::vector<double> valid(rows.size()), cpu(rows.size(), 0.0);
@@ -123,7 +126,7 @@ int bench_kernel(int width, int height, const std::vector<KernelConfig>& only, i
   for (size_t ri = 0; ri < rows.size(); ++ri) {
     const Row& r = rows[ri];
     track::WarpReduceOptions o;
-    o.wg_x = r.wx; o.wg_y = r.wy; o.pixels_per_item = r.pix; o.stats = r.hist > 0; o.hist_bins = r.hist; o.fast_math = r.fast;
+    o.wg_x = r.wx; o.wg_y = r.wy; o.pixels_per_item = r.pix; o.lanes = r.lanes; o.stats = r.hist > 0; o.hist_bins = r.hist; o.fast_math = r.fast;
     track::WarpReduce wr(rt, 3, o);
     track::ReduceSums s;
     wr.run(ref.levels[0].data, width, height, live.levels[0].data, width, height, in, &s);
@@ -138,7 +141,7 @@ int bench_kernel(int width, int height, const std::vector<KernelConfig>& only, i
   }
   for (size_t ri = 0; ri < rows.size(); ++ri) {
     const Row& r = rows[ri];
-    std::printf("%6d %4d %4d %5d %5d %9.3f %9.3f %9.3f  (valid %.0f)\n", r.wx, r.wy, r.pix, r.hist, r.fast ? 1 : 0,
+    std::printf("%6d %4d %4d %5d %5d %5d %9.3f %9.3f %9.3f  (valid %.0f)\n", r.wx, r.wy, r.pix, r.lanes, r.hist, r.fast ? 1 : 0,
                 median(times[ri]), *std::min_element(times[ri].begin(), times[ri].end()), cpu[ri], valid[ri]);
   }
   // Launch overhead: the same pass on a tiny level.
@@ -485,10 +488,16 @@ int bench_speed(int width, int height, double seconds, int rounds) {
   {
     track::TrackerOptions o;
     configs.push_back({"default (finest auto)", o});
+    o.kernel.lanes = 1;  // the fused pass one pixel at a time, as before float8
+    configs.push_back({"default, per-pixel pass", o});
     o.finest_level = 0;
+    configs.push_back({"finest 0, per-pixel pass", o});
+    o.kernel.lanes = 8;
     configs.push_back({"finest level 0", o});
     o.select_blocks[0] = 4;
     configs.push_back({"level 0 at 1/16 + prior", o});
+    o.select_blocks[0] = 3;
+    configs.push_back({"level 0 at 1/9 + prior", o});
     o.select_blocks[0] = 2;
     configs.push_back({"level 0 at 1/4 + prior", o});
     o.select_blocks[0] = 0;
@@ -542,9 +551,11 @@ int main(int argc, char** argv) {
   if (mode == "kernel") {
     const int w = argc > 3 ? std::atoi(argv[2]) : 640, h = argc > 3 ? std::atoi(argv[3]) : 480;
     std::vector<KernelConfig> only;
-    if (argc > 8)
-      only.push_back({std::atoi(argv[4]), std::atoi(argv[5]), std::atoi(argv[6]), std::atoi(argv[7]), std::atoi(argv[8]) != 0});
-    return bench_kernel(w, h, only, argc > 9 ? std::atoi(argv[9]) : 6);
+    // bench_track kernel [w h [wg_x wg_y pix hist fast lanes [rounds]]]
+    if (argc > 9)
+      only.push_back({std::atoi(argv[4]), std::atoi(argv[5]), std::atoi(argv[6]), std::atoi(argv[7]), std::atoi(argv[8]) != 0,
+                      std::atoi(argv[9])});
+    return bench_kernel(w, h, only, argc > 10 ? std::atoi(argv[10]) : 6);
   }
   if (mode == "speed") {
     // bench_track speed [w h] [seconds] [rounds]
@@ -580,6 +591,13 @@ int main(int argc, char** argv) {
         for (size_t l = 0; l < b.size() && l < topt.select_blocks.size(); ++l) topt.select_blocks[l] = std::atoi(b[l].c_str());
       }
       else if (k == "prior") topt.subsample_prior = std::atoi(v.c_str()) != 0;
+      else if (k == "lanes") topt.kernel.lanes = std::atoi(v.c_str());
+      else if (k == "pix") topt.kernel.pixels_per_item = std::atoi(v.c_str());
+      else if (k == "wg") {  // wg=16x4
+        const size_t x = v.find('x');
+        topt.kernel.wg_x = std::atoi(v.substr(0, x).c_str());
+        topt.kernel.wg_y = x == std::string::npos ? 1 : std::atoi(v.substr(x + 1).c_str());
+      }
       else if (k == "conv") topt.convergence_px = std::atof(v.c_str());
       else if (k == "huber") topt.huber_factor = std::atof(v.c_str());
       else if (k == "kf_scale") topt.keyframe_scale_change = std::atof(v.c_str());

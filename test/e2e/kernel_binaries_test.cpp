@@ -95,8 +95,8 @@ void copy_without(const fs::path& from, const fs::path& to, const std::string& p
 
 // The tracker's STATS pass and the roll/pitch estimator's plain pass, as their default options
 // build them (src/track/warp_reduce.cpp); the manifest spells them this way.
-const char* const kTrackerStats = "-D NPARAM=3 -D WG_X=16 -D WG_Y=1 -D PIX=8 -D STATS=1 -D HIST_BINS=16";
-const char* const kRollPitchPass = "-D NPARAM=5 -D WG_X=16 -D WG_Y=1 -D PIX=8";
+const char* const kTrackerStats = "-D NPARAM=3 -D WG_X=16 -D WG_Y=1 -D PIX=8 -D LANES=8 -D STATS=1 -D HIST_BINS=16";
+const char* const kRollPitchPass = "-D NPARAM=5 -D WG_X=16 -D WG_Y=1 -D PIX=8 -D LANES=8";
 
 // One simulated data set (320x240, 2 s) and one export of every kernel for the whole suite.
 // Programs are compiled at run time into a program cache of the suite's own, which the export

@@ -222,13 +222,16 @@ TEST_F(WarpReduceKernel, MatchesReferenceOnRandomLevels) {
   variants.push_back({3, o});  // the defaults
   o.stats = true;
   variants.push_back({3, o});  // the defaults with statistics
-  o.wg_x = 16; o.wg_y = 4; o.pixels_per_item = 1; o.hist_bins = 0; o.fast_math = false;
+  o.wg_x = 16; o.wg_y = 4; o.pixels_per_item = 1; o.lanes = 1; o.hist_bins = 0; o.fast_math = false;
   variants.push_back({3, o});
   o.wg_x = 32; o.wg_y = 2; o.pixels_per_item = 3; o.hist_bins = 12; o.fast_math = true;
   variants.push_back({5, o});
-  o.wg_x = 8; o.wg_y = 1; o.pixels_per_item = 8; o.hist_bins = 16; o.stats = false;
+  o.wg_x = 8; o.wg_y = 1; o.pixels_per_item = 8; o.lanes = 8; o.hist_bins = 16; o.stats = false;
   variants.push_back({1, o});
   o.stats = true; o.cluster_width = 200; o.cluster_bands = 3;  // 3 work-groups x a third of the rows
+  variants.push_back({3, o});
+  o.wg_x = 16; o.wg_y = 2; o.pixels_per_item = 16;  // two runs of 8 per work-item
+  o.cluster_width = 128; o.cluster_bands = 8;
   variants.push_back({3, o});
   const int sizes[][4] = {{97, 61, 101, 67}, {160, 120, 160, 120}, {33, 7, 40, 9}};
   for (const Variant& v : variants) {
