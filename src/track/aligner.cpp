@@ -327,13 +327,25 @@ AlignmentReport Aligner::align(std::vector<AlignmentPair>& pairs, Extrinsics* ex
       e(3) = state.log_gain - prev_state_[p].log_gain;
       e(4) = state.bias - prev_state_[p].bias;
       const VectorL He = H * e.head(nl);
+      // For the covariance's sandwich (tracker.cpp): the prior is the Huber cost's Hessian too,
+      // and its score, H e with e's covariance sigma_there^2 A_there^-1, has the covariance
+      // sigma_here^2 H in this level's units.
+      const int nj = static_cast<int>(sums->JtWJ.rows());
+      const bool bread = sums->has_stats && sums->JtJ_inlier.rows() == nj;
+      const bool meat = sums->score_outer.rows() == nj;
+      const double s2 = measured[p] * measured[p];
       for (int i = 0; i < nl; ++i) {
-        for (int j = 0; j < nl; ++j) sums->JtWJ(idx[i], idx[j]) += H(i, j);
+        for (int j = 0; j < nl; ++j) {
+          sums->JtWJ(idx[i], idx[j]) += H(i, j);
+          if (bread) sums->JtJ_inlier(idx[i], idx[j]) += H(i, j);
+          if (meat) sums->score_outer(idx[i], idx[j]) += s2 * H(i, j);
+        }
         sums->JtWr(idx[i]) += He(i);
       }
       sums->cost += 0.5 * e.head(nl).dot(He);
     };
     for (size_t p = 0; p < P; ++p) apply_prior(p, pairs[p], &cur_[p]);
+    if (level == levels.finest) report.finest_stats = cur_;  // with the prior, for the covariance
 
     double lambda = 0.0;
     int steps = 0;
