@@ -105,6 +105,78 @@
 // outside) and the addresses are clamped, so nothing is read out of bounds.
 #define SAMPLE_CLAMP 1.0e6f
 
+// The per-pixel algebra after the sample, shared by both forms: T is float (LANES 1) or float8
+// (LANES 8), IT the matching int type (comparisons give 1 or -1 in it, which select() takes
+// alike). Expects in scope: m (the pair's mask), lI, lGu, lGv (the live sample), rI, rGu, rGv,
+// mref (the reference entry), fu, fv (the reference pixel), iz, wu, wv (the warp), h0..h8,
+// params, gain, bias, huber_k and acc[NOUT] of T. Declares r, J, ar, inlier, wgt and rho.
+#define WR_PIXEL_SUMS(T, IT)                                                                    \
+  /* Residual with brightness (eq. 7). */                                                       \
+  const T r = m * (gain * lI + bias - rI);                                                      \
+  /* ESM gradient in reference coordinates (eq. 11): the live gradient through Dw. */           \
+  const T d00 = iz * (h0 - wu * h6), d01 = iz * (h1 - wu * h7);                                 \
+  const T d10 = iz * (h3 - wv * h6), d11 = iz * (h4 - wv * h7);                                 \
+  const T gu = 0.5f * (rGu + gain * (lGu * d00 + lGv * d10));                                   \
+  const T gv = 0.5f * (rGv + gain * (lGu * d01 + lGv * d11));                                   \
+  /* Jacobian (eq. 12), zero where masked. */                                                   \
+  T J[NJ];                                                                                      \
+  _Pragma("unroll") for (int i = 0; i < NPARAM; ++i) {                                          \
+    __constant const float* G = params + 9 + 9 * i;                                             \
+    const T mx = G[0] * fu + G[1] * fv + G[2];                                                  \
+    const T my = G[3] * fu + G[4] * fv + G[5];                                                  \
+    const T mz = G[6] * fu + G[7] * fv + G[8];                                                  \
+    J[i] = m * (gu * (mx - fu * mz) + gv * (my - fv * mz));                                     \
+  }                                                                                             \
+  J[NPARAM] = m * gain * lI;                                                                    \
+  J[NPARAM + 1] = m;                                                                            \
+  /* Huber weight and cost (a masked pixel has r = 0, an inlier). */                            \
+  const T ar = fabs(r);                                                                         \
+  const IT inlier = ar <= huber_k;                                                              \
+  const T wgt = m * select(huber_k / ar, (T)(1.0f), inlier);                                    \
+  const T rho = m * select(huber_k * (ar - 0.5f * huber_k), 0.5f * r * r, inlier);              \
+  {                                                                                             \
+    int o = 0;                                                                                  \
+    _Pragma("unroll") for (int i = 0; i < NJ; ++i) {                                            \
+      const T wj = wgt * J[i];                                                                  \
+      _Pragma("unroll") for (int j = i; j < NJ; ++j) acc[o++] += wj * J[j];                     \
+    }                                                                                           \
+  }                                                                                             \
+  _Pragma("unroll") for (int i = 0; i < NJ; ++i) acc[OUT_JTR + i] += wgt * J[i] * r;            \
+  acc[OUT_COST] += rho;                                                                         \
+  acc[OUT_WRR] += wgt * r * r;                                                                  \
+  acc[OUT_VALID] += m;                                                                          \
+  acc[OUT_INLIER] += select((T)(0.0f), m, inlier);                                              \
+  acc[OUT_REF] += mref;                                                                         \
+  WR_STATS_SUMS(T)
+
+#if STATS
+// The histogram's bin j counts |r| < 0.25 * 2^(j/2) (ReduceLayout::hist_threshold): exact
+// powers of two for even j, times sqrt(2) for odd j.
+float wr_hist_threshold(const int j) {
+  return (j & 1) ? 0.35355339059327373f * (float)(1 << (j >> 1)) : 0.25f * (float)(1 << (j >> 1));
+}
+
+// The statistics' sums (the histogram is each form's own). The Huber cost's own Hessian
+// (psi' = 1 inside k, 0 beyond) for the covariance: J^T J over the inliers, unweighted.
+#define WR_STATS_SUMS(T)                                                                        \
+  acc[OUT_RR] += r * r;                                                                         \
+  {                                                                                             \
+    const T ic = m * (rI - 128.0f);                                                             \
+    acc[OUT_IREF] += ic;                                                                        \
+    acc[OUT_IREF2] += ic * ic;                                                                  \
+    acc[OUT_GLIVE] += m * (lGu * lGu + lGv * lGv);                                              \
+    acc[OUT_GREF] += m * (rGu * rGu + rGv * rGv);                                               \
+    const T win = select((T)(0.0f), m, inlier);                                                 \
+    int oi = OUT_JTJ_IN;                                                                        \
+    _Pragma("unroll") for (int i = 0; i < NJ; ++i) {                                            \
+      const T wj = win * J[i];                                                                  \
+      _Pragma("unroll") for (int j = i; j < NJ; ++j) acc[oi++] += wj * J[j];                    \
+    }                                                                                           \
+  }
+#else
+#define WR_STATS_SUMS(T)
+#endif
+
 // The work-group's sums into its row of the partials: a tree reduction in local memory, one
 // column of WG values per output.
 void warp_reduce_store(const float* acc, __local float* scratch, __global float* partials) {
@@ -244,67 +316,8 @@ void warp_reduce(__global const float4* ref, const int ref_stride, const int ref
 #undef WR_SAMPLE
     const float8 m = select((float8)(0.0f), mref * lV, inside);
 
-    // Residual with brightness (eq. 7).
-    const float8 r = m * (gain * lI + bias - rI);
-
-    // ESM gradient in reference coordinates (eq. 11): the live gradient through Dw.
-    const float8 d00 = iz * (h0 - wu * h6), d01 = iz * (h1 - wu * h7);
-    const float8 d10 = iz * (h3 - wv * h6), d11 = iz * (h4 - wv * h7);
-    const float8 glu = lGu * d00 + lGv * d10;
-    const float8 glv = lGu * d01 + lGv * d11;
-    const float8 gu = 0.5f * (rGu + gain * glu);
-    const float8 gv = 0.5f * (rGv + gain * glv);
-
-    // Jacobian (eq. 12), zero where masked.
-    float8 J[NJ];
-#pragma unroll
-    for (int i = 0; i < NPARAM; ++i) {
-      __constant const float* G = params + 9 + 9 * i;
-      const float8 mx = G[0] * fu + G[1] * fv + G[2];
-      const float8 my = G[3] * fu + G[4] * fv + G[5];
-      const float8 mz = G[6] * fu + G[7] * fv + G[8];
-      J[i] = m * (gu * (mx - fu * mz) + gv * (my - fv * mz));
-    }
-    J[NPARAM] = m * gain * lI;
-    J[NPARAM + 1] = m;
-
-    // Huber weight and cost (a masked pixel has r = 0, an inlier).
-    const float8 ar = fabs(r);
-    const int8 inlier = ar <= huber_k;
-    const float8 wgt = m * select(huber_k / ar, (float8)(1.0f), inlier);
-    const float8 rho = m * select(huber_k * (ar - 0.5f * huber_k), 0.5f * r * r, inlier);
-
-    int o = 0;
-#pragma unroll
-    for (int i = 0; i < NJ; ++i) {
-      const float8 wj = wgt * J[i];
-#pragma unroll
-      for (int j = i; j < NJ; ++j) acc[o++] += wj * J[j];
-    }
-#pragma unroll
-    for (int i = 0; i < NJ; ++i) acc[OUT_JTR + i] += wgt * J[i] * r;
-    acc[OUT_COST] += rho;
-    acc[OUT_WRR] += wgt * r * r;
-    acc[OUT_VALID] += m;
-    acc[OUT_INLIER] += select((float8)(0.0f), m, inlier);
-    acc[OUT_REF] += mref;
+    WR_PIXEL_SUMS(float8, int8)
 #if STATS
-    acc[OUT_RR] += r * r;
-    const float8 ic = m * (rI - 128.0f);
-    acc[OUT_IREF] += ic;
-    acc[OUT_IREF2] += ic * ic;
-    acc[OUT_GLIVE] += m * (lGu * lGu + lGv * lGv);
-    acc[OUT_GREF] += m * (rGu * rGu + rGv * rGv);
-    {
-      const float8 win = select((float8)(0.0f), m, inlier);
-      int oi = OUT_JTJ_IN;
-#pragma unroll
-      for (int i = 0; i < NJ; ++i) {
-        const float8 wj = win * J[i];
-#pragma unroll
-        for (int j = i; j < NJ; ++j) acc[oi++] += wj * J[j];
-      }
-    }
     // The histogram's subsample: the first WG_X pixels of the work-group's span, counted into
     // scalars (a float8 accumulator each would not fit the registers).
     if (k == 0 && lx * 8 < WG_X) {
@@ -312,9 +325,7 @@ void warp_reduce(__global const float4* ref, const int ref_stride, const int ref
       hist[0] += wr_sum8(hm);
 #pragma unroll
       for (int j = 0; j < HIST_BINS; ++j) {
-        const float t = (j & 1) ? 0.35355339059327373f * (float)(1 << (j >> 1))
-                                : 0.25f * (float)(1 << (j >> 1));
-        hist[1 + j] += wr_sum8(select((float8)(0.0f), hm, ar < t));
+        hist[1 + j] += wr_sum8(select((float8)(0.0f), hm, ar < wr_hist_threshold(j)));
       }
     }
 #endif
@@ -412,79 +423,15 @@ void warp_reduce(__global const float4* ref, const int ref_stride, const int ref
                                  livep[b10 + 7]
                            : 0.0f;
 
-    // Residual with brightness (eq. 7).
-    const float r = m * (gain * lI + bias - rI);
-
-    // ESM gradient in reference coordinates (eq. 11): the live gradient through Dw.
-    const float d00 = iz * (h0 - wu * h6), d01 = iz * (h1 - wu * h7);
-    const float d10 = iz * (h3 - wv * h6), d11 = iz * (h4 - wv * h7);
-    const float glu = lGu * d00 + lGv * d10;
-    const float glv = lGu * d01 + lGv * d11;
-    const float gu = 0.5f * (rGu + gain * glu);
-    const float gv = 0.5f * (rGv + gain * glv);
-
-    // Jacobian (eq. 12), zero where masked.
-    float J[NJ];
-#pragma unroll
-    for (int i = 0; i < NPARAM; ++i) {
-      __constant const float* G = params + 9 + 9 * i;
-      const float mx = G[0] * fu + G[1] * fv + G[2];
-      const float my = G[3] * fu + G[4] * fv + G[5];
-      const float mz = G[6] * fu + G[7] * fv + G[8];
-      J[i] = m * (gu * (mx - fu * mz) + gv * (my - fv * mz));
-    }
-    J[NPARAM] = m * gain * lI;
-    J[NPARAM + 1] = m;
-
-    // Huber weight and cost.
-    const float ar = fabs(r);
-    const int inlier = ar <= huber_k;
-    const float wgt = m * (inlier ? 1.0f : huber_k / ar);
-    const float rho = m * (inlier ? 0.5f * r * r : huber_k * (ar - 0.5f * huber_k));
-
-    int o = 0;
-#pragma unroll
-    for (int i = 0; i < NJ; ++i) {
-      const float wj = wgt * J[i];
-#pragma unroll
-      for (int j = i; j < NJ; ++j) acc[o++] += wj * J[j];
-    }
-#pragma unroll
-    for (int i = 0; i < NJ; ++i) acc[OUT_JTR + i] += wgt * J[i] * r;
-    acc[OUT_COST] += rho;
-    acc[OUT_WRR] += wgt * r * r;
-    acc[OUT_VALID] += m;
-    acc[OUT_INLIER] += inlier ? m : 0.0f;
-    acc[OUT_REF] += mref;
+    WR_PIXEL_SUMS(float, int)
 #if STATS
-    acc[OUT_RR] += r * r;
-    const float ic = m * (rI - 128.0f);
-    acc[OUT_IREF] += ic;
-    acc[OUT_IREF2] += ic * ic;
-    acc[OUT_GLIVE] += m * (lGu * lGu + lGv * lGv);
-    acc[OUT_GREF] += m * (rGu * rGu + rGv * rGv);
-    // The Huber cost's own Hessian (psi' = 1 inside k, 0 beyond) for the covariance: J^T J
-    // over the inliers, unweighted.
-    {
-      const float win = inlier ? m : 0.0f;
-      int oi = OUT_JTJ_IN;
-#pragma unroll
-      for (int i = 0; i < NJ; ++i) {
-        const float wj = win * J[i];
-#pragma unroll
-        for (int j = i; j < NJ; ++j) acc[oi++] += wj * J[j];
-      }
-    }
     // The histogram of |r| for the robust scale: a subsample (each work-item's first pixel)
     // is plenty for a median and saves most of its cost.
     if (k == 0) {
       acc[OUT_HVALID] += m;
 #pragma unroll
       for (int j = 0; j < HIST_BINS; ++j) {
-        // 0.25 * 2^(j/2): exact powers of two for even j, times sqrt(2) for odd j.
-        const float t = (j & 1) ? 0.35355339059327373f * (float)(1 << (j >> 1))
-                                : 0.25f * (float)(1 << (j >> 1));
-        acc[OUT_HIST + j] += ar < t ? m : 0.0f;
+        acc[OUT_HIST + j] += ar < wr_hist_threshold(j) ? m : 0.0f;
       }
     }
 #endif

@@ -299,10 +299,7 @@ AlignmentReport Aligner::align(std::vector<AlignmentPair>& pairs, Extrinsics* ex
         ++passes;
       }
     }
-    if (level == levels.finest) {
-      report.finest_stats = cur_;
-      report.finest_sigma = measured;
-    }
+    if (level == levels.finest) report.finest_sigma = measured;
     if (level == std::max(levels.finest, std::min(1, levels.coarsest))) report.match_stats = cur_;
     // A subsampled level is solved together with what the level before it found: that level's
     // estimate as a Gaussian prior with its J^T W J (in this level's noise units, (sigma_here /
@@ -345,7 +342,7 @@ AlignmentReport Aligner::align(std::vector<AlignmentPair>& pairs, Extrinsics* ex
       sums->cost += 0.5 * e.head(nl).dot(He);
     };
     for (size_t p = 0; p < P; ++p) apply_prior(p, pairs[p], &cur_[p]);
-    if (level == levels.finest) report.finest_stats = cur_;  // with the prior, for the covariance
+    if (level == levels.finest) report.finest_stats = cur_;  // with the prior (if any), for the covariance
 
     double lambda = 0.0;
     int steps = 0;
