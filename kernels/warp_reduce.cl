@@ -177,6 +177,25 @@ float wr_hist_threshold(const int j) {
 #define WR_STATS_SUMS(T)
 #endif
 
+// The kernel's arguments, one list for both forms (WarpReduce::run sets them by position):
+// params holds H (9, row-major), then G_0 .. G_{NPARAM-1} (9 each).
+#if SELECT
+#define WR_SELECT_ARG const int select_block,
+#else
+#define WR_SELECT_ARG
+#endif
+#ifdef DEBUG_OUTPUT
+#define WR_DEBUG_ARG , __global float4* debug
+#else
+#define WR_DEBUG_ARG
+#endif
+#define WR_KERNEL                                                                               \
+  __kernel __attribute__((reqd_work_group_size(WG_X, WG_Y, 1))) void warp_reduce(               \
+      __global const float4* ref, const int ref_stride, const int ref_w, const int ref_h,       \
+      __global const float4* live, const int live_stride, const int live_w, const int live_h,   \
+      __constant float* params, const float gain, const float bias, const float huber_k,        \
+      WR_SELECT_ARG __global float* partials WR_DEBUG_ARG)
+
 // The work-group's sums into its row of the partials: a tree reduction in local memory, one
 // column of WG values per output.
 void warp_reduce_store(const float* acc, __local float* scratch, __global float* partials) {
@@ -215,20 +234,7 @@ float wr_sum8(const float8 v) {
   return (h.x + h.y) + (h.z + h.w);
 }
 
-__kernel __attribute__((reqd_work_group_size(WG_X, WG_Y, 1)))
-void warp_reduce(__global const float4* ref, const int ref_stride, const int ref_w,
-                 const int ref_h, __global const float4* live, const int live_stride,
-                 const int live_w, const int live_h,
-                 __constant float* params,  // H (9, row-major), then G_0 .. G_{NPARAM-1} (9 each)
-                 const float gain, const float bias, const float huber_k,
-#if SELECT
-                 const int select_block,
-#endif
-                 __global float* partials
-#ifdef DEBUG_OUTPUT
-                 , __global float4* debug
-#endif
-) {
+WR_KERNEL {
   const int lx = (int)get_local_id(0);
   const int y = (int)get_global_id(1);
   const int x0 = (int)get_group_id(0) * (WG_X * PIX) + lx * 8;
@@ -349,20 +355,7 @@ void warp_reduce(__global const float4* ref, const int ref_stride, const int ref
 }
 
 #else  // LANES == 1: one pixel at a time
-__kernel __attribute__((reqd_work_group_size(WG_X, WG_Y, 1)))
-void warp_reduce(__global const float4* ref, const int ref_stride, const int ref_w,
-                 const int ref_h, __global const float4* live, const int live_stride,
-                 const int live_w, const int live_h,
-                 __constant float* params,  // H (9, row-major), then G_0 .. G_{NPARAM-1} (9 each)
-                 const float gain, const float bias, const float huber_k,
-#if SELECT
-                 const int select_block,
-#endif
-                 __global float* partials
-#ifdef DEBUG_OUTPUT
-                 , __global float4* debug
-#endif
-) {
+WR_KERNEL {
   const int lx = (int)get_local_id(0);
   const int y = (int)get_global_id(1);
   const int x0 = (int)get_group_id(0) * (WG_X * PIX) + lx;
