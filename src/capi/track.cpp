@@ -91,7 +91,12 @@ planarvo::track::TrackerOptions tracker_options_from_c(const planarvo_tracker_op
     if (options->struct_size >= offsetof(planarvo_tracker_options, level0_subsample) + sizeof(int32_t)) {
       require(options->level0_subsample >= 0 && options->level0_subsample <= 8,
               "planarvo_tracker_options.level0_subsample must be 0..8");
-      o.select_blocks[0] = options->level0_subsample >= 2 ? options->level0_subsample : 0;
+      const int b = options->level0_subsample;
+      if (o.finest_level < 0) {
+        if (b > 0) o.auto_finer_block = b;  // 0: the default's 3
+      } else {
+        o.select_blocks[static_cast<size_t>(o.finest_level)] = b >= 2 ? b : 0;
+      }
     }
   }
   return o;

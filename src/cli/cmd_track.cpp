@@ -257,11 +257,13 @@ int cmd_track(int argc, char** argv) {
       {"motions-out", "FILE", "write the tracked frame-to-frame motions, with the data set's odometry and direction "
                               "labels, as motion pairs (CSV) for calibrate --motions", ""},
       {"levels", "N", "pyramid levels", "4"},
-      {"finest-level", "N", "finest pyramid level tracked (0 = full resolution)", "the coarsest at least 320 px wide"},
+      {"finest-level", "N", "finest pyramid level tracked (0 = full resolution)",
+       "the coarsest at least 320 px wide, then the level below it subsampled (--level0-subsample)"},
       {"max-iterations", "N", "cap on alignment steps per level", "per-level defaults"},
-      {"level0-subsample", "B", "with --finest-level 0: full resolution on one pixel per BxB block, joined with "
-                                "half resolution (3: about 1.4x the default's time and more accurate in every measured scene; 2: about "
-                                "ECC's accuracy at about 0.7 of full resolution's cost)", "0"},
+      {"level0-subsample", "B", "align the finest level (level 0 at 640x480) on one pixel per BxB block, joined with "
+                                "the level above (1: every pixel; the default 3 takes about 1.4x the time of stopping "
+                                "at half resolution for 0.75 of its error; 1 takes about 2.5x)",
+       "3 with the automatic finest level, else 1"},
       {"video", "FILE", "a video file standing in for images/ and frames.txt", ""},
       roi_option("camera.yaml's region_of_interest, else the whole image"),
       {"skip-bad-frames", "", "a missing or undecodable image is a gap (a warning, a \"skipped\" statistics row, "
@@ -288,9 +290,7 @@ int cmd_track(int argc, char** argv) {
   o.levels = args.get_int_in("levels", o.levels, 1, 8);
   if (args.has("finest-level")) o.finest_level = args.get_int_in("finest-level", 0, 0, o.levels - 1);
   o.max_iterations = args.get_int_in("max-iterations", 0, 1, 1000);
-  o.level0_subsample = args.get_int_in("level0-subsample", 0, 0, 8);
-  if (o.level0_subsample > 1 && o.finest_level != 0)
-    throw UsageError("--level0-subsample subsamples full resolution: it needs --finest-level 0");
+  o.level0_subsample = args.get_int_in("level0-subsample", 0, 1, 8);
   const std::optional<planarvo_region> roi = parse_roi(args);  // before any file is read
   const double max_lost = args.get_double("max-lost", 5.0);
   if (!(max_lost >= 0.0 && max_lost <= 100.0))

@@ -98,6 +98,27 @@ PairBlock pair_block(const ReduceSums& s, int nl, bool orientation) {
   return b;
 }
 
+// The state of a pair relative to the prior's (the coarser level's estimate), in the pass's local
+// order: the motion in SE(2)'s tangent space, then log-gain and bias.
+Vector5d prior_error(const AlignmentPair& prior, const AlignmentPair& state) {
+  Vector5d e;
+  e.head<3>() = (prior.motion.inverse() * state.motion).log();
+  e(3) = state.log_gain - prior.log_gain;
+  e(4) = state.bias - prior.bias;
+  return e;
+}
+
+// Why the prior is tested (prior_consistency_scale, aligner.h): a rear camera 55 degrees from
+// vertical over asphalt, where half resolution blurs the foreshortened far field differently as
+// the view moves: its estimate is 10-15 of its standard deviations off, and with the prior at
+// full weight the subsample kept that bias (0.19 mm per frame where full resolution has 0.06).
+double prior_scale_of(const ReduceSums& data, const MatrixL& H, const Vector5d& e, int nl, double sigma,
+                      double chi2) {
+  const PairBlock b = pair_block(data, nl, false);
+  return prior_consistency_scale(MatrixL(b.A_ll.topLeftCorner(nl, nl)), VectorL(b.g_l.head(nl)), H,
+                                 e.head<3>(), sigma, chi2);
+}
+
 // Levenberg's damping H_ii (1 + lambda) plus a ridge of 1e-12 of the largest diagonal entry, so
 // that a parameter the images do not constrain at all gives a finite step.
 template <typename M>
@@ -108,6 +129,29 @@ void damp(M* A, int n, double lambda) {
 }
 
 }  // namespace
+
+double prior_consistency_scale(const PriorMatrix& A, const PriorVector& g, const PriorMatrix& H,
+                               const Eigen::Vector3d& e_motion, double sigma, double chi2) {
+  if (!(chi2 > 0.0)) return 1.0;
+  const int n = static_cast<int>(A.rows());
+  const Eigen::LDLT<PriorMatrix> Al(A), Hl(H);
+  if (Al.info() != Eigen::Success || Hl.info() != Eigen::Success || !Al.isPositive() || !Hl.isPositive()) return 1.0;
+  const PriorVector step = -Al.solve(g);
+  const Eigen::Vector3d dm = e_motion + step.head<3>();
+  const PriorMatrix I = PriorMatrix::Identity(n, n);
+  const Eigen::Matrix3d C0 = sigma * sigma * Al.solve(I).topLeftCorner<3, 3>();
+  const Eigen::Matrix3d C1 = sigma * sigma * Hl.solve(I).topLeftCorner<3, 3>();
+  auto d2 = [&](double scale) { return dm.dot((C0 + C1 / scale).ldlt().solve(dm)); };
+  if (!(d2(1.0) > chi2)) return 1.0;  // consistent (or not finite)
+  // d2 increases with the scale: bisection in log scale down to 1e-6 (below it, no prior).
+  double lo = std::log(1e-6), hi = 0.0;
+  if (d2(std::exp(lo)) > chi2) return 0.0;
+  for (int i = 0; i < 30; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    (d2(std::exp(mid)) > chi2 ? hi : lo) = mid;
+  }
+  return std::exp(lo);
+}
 
 Aligner::Aligner(ocl::Runtime& runtime, const Eigen::Matrix3d& K, const AlignerOptions& options,
                  bool with_orientation)
@@ -120,6 +164,7 @@ Aligner::Aligner(ocl::Runtime& runtime, const Eigen::Matrix3d& K, const AlignerO
   // reaches their level.
   for (int b : options.select_blocks)
     if (b >= 2) select_passes(b);
+  if (options.finest_level < 0 && options.auto_finer_block >= 2) select_passes(options.auto_finer_block);
 }
 
 std::array<std::unique_ptr<WarpReduce>, 2>& Aligner::select_passes(int block) {
@@ -141,12 +186,18 @@ AlignmentLevels Aligner::levels(const Pyramid& reference, const Pyramid& live) c
                    live.levels[static_cast<size_t>(n - 1)].height < kMinLevelSide))
     --n;
   r.coarsest = std::max(0, n - 1);
+  r.select_block = options_.select_blocks;
   int finest = options_.finest_level;
   if (finest < 0) {
     finest = 0;
     while (finest < r.coarsest &&
            live.levels[static_cast<size_t>(finest + 1)].width >= options_.min_finest_width)
       ++finest;
+    if (finest > 0 && options_.auto_finer_block >= 1) {
+      --finest;
+      int& b = r.select_block[static_cast<size_t>(finest)];
+      if (b < 2) b = options_.auto_finer_block >= 2 ? options_.auto_finer_block : 0;
+    }
   }
   r.finest = std::clamp(finest, 0, r.coarsest);
   return r;
@@ -311,18 +362,18 @@ AlignmentReport Aligner::align(std::vector<AlignmentPair>& pairs, Extrinsics* ex
     prior_H.assign(P, MatrixL());
     if (options_.subsample_prior && have_prev_ && !with_orientation_)
       for (size_t p = 0; p < P; ++p)
-        if (selection_at(pairs[p], level) != nullptr && prev_sigma_[p] > 0.0)
+        if (selection_at(pairs[p], level) != nullptr && prev_sigma_[p] > 0.0) {
           prior_H[p] = std::pow(measured[p] / prev_sigma_[p], 2) *
                        pair_block(prev_sums_[p], nl, false).A_ll.topLeftCorner(nl, nl);
+          prior_H[p] *= prior_scale_of(cur_[p], prior_H[p], prior_error(prev_state_[p], pairs[p]), nl,
+                                                measured[p], options_.prior_chi2);
+        }
     auto apply_prior = [&](size_t p, const AlignmentPair& state, ReduceSums* sums) {
       const MatrixL& H = prior_H[p];
       if (H.rows() == 0) return;
       const int np = static_cast<int>(sums->JtWr.size()) - 2;
       const int idx[5] = {0, 1, 2, np, np + 1};
-      Vector5d e = Vector5d::Zero();
-      e.head<3>() = (prev_state_[p].motion.inverse() * state.motion).log();
-      e(3) = state.log_gain - prev_state_[p].log_gain;
-      e(4) = state.bias - prev_state_[p].bias;
+      const Vector5d e = prior_error(prev_state_[p], state);
       const VectorL He = H * e.head(nl);
       // For the covariance's sandwich (tracker.cpp): the prior is the Huber cost's Hessian too,
       // and its score, H e with e's covariance sigma_there^2 A_there^-1, has the covariance

@@ -38,12 +38,16 @@ struct AlignerOptions {
   // Pyramid levels used, coarsest first: levels - 1 down to finest_level. Levels smaller than
   // 8x8 pixels are skipped.
   int levels = 4;
-  // The finest level aligned: 0 is full resolution; 1 stops at half resolution, a third of
-  // the time for 5-8 instead of 2-3 micrometres RMS per frame at 640x480 on the simulator
-  // (src/track/README.md). -1 (the default): the coarsest level at least min_finest_width pixels
-  // wide (level 1 at 640x480, level 0 at 320x240).
+  // The finest level aligned: 0 is full resolution. -1 (the default): the coarsest level at
+  // least min_finest_width pixels wide, A, on every pixel, and then (when A > 0) the level below
+  // it on one pixel per auto_finer_block x auto_finer_block block with A's estimate as a prior
+  // (select_blocks, subsample_prior): at 640x480 level 1 and then level 0 at 1/9, 1.4 times the
+  // time of stopping at level 1 for about 0.75 of its error and 0.5-0.75 of its worst frame
+  // (src/track/README.md, "The default"); at 320x240 level 0 on every pixel. auto_finer_block 1:
+  // the level below A on every pixel; 0: stop at A.
   int finest_level = -1;
   int min_finest_width = 320;
+  int auto_finer_block = 3;
   // Gauss-Newton steps per level, index = level (each step costs one fused pass per pair at that
   // level except the last, which is applied without checking when it is below convergence_px).
   std::array<int, kMaxLevels> max_iterations = {2, 6, 10, 12, 12, 12, 12, 12};
@@ -63,6 +67,13 @@ struct AlignerOptions {
   // keyframe); 0 or 1: every pixel of the level.
   std::array<int, kMaxLevels> select_blocks = {0, 0, 0, 0, 0, 0, 0, 0};
   bool subsample_prior = true;
+  // The prior's covariance is inflated when the subsampled level's own estimate and the prior
+  // differ by more than their covariances explain (prior_consistency_scale below): until the
+  // difference's chi-square (3 degrees of freedom) is prior_chi2. 3, its expected value, matches
+  // the covariance to the discrepancy (as adaptive Kalman filters match innovations); 11.34 (1 %
+  // of consistent cases) kept the rear cameras' NEES at 8-9 and their worst frames 5-10 % larger
+  // (src/track/README.md, "The default"). 0: the prior always at full weight.
+  double prior_chi2 = 3.0;
   // Estimate the affine brightness change (r = e^a I_l + b - I_r) jointly with the motion.
   bool estimate_brightness = true;
   // Levenberg damping: H + lambda diag(H); lambda starts at 0 (Gauss-Newton) and grows by
@@ -95,6 +106,9 @@ struct AlignmentPair {
 
 struct AlignmentLevels {
   int coarsest = 0, finest = 0;
+  // Per level: B >= 2 aligns one pixel per B x B block of the reference (a tracker's keyframe
+  // selection at that level); 0, every pixel.
+  std::array<int, kMaxLevels> select_block{};
 };
 
 struct AlignmentReport {
@@ -145,6 +159,19 @@ bool solve_joint(const std::vector<ReduceSums>& sums, bool brightness, bool orie
 // The tilt's information with every pair's block marginalised (undamped Schur complement).
 Eigen::Matrix2d joint_orientation_information(const std::vector<ReduceSums>& sums, bool brightness);
 
+// A subsampled level's prior (the coarser level's estimate, information H in this level's noise
+// units: covariance sigma^2 H^-1, n x n over motion and brightness, n = 3 or 5) against the
+// level's own data (A = J^T W J, g = J^T W r at the state, which lies at `e_motion` from the
+// prior): the data alone's estimate is one Gauss-Newton step, -A^-1 g, from the state; its
+// motion's difference dm from the prior has d^2 = dm^T (sigma^2 (A^-1 + H^-1)_motion)^-1 dm,
+// chi-square with 3 degrees of freedom when both covariances are right. Returns 1 when d^2 <=
+// chi2 (or chi2 <= 0), else the factor s on H that makes the inflated prior explain the
+// difference (d^2 with H^-1 / s equal to chi2), 0 below 1e-6.
+using PriorMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 5, 5>;
+using PriorVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 5, 1>;
+double prior_consistency_scale(const PriorMatrix& A, const PriorVector& g, const PriorMatrix& H,
+                               const Eigen::Vector3d& e_motion, double sigma, double chi2);
+
 class Aligner {
  public:
   // K: the camera matrix of level 0 (undistorted pinhole). with_orientation: the pairs share the
@@ -152,7 +179,8 @@ class Aligner {
   Aligner(ocl::Runtime& runtime, const Eigen::Matrix3d& K, const AlignerOptions& options,
           bool with_orientation);
 
-  // The levels to align for pyramids like these (options' levels and finest_level).
+  // The levels to align for pyramids like these (options' levels, finest_level, select_blocks
+  // and auto_finer_block).
   AlignmentLevels levels(const Pyramid& reference, const Pyramid& live) const;
 
   // Aligns every pair from its current estimate, coarse to fine over `levels`, updating the

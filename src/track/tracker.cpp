@@ -60,6 +60,8 @@ CameraModel validated(const CameraModel& c, const Extrinsics& e, const TrackerOp
   if (!(e.z > 0.0)) throw_invalid_argument("Tracker: the camera height z must be positive");
   for (int b : o.select_blocks)
     if (b < 0 || b > 16) throw_invalid_argument("TrackerOptions::select_blocks must be 0..16");
+  if (o.auto_finer_block < 0 || o.auto_finer_block > 16)
+    throw_invalid_argument("TrackerOptions::auto_finer_block must be 0..16");
   if (!(o.keyframe_scale_change > 0.0))
     throw_invalid_argument("TrackerOptions::keyframe_scale_change must be positive");
   if (!(o.covariance_step_fraction >= 0.0))
@@ -96,7 +98,7 @@ struct Tracker::Impl {
 
   Pyramid keyframe;
   bool has_keyframe = false;
-  // The keyframe's selected pixels per level (AlignerOptions::select_blocks).
+  // The keyframe's selected pixels per level (AlignmentLevels::select_block).
   PixelSelector selector;
   std::array<SelectedPixels, kMaxLevels> selection;
   // The camera-frame path: the pipeline and two pyramids, one the keyframe's (aliased by
@@ -316,10 +318,13 @@ struct Tracker::Impl {
         rt.queue().enqueueCopyBuffer(src.data, dst.data, 0, 0, bytes);
       }
     }
+    const AlignmentLevels levels = aligner.levels(keyframe, keyframe);
     for (int l = 0; l < keyframe.num_levels() && l < kMaxLevels; ++l) {
       const auto L = static_cast<size_t>(l);
-      if (opt.select_blocks[L] >= 2)
-        selector.run(keyframe.levels[L], l, opt.select_blocks[L], &selection[L]);
+      if (levels.select_block[L] >= 2)
+        selector.run(keyframe.levels[L], l, levels.select_block[L], &selection[L]);
+      else
+        selection[L] = SelectedPixels();
     }
     has_keyframe = true;
     prev = Estimate();

@@ -10,7 +10,7 @@
 //        off by +10,-10,+10 mm and +2.5,-2.5,+2.5 deg), ext=x,y,z,roll,pitch,yaw (m, deg; instead
 //        of config), fov=deg, motion=...|car, speed=m/s, turn=rad/s, radius=m (car), noise=grey
 //        levels, select=B0,B1,.. (level l on one pixel per Bl x Bl block), prior=0|1 (a
-//        subsampled level joined with the level before it), the fused pass's lanes=1|8, pix=N,
+//        subsampled level joined with the level before it), prior_chi2=X (its consistency test; 0: off), the fused pass's lanes=1|8, pix=N,
 //        wg=XxY; scene extras ss=N (the renderer's supersampling), mip=0|1; BENCH_VERBOSE=1 adds per-level
 //        times, the slowest frames and the frames not tracked ok; see main())
 //   bench_track nees [key=value...]         NEES of the covariances (alignment and frame-to-frame
@@ -166,6 +166,8 @@ struct SequenceReport {
   double ms_frame = 0, ms_pipeline = 0, cpu_frame = 0;
   std::vector<double> ms;  // per frame after the first (which builds the programs and the first keyframe)
   std::vector<std::array<double, 5>> slow;  // verbose: (ms, frame, keyframe, passes, pipeline ms) per frame
+  // verbose: (error mm, frame, frames since the keyframe, speed m/s, error / reported position std) per frame
+  std::vector<std::array<double, 5>> worst;
   double passes[kMaxLevelsBench] = {};
   double level_ms[kMaxLevelsBench] = {};
   double std_pos_median = 0, std_pos_max = 0, std_head_median = 0, nees = 0, aniso_max = 0;
@@ -183,7 +185,7 @@ SequenceReport run_sequence(ocl::Runtime& rt, const sim::Options& so, const trac
   std::vector<SE2> est, truth;
   std::vector<double> dts, std_pos, std_head;
   double nees = 0;
-  int nees_n = 0;
+  int nees_n = 0, since_kf = 0;
   for (size_t k = 0; k < traj.t.size(); ++k) {
     const cv::Mat img = bench::camera_frame(renderer, so, traj, exposure, k);
     const double c0 = cpu_ms();
@@ -213,6 +215,11 @@ SequenceReport run_sequence(ocl::Runtime& rt, const sim::Options& so, const trac
     truth.push_back(t);
     dts.push_back(traj.t[k] - traj.t[k - 1]);
     const double e = std::hypot(r.motion.value.x - t.x, r.motion.value.y - t.y);
+    since_kf = r.keyframe ? 0 : since_kf + 1;
+    if (verbose)
+      rep.worst.push_back({e * 1e3, static_cast<double>(k), static_cast<double>(since_kf),
+                           std::hypot(t.x, t.y) / (traj.t[k] - traj.t[k - 1]),
+                           e / std::sqrt(std::max(1e-30, std::max(r.motion.covariance(0, 0), r.motion.covariance(1, 1))))});
     if (r.status == track::FrameResult::Status::Ok) {
       std_pos.push_back(std::sqrt(std::max(r.motion.covariance(0, 0), r.motion.covariance(1, 1))));
       std_head.push_back(std::sqrt(r.motion.covariance(2, 2)));
@@ -277,6 +284,12 @@ int bench_accuracy(const std::vector<std::string>& textures, double seconds, int
       std::printf("  slowest frames (ms, frame, keyframe, passes, pipeline ms):");
       for (size_t i = 0; i < slow.size() && i < 6; ++i)
         std::printf(" (%.2f %.0f %.0f %.0f %.2f)", slow[i][0], slow[i][1], slow[i][2], slow[i][3], slow[i][4]);
+      std::printf("\n");
+      std::vector<std::array<double, 5>> worst = r.worst;
+      std::sort(worst.begin(), worst.end(), [](const auto& a, const auto& b) { return a[0] > b[0]; });
+      std::printf("  largest errors (mm, frame, frames since the keyframe, speed m/s, error / std):");
+      for (size_t i = 0; i < worst.size() && i < 6; ++i)
+        std::printf(" (%.3f %.0f %.0f %.2f %.1f)", worst[i][0], worst[i][1], worst[i][2], worst[i][3], worst[i][4]);
       std::printf("\n");
       std::printf("  mean ms per level, coarse to fine:");
       for (int l = topt.levels - 1; l >= 0; --l) std::printf(" %.2f", r.level_ms[l] / n);
@@ -487,26 +500,27 @@ int bench_speed(int width, int height, double seconds, int rounds) {
   std::vector<Config> configs;
   {
     track::TrackerOptions o;
-    configs.push_back({"default (finest auto)", o});
+    configs.push_back({"default (level 1, level 0 at 1/9)", o});
     o.kernel.lanes = 1;  // the fused pass one pixel at a time, as before float8
     configs.push_back({"default, per-pixel pass", o});
-    o.finest_level = 0;
-    configs.push_back({"finest 0, per-pixel pass", o});
-    o.kernel.lanes = 8;
-    configs.push_back({"finest level 0", o});
-    o.select_blocks[0] = 4;
-    configs.push_back({"level 0 at 1/16 + prior", o});
-    o.select_blocks[0] = 3;
-    configs.push_back({"level 0 at 1/9 + prior", o});
-    o.select_blocks[0] = 2;
-    configs.push_back({"level 0 at 1/4 + prior", o});
-    o.select_blocks[0] = 0;
-    o.finest_level = -1;
-    o.refine_keyframes = true;
-    configs.push_back({"auto + refine keyframes", o});
-    o.refine_keyframes = false;
-    o.levels = 3;
-    configs.push_back({"3 levels", o});
+    track::TrackerOptions h;
+    h.finest_level = 1;
+    configs.push_back({"half resolution (finest 1)", h});
+    h.refine_keyframes = true;
+    configs.push_back({"finest 1 + refine keyframes", h});
+    track::TrackerOptions f;
+    f.finest_level = 0;
+    configs.push_back({"full resolution (finest 0)", f});
+    f.kernel.lanes = 1;
+    configs.push_back({"finest 0, per-pixel pass", f});
+    f.kernel.lanes = 8;
+    f.select_blocks[0] = 4;
+    configs.push_back({"level 0 at 1/16 + prior", f});
+    f.select_blocks[0] = 2;
+    configs.push_back({"level 0 at 1/4 + prior", f});
+    track::TrackerOptions l3;
+    l3.levels = 3;
+    configs.push_back({"3 levels", l3});
   }
   struct Stats {
     std::vector<double> frame, pipe, track;
@@ -591,6 +605,7 @@ int main(int argc, char** argv) {
         for (size_t l = 0; l < b.size() && l < topt.select_blocks.size(); ++l) topt.select_blocks[l] = std::atoi(b[l].c_str());
       }
       else if (k == "prior") topt.subsample_prior = std::atoi(v.c_str()) != 0;
+      else if (k == "prior_chi2") topt.prior_chi2 = std::atof(v.c_str());
       else if (k == "lanes") topt.kernel.lanes = std::atoi(v.c_str());
       else if (k == "pix") topt.kernel.pixels_per_item = std::atoi(v.c_str());
       else if (k == "wg") {  // wg=16x4
@@ -633,6 +648,7 @@ int main(int argc, char** argv) {
       else if (k == "seed") seed = std::strtoull(v.c_str(), nullptr, 10);
       else if (k == "noise") noise = std::atof(v.c_str());
       else if (k == "prior") topt.subsample_prior = std::atoi(v.c_str()) != 0;
+      else if (k == "prior_chi2") topt.prior_chi2 = std::atof(v.c_str());
       else if (k == "conv") topt.convergence_px = std::atof(v.c_str());
       else if (k == "huber") topt.huber_factor = std::atof(v.c_str());
       else if (k == "brightness") topt.estimate_brightness = std::atoi(v.c_str()) != 0;

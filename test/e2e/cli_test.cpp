@@ -229,8 +229,7 @@ TEST(Cli, UsageErrorsSayWhatWasWrong) {
       {"track d --roi 0,0,100", "--roi needs 4 comma-separated numbers"},
       {"track d --roi 0,0,100.5,100", "--roi needs four non-negative integers"},
       {"calibrate d --roi 5,5,0,0", "--roi: give a width and a height"},
-      {"track d --level0-subsample 2", "--level0-subsample subsamples full resolution: it needs --finest-level 0"},
-      {"track d --finest-level 0 --level0-subsample 9", "--level0-subsample must be 0 to 8"},
+      {"track d --finest-level 0 --level0-subsample 9", "--level0-subsample must be 1 to 8"},
       // Output files never get directories made for them (simulate --out and kernels --export,
       // which name directories, do).
       {"track d -o /nonexistent-planarvo/t.txt", "-o: the directory /nonexistent-planarvo does not exist"},

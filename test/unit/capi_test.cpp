@@ -419,6 +419,70 @@ TEST(CApiTracker, Level0SubsampleIsCheckedOnlyWhenTheStructHasIt) {
   planarvo_context_destroy(c);
 }
 
+// level0_subsample's meaning at 640x480, where the automatic finest level is level 0 after
+// level 1: 0 with finest_level -1 is the same tracking as finest_level 0 with 3 (one pixel per
+// 3x3 block), 1 with -1 the same as finest_level 0 on every pixel; finest_level 1 never reaches
+// level 0.
+TEST(CApiTracker, Level0SubsampleWithTheAutomaticFinestLevel) {
+  planarvo_context* c = make_context();
+  ScratchDir dir;
+  planarvo_sim_options so;
+  planarvo_sim_options_init(&so);
+  const std::string tex = planarvo::test::texture("asphalt_01.png").string();
+  so.texture = tex.c_str();
+  so.seconds = 0.2;
+  ASSERT_EQ(planarvo_sim_default_camera(640, 480, 80.0, &so.camera), PLANARVO_OK);
+  ASSERT_EQ(planarvo_simulate(c, &so, dir.path().c_str()), PLANARVO_OK) << planarvo_last_error();
+  planarvo_dataset* d = nullptr;
+  ASSERT_EQ(planarvo_dataset_open(dir.path().c_str(), nullptr, &d), PLANARVO_OK);
+  struct Run {
+    int32_t finest, block;
+    std::vector<planarvo_se2> motions;
+    std::vector<int32_t> level0_steps;
+  };
+  std::vector<Run> runs = {{-1, 0, {}, {}}, {0, 3, {}, {}}, {-1, 1, {}, {}}, {0, 0, {}, {}}, {1, 0, {}, {}}};
+  for (Run& run : runs) {
+    planarvo_tracker_options o;
+    planarvo_tracker_options_init(&o);
+    o.finest_level = run.finest;
+    o.level0_subsample = run.block;
+    planarvo_tracker* t = nullptr;
+    ASSERT_EQ(planarvo_tracker_create(c, &so.camera, &so.extrinsics, &o, &t), PLANARVO_OK) << planarvo_last_error();
+    planarvo_image img{};
+    planarvo_frame_data f{};
+    planarvo_track_result r{};
+    r.struct_size = sizeof r;
+    for (int64_t i = 0; i < 6; ++i) {
+      ASSERT_EQ(planarvo_dataset_frame(d, i, &img), PLANARVO_OK);
+      ASSERT_EQ(planarvo_dataset_frame_data(d, i, &f), PLANARVO_OK);
+      ASSERT_EQ(planarvo_tracker_track(t, &img, f.timestamp, &r), PLANARVO_OK) << planarvo_last_error();
+      if (i == 0) continue;
+      EXPECT_EQ(r.status, PLANARVO_TRACK_OK) << i << " " << r.reason;
+      run.motions.push_back(r.motion);
+      run.level0_steps.push_back(r.iterations[0]);
+    }
+    planarvo_tracker_destroy(t);
+  }
+  auto same = [](const Run& a, const Run& b) {
+    ASSERT_EQ(a.motions.size(), b.motions.size());
+    for (size_t i = 0; i < a.motions.size(); ++i) {
+      EXPECT_EQ(a.motions[i].x, b.motions[i].x) << i;
+      EXPECT_EQ(a.motions[i].y, b.motions[i].y) << i;
+      EXPECT_EQ(a.motions[i].theta, b.motions[i].theta) << i;
+    }
+  };
+  same(runs[0], runs[1]);
+  same(runs[2], runs[3]);
+  EXPECT_NE(runs[0].motions[2].x, runs[2].motions[2].x) << "1/9 and every pixel differ";
+  for (size_t i = 0; i < runs[0].level0_steps.size(); ++i) {
+    EXPECT_GT(runs[0].level0_steps[i], 0) << i;
+    EXPECT_GT(runs[2].level0_steps[i], 0) << i;
+    EXPECT_EQ(runs[4].level0_steps[i], 0) << i;
+  }
+  planarvo_dataset_destroy(d);
+  planarvo_context_destroy(c);
+}
+
 TEST(CApiTracker, EvaluateMotionsChecksItsArguments) {
   planarvo_motion_accuracy a{};
   const planarvo_se2 m[2] = {{0.01, 0, 0}, {0.01, 0, 0.01}};

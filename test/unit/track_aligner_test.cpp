@@ -1,12 +1,14 @@
 // The aligner's joint solve (track/aligner.h: each pair's block eliminated onto the shared tilt,
 // then back-substitution) against a dense solve of the whole assembled system, and the tilt's
-// information against the inverse of the dense covariance's tilt block.
+// information against the inverse of the dense covariance's tilt block; the levels it aligns
+// (AlignerOptions::finest_level's automatic rule) against the rule worked by hand.
 #include <random>
 #include <vector>
 
 #include <Eigen/Dense>
 #include <gtest/gtest.h>
 
+#include "ocl/runtime.h"
 #include "track/aligner.h"
 
 namespace planarvo::track {
@@ -97,6 +99,100 @@ TEST(AlignerJointSolve, WithoutTheTiltEachPairIsItsOwnSystem) {
   const Eigen::Vector3d motion = -A3.ldlt().solve(s.JtWr.head(3));
   for (int k = 0; k < 3; ++k) EXPECT_NEAR(step.local[0](k), motion(k), 1e-9 * (1 + std::abs(motion(k))));
   EXPECT_EQ(step.local[0](3), 0.0);
+}
+
+// Pyramid shapes only: Aligner::levels reads the levels' sizes, not their pixels.
+Pyramid shape(int width, int height, int levels) {
+  Pyramid p;
+  for (int l = 0; l < levels; ++l) {
+    PyramidLevel L;
+    L.width = width >> l;
+    L.height = height >> l;
+    p.levels.push_back(L);
+  }
+  return p;
+}
+
+// finest_level -1: A = the coarsest level at least 320 px wide on every pixel, then level A - 1
+// on one pixel per 3x3 block (auto_finer_block); explicit levels and blocks are taken as given.
+TEST(AlignerLevels, TheAutomaticFinestLevelIsTheOneBelowTheCoarsestAtLeast320Wide) {
+  ocl::Runtime rt;
+  const Eigen::Matrix3d K = Eigen::Matrix3d::Identity();
+  struct Case {
+    int w, h, finest_level, auto_block, select0;
+    int want_finest, want_block_at_finest;
+  };
+  const Case cases[] = {
+      {640, 480, -1, 3, 0, 0, 3},    // A = 1: level 0 at 1/9
+      {320, 240, -1, 3, 0, 0, 0},    // A = 0: level 0 on every pixel
+      {1280, 960, -1, 3, 0, 1, 3},   // A = 2: level 1 at 1/9
+      {640, 480, -1, 0, 0, 1, 0},    // auto_finer_block 0: stop at A
+      {640, 480, -1, 1, 0, 0, 0},    // 1: level A - 1 on every pixel
+      {640, 480, -1, 3, 4, 0, 4},    // an explicit block at that level wins
+      {640, 480, 0, 3, 0, 0, 0},     // an explicit finest level: every pixel
+      {640, 480, 0, 3, 2, 0, 2},
+      {640, 480, 2, 3, 0, 2, 0},
+  };
+  for (const Case& c : cases) {
+    AlignerOptions o;
+    o.finest_level = c.finest_level;
+    o.auto_finer_block = c.auto_block;
+    o.select_blocks[0] = c.select0;
+    Aligner aligner(rt, K, o, false);
+    const Pyramid p = shape(c.w, c.h, 4);
+    const AlignmentLevels L = aligner.levels(p, p);
+    EXPECT_EQ(L.coarsest, 3) << c.w;
+    EXPECT_EQ(L.finest, c.want_finest) << c.w << "x" << c.h << " finest_level " << c.finest_level << " block " << c.auto_block;
+    EXPECT_EQ(L.select_block[static_cast<size_t>(L.finest)], c.want_block_at_finest)
+        << c.w << "x" << c.h << " finest_level " << c.finest_level << " block " << c.auto_block;
+    for (int l = L.finest + 1; l <= L.coarsest; ++l) EXPECT_EQ(L.select_block[static_cast<size_t>(l)], 0) << l;
+  }
+}
+
+// The subsampled level's prior test (prior_consistency_scale) against the same algebra done with
+// dense inverses: 1 when the data's own estimate lies within chi2 of the prior, else the factor
+// on H at which the inflated prior's d^2 equals chi2.
+TEST(AlignerPrior, ConsistencyScaleInflatesThePriorUntilItExplainsTheDifference) {
+  std::mt19937 rng(4);
+  std::normal_distribution<double> n;
+  int consistent = 0, scaled = 0;
+  for (int nl : {3, 5}) {
+    Eigen::MatrixXd J(60, nl), Jp(60, nl);
+    for (int i = 0; i < 60; ++i)
+      for (int j = 0; j < nl; ++j) {
+        J(i, j) = n(rng) * (j < 3 ? 50.0 : 5.0);
+        Jp(i, j) = n(rng) * (j < 3 ? 80.0 : 5.0);
+      }
+    const Eigen::MatrixXd A = J.transpose() * J, H = Jp.transpose() * Jp;
+    const double sigma = 1.7, chi2 = 3.0;
+    // The dense reference: d^2(scale) of the data's one-step estimate against the prior.
+    auto d2 = [&](const Eigen::VectorXd& g, const Eigen::Vector3d& e, double scale) {
+      const Eigen::VectorXd step = -A.inverse() * g;
+      const Eigen::Vector3d dm = e + step.head<3>();
+      const Eigen::Matrix3d C = sigma * sigma * (A.inverse().topLeftCorner<3, 3>() + H.inverse().topLeftCorner<3, 3>() / scale);
+      return dm.dot(C.inverse() * dm);
+    };
+    for (double size : {0.1, 1.0, 10.0, 100.0}) {
+      Eigen::VectorXd g(nl);
+      for (int i = 0; i < nl; ++i) g(i) = n(rng) * size * sigma * 50.0;
+      const Eigen::Vector3d e(n(rng) * size * 0.01, n(rng) * size * 0.01, n(rng) * size * 0.01);
+      const double s = prior_consistency_scale(PriorMatrix(A), PriorVector(g), PriorMatrix(H), e, sigma, chi2);
+      const double at1 = d2(g, e, 1.0);
+      if (at1 <= chi2) {
+        EXPECT_EQ(s, 1.0) << "nl " << nl << " size " << size << " d2 " << at1;
+        ++consistent;
+      } else if (s > 0.0) {
+        ++scaled;
+        EXPECT_LT(s, 1.0);
+        EXPECT_NEAR(d2(g, e, s), chi2, 1e-5 * chi2) << "nl " << nl << " size " << size;
+      } else {
+        EXPECT_GT(d2(g, e, 1e-6), chi2);
+      }
+      EXPECT_EQ(prior_consistency_scale(PriorMatrix(A), PriorVector(g), PriorMatrix(H), e, sigma, 0.0), 1.0);
+    }
+  }
+  EXPECT_GT(consistent, 0);
+  EXPECT_GT(scaled, 0);
 }
 
 }  // namespace
