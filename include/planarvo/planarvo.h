@@ -422,7 +422,7 @@ typedef struct planarvo_tracker_options {
    * a fraction of its cost. Named for 640x480 images, where the finest level is level 0 (full
    * resolution). With finest_level -1: 0 (the default) is B = 3, so 640x480 is tracked to half
    * resolution and then on one full-resolution pixel in 9 (1.4 times the time of stopping at half
-   * resolution, for 0.75 of its error); at 320x240, A is level 0 and nothing is subsampled. With
+   * resolution, for 0.6-0.9 of its RMS error); at 320x240, A is level 0 and nothing is subsampled. With
    * finest_level >= 0: 0 is every pixel of that level. 1: every pixel; 2..8: B. Read only when
    * struct_size covers it (when it does not: B = 3 with finest_level -1, else every pixel). */
   int32_t level0_subsample;

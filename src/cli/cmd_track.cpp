@@ -262,7 +262,7 @@ int cmd_track(int argc, char** argv) {
       {"max-iterations", "N", "cap on alignment steps per level", "per-level defaults"},
       {"level0-subsample", "B", "align the finest level (level 0 at 640x480) on one pixel per BxB block, joined with "
                                 "the level above (1: every pixel; the default 3 takes about 1.4x the time of stopping "
-                                "at half resolution for 0.75 of its error; 1 takes about 2.5x)",
+                                "at half resolution for 0.6-0.9 of its RMS error; 1 takes about 2.5x)",
        "3 with the automatic finest level, else 1"},
       {"video", "FILE", "a video file standing in for images/ and frames.txt", ""},
       roi_option("camera.yaml's region_of_interest, else the whole image"),

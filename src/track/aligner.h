@@ -42,7 +42,7 @@ struct AlignerOptions {
   // least min_finest_width pixels wide, A, on every pixel, and then (when A > 0) the level below
   // it on one pixel per auto_finer_block x auto_finer_block block with A's estimate as a prior
   // (select_blocks, subsample_prior): at 640x480 level 1 and then level 0 at 1/9, 1.4 times the
-  // time of stopping at level 1 for about 0.75 of its error and 0.5-0.75 of its worst frame
+  // time of stopping at level 1 for 0.6-0.9 of its RMS error and 0.3-1.0 of its worst frame
   // (src/track/README.md, "The default"); at 320x240 level 0 on every pixel. auto_finer_block 1:
   // the level below A on every pixel; 0: stop at A.
   int finest_level = -1;
