@@ -47,11 +47,12 @@ struct Scene {
   double fov = 80.0, speed = 0.8, turn = 1.5, radius = 0.0, noise = 1.0;
   int supersampling = 3;  // ss=N: the renderer's subsamples per pixel along each axis
   bool mipmap = true;     // mip=0: no prefiltered texture (only the subsamples average)
+  bool distortion = true; // dist=0: a pinhole camera (no lens distortion, so no resampling of the noise)
   sim::MotionProfile motion = sim::MotionProfile::Mixed;
 
   Extrinsics extrinsics() const { return has_ext ? ext : sim::paper_configuration(config); }
 
-  // Takes one key=value argument: config, ext, fov, motion, speed, turn, radius, noise, ss, mip. False
+  // Takes one key=value argument: config, ext, fov, motion, speed, turn, radius, noise, ss, mip, dist. False
   // for another key; exits with a message on a bad value.
   bool parse(const std::string& k, const std::string& v) {
     if (k == "config") {
@@ -84,6 +85,8 @@ struct Scene {
       supersampling = std::atoi(v.c_str());
     } else if (k == "mip") {
       mipmap = std::atoi(v.c_str()) != 0;
+    } else if (k == "dist") {
+      distortion = std::atoi(v.c_str()) != 0;
     } else {
       return false;
     }
@@ -94,6 +97,10 @@ struct Scene {
     sim::Options so;
     so.texture = texture_path(texture);
     so.camera = sim::default_camera(width, height, fov);
+    if (!distortion) {
+      so.camera.k1 = so.camera.k2 = 0.0;
+      so.camera.fx = so.camera.fy = 0.5 * width / std::tan(0.5 * fov * M_PI / 180.0);
+    }
     so.seconds = seconds;
     so.seed = seed;
     so.motion = motion;
