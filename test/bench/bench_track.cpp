@@ -11,7 +11,7 @@
 //        of config), fov=deg, motion=...|car, speed=m/s, turn=rad/s, radius=m (car), noise=grey
 //        levels, select=B0,B1,.. (level l on one pixel per Bl x Bl block), prior=0|1 (a
 //        subsampled level joined with the level before it), prior_chi2=X (its consistency test; 0: off), the fused pass's lanes=1|8, pix=N,
-//        wg=XxY; scene extras ss=N (the renderer's supersampling), mip=0|1, dist=0 (no lens distortion); BENCH_VERBOSE=1 adds per-level
+//        wg=XxY; scene extras ss=N (the renderer's supersampling), mip=0|1, dist=0 (no lens distortion); BENCH_PREBLUR=sigma blurs each camera image first; BENCH_VERBOSE=1 adds per-level
 //        times, the slowest frames and the frames not tracked ok; see main())
 //   bench_track nees [key=value...]         NEES of the covariances (alignment and frame-to-frame
 //       motion) and the lag-1 correlation of the errors per texture x configuration x size x
@@ -187,7 +187,11 @@ SequenceReport run_sequence(ocl::Runtime& rt, const sim::Options& so, const trac
   double nees = 0;
   int nees_n = 0, since_kf = 0;
   for (size_t k = 0; k < traj.t.size(); ++k) {
-    const cv::Mat img = bench::camera_frame(renderer, so, traj, exposure, k);
+    cv::Mat img = bench::camera_frame(renderer, so, traj, exposure, k);
+    // BENCH_PREBLUR=sigma: the camera image Gaussian-blurred before tracking (the interpolation
+    // noise bias experiment, src/track/README.md).
+    if (const char* pb = std::getenv("BENCH_PREBLUR"); pb && std::atof(pb) > 0.0)
+      cv::GaussianBlur(img, img, cv::Size(0, 0), std::atof(pb));
     const double c0 = cpu_ms();
     const track::FrameResult r = tracker.track(img.data, img.cols, img.rows, img.step, traj.t[k]);
     rep.cpu_frame += cpu_ms() - c0;
