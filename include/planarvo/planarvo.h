@@ -411,20 +411,16 @@ typedef struct planarvo_tracker planarvo_tracker;
 typedef struct planarvo_tracker_options {
   size_t struct_size;
   int32_t levels;             /* pyramid levels; default 4 */
-  int32_t finest_level;       /* finest level tracked, 0 = full resolution; default -1: the
-                                 coarsest level at least 320 pixels wide, A, on every pixel,
-                                 then the level below it subsampled (level0_subsample) */
+  int32_t finest_level;       /* finest level tracked, 0 = full resolution; default -1: see
+                                 level0_subsample */
   int32_t max_iterations;     /* cap on alignment steps per level; 0 = the per-level defaults */
   double keyframe_overlap;    /* a new keyframe when the overlap falls below this; default 0.7 */
   int32_t estimate_brightness;/* non-zero: estimate gain and offset per frame; default 1 */
-  /* The finest level aligned on one pixel per B x B block only (a jittered grid chosen per
-   * keyframe), solved together with the level above's estimate: nearly that level's accuracy at
-   * a fraction of its cost. Named for 640x480 images, where the finest level is level 0 (full
-   * resolution). With finest_level -1: 0 (the default) is B = 3, so 640x480 is tracked to half
-   * resolution and then on one full-resolution pixel in 9 (1.4 times the time of stopping at half
-   * resolution, for 0.6-0.9 of its RMS error); at 320x240, A is level 0 and nothing is subsampled. With
-   * finest_level >= 0: 0 is every pixel of that level. 1: every pixel; 2..8: B. Read only when
-   * struct_size covers it (when it does not: B = 3 with finest_level -1, else every pixel). */
+  /* The finest level on one pixel per B x B block (a jittered grid per keyframe), solved with the
+   * level above's estimate. finest_level -1: the coarsest level at least 320 px wide on every
+   * pixel, then the level below it at B, 0 meaning 3 (640x480: level 0 at 1/9, 1.4x the time of
+   * stopping at level 1 for 0.6-0.9 of its RMS error; 320x240: level 0 on every pixel). Explicit
+   * finest_level: 0 is every pixel. 1: every pixel; 2..8: B. Unread (so 0) for older struct_size. */
   int32_t level0_subsample;
 } planarvo_tracker_options;
 

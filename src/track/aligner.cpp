@@ -22,10 +22,10 @@ constexpr double kMadToSigma = 1.4826;
 
 using Vector5d = JointStep::Vector5d;
 using Matrix52d = JointStep::Matrix52d;
-// At most 5x5, on the stack.
-using MatrixL = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 5, 5>;
+// At most 5x5, on the stack (aligner.h's PriorMatrix and PriorVector).
+using MatrixL = PriorMatrix;
 using MatrixL2 = Eigen::Matrix<double, Eigen::Dynamic, 2, 0, 5, 2>;
-using VectorL = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 5, 1>;
+using VectorL = PriorVector;
 
 WarpReduceOptions kernel_options(const AlignerOptions& o, bool stats) {
   WarpReduceOptions k = o.kernel;

@@ -218,8 +218,8 @@ class Aligner {
   std::vector<AlignmentPair> prev_state_;
   std::vector<double> prev_sigma_;
   bool have_prev_ = false;
-  // Per pair, the prior's J^T W J at a subsampled level (aligner.cpp's MatrixL, at most 5x5).
-  std::vector<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 5, 5>> prior_H_;
+  // Per pair, the prior's J^T W J at a subsampled level.
+  std::vector<PriorMatrix> prior_H_;
   std::vector<ReduceSums> cur_, next_;
   std::vector<AlignmentPair> cand_;
   std::vector<double> measured_;

@@ -247,6 +247,17 @@ SequenceReport run_sequence(ocl::Runtime& rt, const sim::Options& so, const trac
   return rep;
 }
 
+// The six rows with the largest first column, each value with its column's decimals.
+void print_largest(const char* title, std::vector<std::array<double, 5>> rows, const std::array<int, 5>& decimals) {
+  const size_t n = std::min<size_t>(6, rows.size());
+  std::partial_sort(rows.begin(), rows.begin() + static_cast<std::ptrdiff_t>(n), rows.end(),
+                    [](const auto& a, const auto& b) { return a[0] > b[0]; });
+  std::printf("  %s:", title);
+  for (size_t i = 0; i < n; ++i)
+    for (size_t j = 0; j < 5; ++j) std::printf("%s%.*f%s", j ? " " : " (", decimals[j], rows[i][j], j == 4 ? ")" : "");
+  std::printf("\n");
+}
+
 int bench_accuracy(const std::vector<std::string>& textures, double seconds, int width, int height,
                    uint64_t seed, const Scene& scene, bool perturb, const track::TrackerOptions& topt, bool verbose) {
   ocl::Runtime rt;
@@ -283,18 +294,9 @@ int bench_accuracy(const std::vector<std::string>& textures, double seconds, int
                   "mean NEES %.1f (3 if calibrated); largest std ratio of the position axes %.1f\n", r.std_pos_median,
                   r.std_pos_max, r.std_head_median, r.nees, r.aniso_max);
     if (verbose) {
-      std::vector<std::array<double, 5>> slow = r.slow;
-      std::sort(slow.begin(), slow.end(), [](const auto& a, const auto& b) { return a[0] > b[0]; });
-      std::printf("  slowest frames (ms, frame, keyframe, passes, pipeline ms):");
-      for (size_t i = 0; i < slow.size() && i < 6; ++i)
-        std::printf(" (%.2f %.0f %.0f %.0f %.2f)", slow[i][0], slow[i][1], slow[i][2], slow[i][3], slow[i][4]);
-      std::printf("\n");
-      std::vector<std::array<double, 5>> worst = r.worst;
-      std::sort(worst.begin(), worst.end(), [](const auto& a, const auto& b) { return a[0] > b[0]; });
-      std::printf("  largest errors (mm, frame, frames since the keyframe, speed m/s, error / std):");
-      for (size_t i = 0; i < worst.size() && i < 6; ++i)
-        std::printf(" (%.3f %.0f %.0f %.2f %.1f)", worst[i][0], worst[i][1], worst[i][2], worst[i][3], worst[i][4]);
-      std::printf("\n");
+      print_largest("slowest frames (ms, frame, keyframe, passes, pipeline ms)", r.slow, {2, 0, 0, 0, 2});
+      print_largest("largest errors (mm, frame, frames since the keyframe, speed m/s, error / std)", r.worst,
+                    {3, 0, 0, 2, 1});
       std::printf("  mean ms per level, coarse to fine:");
       for (int l = topt.levels - 1; l >= 0; --l) std::printf(" %.2f", r.level_ms[l] / n);
       std::printf("\n");

@@ -20,6 +20,21 @@
 namespace planarvo::track {
 namespace {
 
+// A camera on a car (60 degree field of view) driving at up to 3 m/s with turns of at least 6 m
+// radius, rendered with 2x2 supersampling: the paper's rear parking camera setting.
+sim::Options car_camera(const char* texture, int width, int height, const Extrinsics& e, double seconds) {
+  sim::Options so;
+  so.texture = test::texture(texture).string();
+  so.camera = sim::default_camera(width, height, 60.0);
+  so.extrinsics = e;
+  so.motion = sim::MotionProfile::Car;
+  so.max_speed = 3.0;
+  so.min_turn_radius = 6.0;
+  so.seconds = seconds;
+  so.supersampling = 2;
+  return so;
+}
+
 TEST(TrackSequence, SimulatedDataSetIsTrackedAccurately) {
   test::ScratchDir dir;
   ocl::Runtime rt;
@@ -73,15 +88,7 @@ TEST(TrackSequence, SimulatedDataSetIsTrackedAccurately) {
 // tracks within 0.2 mm of the truth (the tracker used to refuse every frame as "no texture").
 TEST(TrackSequence, RearCameraOverFineTilesStartsAndTracks) {
   ocl::Runtime rt;
-  sim::Options so;
-  so.texture = test::texture("anti_skid_tiles.png").string();
-  so.camera = sim::default_camera(640, 480, 60.0);
-  so.extrinsics = Extrinsics{-1.0, 0.2, 1.1, 0.0, 55.0 * M_PI / 180.0, M_PI};
-  so.motion = sim::MotionProfile::Car;
-  so.max_speed = 3.0;
-  so.min_turn_radius = 6.0;
-  so.seconds = 0.5;
-  so.supersampling = 2;
+  const sim::Options so = car_camera("anti_skid_tiles.png", 640, 480, Extrinsics{-1.0, 0.2, 1.1, 0.0, 55.0 * M_PI / 180.0, M_PI}, 0.5);
   const sim::Trajectory traj = sim::generate_trajectory(so);
   sim::Renderer renderer(rt, cv::imread(so.texture, cv::IMREAD_GRAYSCALE), so);
   Tracker tracker(rt, so.camera, so.extrinsics);
@@ -106,15 +113,7 @@ TEST(TrackSequence, RearCameraOverFineTilesStartsAndTracks) {
 // numerically at the image's centre and corners), and every frame is Ok.
 TEST(TrackSequence, APerspectiveViewGetsANewKeyframeWhenTheScaleChanges) {
   ocl::Runtime rt;
-  sim::Options so;
-  so.texture = test::texture("asphalt_01.png").string();
-  so.camera = sim::default_camera(320, 240, 60.0);
-  so.extrinsics = Extrinsics{-1.0, 0.0, 0.8, 0.0, 35.0 * M_PI / 180.0, M_PI};
-  so.motion = sim::MotionProfile::Car;
-  so.max_speed = 3.0;
-  so.min_turn_radius = 6.0;
-  so.seconds = 3.0;
-  so.supersampling = 2;
+  const sim::Options so = car_camera("asphalt_01.png", 320, 240, Extrinsics{-1.0, 0.0, 0.8, 0.0, 35.0 * M_PI / 180.0, M_PI}, 3.0);
   const sim::Trajectory traj = sim::generate_trajectory(so);
   sim::Renderer renderer(rt, cv::imread(so.texture, cv::IMREAD_GRAYSCALE), so);
   const Eigen::Matrix3d K = so.camera.K();
@@ -253,15 +252,7 @@ TEST(TrackSequence, TheDefaultAt640x480FinishesAtFullResolutionOnOnePixelIn9) {
 // within 2 times; with the prior at full weight (prior_chi2 0) both are about 3 times.
 TEST(TrackSequence, RearCameraSubsampleIsNotHeldByTheHalfResolutionBias) {
   ocl::Runtime rt;
-  sim::Options so;
-  so.texture = test::texture("asphalt_02.png").string();
-  so.camera = sim::default_camera(640, 480, 60.0);
-  so.extrinsics = Extrinsics{-1.0, 0.2, 1.1, 0.0, 55.0 * M_PI / 180.0, M_PI};
-  so.motion = sim::MotionProfile::Car;
-  so.max_speed = 3.0;
-  so.min_turn_radius = 6.0;
-  so.seconds = 1.5;
-  so.supersampling = 2;
+  const sim::Options so = car_camera("asphalt_02.png", 640, 480, Extrinsics{-1.0, 0.2, 1.1, 0.0, 55.0 * M_PI / 180.0, M_PI}, 1.5);
   const sim::Trajectory traj = sim::generate_trajectory(so);
   sim::Renderer renderer(rt, cv::imread(so.texture, cv::IMREAD_GRAYSCALE), so);
   TrackerOptions full, held;
