@@ -69,6 +69,50 @@ void downsample(__global const float* src, const int sw, const int sh, __global 
 }
 
 // ---------------------------------------------------------------------------------------------
+// The prefilter: an intensity image (w x h) -> the same size, the separable 3-tap binomial
+// [1 2 1] / 4 in x then y (a Gaussian of sigma about 0.7 px), taps clamped to the edge, invalid
+// if any tap is. It damps the pixel noise that bilinear interpolation turns into a bias of the
+// alignment (src/track/README.md, "The prefilter").
+
+// Elements x - 1 .. x + 8 of a row of w pixels, clamped to 0..w-1: the taps of 8 outputs.
+inline float8 pv_row3(__global const float* r, const int x, const int w) {
+  float8 c;
+  float l, rr;
+  if (x >= 1 && x + 9 <= w) {
+    c = vload8(0, r + x);
+    l = r[x - 1];
+    rr = r[x + 8];
+  } else {
+    const int xm = w - 1;
+#define PV_AT(i) r[clamp(x + (i), 0, xm)]
+    c = (float8)(PV_AT(0), PV_AT(1), PV_AT(2), PV_AT(3), PV_AT(4), PV_AT(5), PV_AT(6), PV_AT(7));
+    l = PV_AT(-1);
+    rr = PV_AT(8);
+#undef PV_AT
+  }
+  const float8 left = (float8)(l, c.s0, c.s1, c.s2, c.s3, c.s4, c.s5, c.s6);
+  const float8 right = (float8)(c.s1, c.s2, c.s3, c.s4, c.s5, c.s6, c.s7, rr);
+  return (left + right) + 2.0f * c;
+}
+
+__kernel __attribute__((reqd_work_group_size(PYRAMID_WG_X, PYRAMID_WG_Y, 1)))
+void smooth(__global const float* src, const int w, const int h, __global float* dst) {
+  const int x = (int)get_global_id(0) * 8;
+  const int y = (int)get_global_id(1);
+  if (x >= w || y >= h) return;
+  const int ym = h - 1;
+  const float8 t = pv_row3(src + max(y - 1, 0) * w, x, w);
+  const float8 c = pv_row3(src + y * w, x, w);
+  const float8 b = pv_row3(src + min(y + 1, ym) * w, x, w);
+  const float8 s = (t + b) + 2.0f * c;
+  const float8 out = select((float8)(PV_INVALID), s * (1.0f / 16.0f), s >= 0.0f);
+  if (x + 8 <= w)
+    vstore8(out, 0, dst + y * w + x);
+  else
+    pv_store_head(out, dst + y * w + x, w - x);
+}
+
+// ---------------------------------------------------------------------------------------------
 // Gradients: an intensity image (w x h) -> the level's float4 layout of pyramid.h,
 // (I, (I(u+1) - I(u-1)) / 2, (I(v+1) - I(v-1)) / 2, 1), or all 0 where the pixel or one of its
 // four neighbours is invalid or outside the image.

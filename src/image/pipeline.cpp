@@ -162,6 +162,7 @@ PipelineKernels::PipelineKernels(ocl::Runtime& runtime, const ImagePipelineOptio
     undistort_ = make_kernel(runtime.program("undistort", undistort_opts), "undistort", dev,
                              undistort_wg_);
     cl::Program& pyramid = runtime.program("pyramid", pyramid_opts);
+    smooth_ = make_kernel(pyramid, "smooth", dev, pyramid_wg_);
     downsample_ = make_kernel(pyramid, "downsample", dev, pyramid_wg_);
     gradient_ = make_kernel(pyramid, "gradient", dev, pyramid_wg_);
   } catch (const cl::Error& e) {
@@ -214,6 +215,14 @@ void PipelineKernels::downsample(const cl::Buffer& src, int src_width, int src_h
   launch(runtime_.queue(), downsample_, pyramid_wg_, dw, dh);
 }
 
+void PipelineKernels::smooth(const cl::Buffer& src, int width, int height, const cl::Buffer& dst) {
+  smooth_.setArg(0, src);
+  smooth_.setArg(1, static_cast<cl_int>(width));
+  smooth_.setArg(2, static_cast<cl_int>(height));
+  smooth_.setArg(3, dst);
+  launch(runtime_.queue(), smooth_, pyramid_wg_, width, height);
+}
+
 void PipelineKernels::gradient(const cl::Buffer& src, int width, int height, const cl::Buffer& dst) {
   gradient_.setArg(0, src);
   gradient_.setArg(1, static_cast<cl_int>(width));
@@ -233,7 +242,9 @@ struct ImagePipeline::Impl {
   cl::Buffer frame;                   // PipelineKernels::frame_buffer_size bytes
   cl::Buffer map_index, map_weights;  // PipelineKernels::device_map
   std::vector<cl::Buffer> intensity;  // per level, its intensity image
-  Impl(ocl::Runtime& r, const ImagePipelineOptions& o) : rt(r), kernels(r, o) {}
+  bool prefilter = true;
+  cl::Buffer raw;                     // level 0 before the prefilter (when it is on)
+  Impl(ocl::Runtime& r, const ImagePipelineOptions& o) : rt(r), kernels(r, o), prefilter(o.prefilter) {}
 
   int w(int l) const { return level_size(camera.width, l); }
   int h(int l) const { return level_size(camera.height, l); }
@@ -270,7 +281,14 @@ struct ImagePipeline::Impl {
     }
   }
 
-  void undistort() { kernels.undistort(frame, map_index, map_weights, w(0), h(0), intensity[0]); }
+  void undistort() {
+    if (!prefilter) {
+      kernels.undistort(frame, map_index, map_weights, w(0), h(0), intensity[0]);
+      return;
+    }
+    kernels.undistort(frame, map_index, map_weights, w(0), h(0), raw);
+    kernels.smooth(raw, w(0), h(0), intensity[0]);
+  }
   void pyramid() {
     for (int l = 1; l < levels; ++l)
       kernels.downsample(intensity[static_cast<size_t>(l - 1)], w(l - 1), h(l - 1),
@@ -304,6 +322,9 @@ ImagePipeline::ImagePipeline(ocl::Runtime& runtime, const CameraModel& camera, i
     for (int l = 0; l < levels; ++l)
       m.intensity.emplace_back(ctx, CL_MEM_READ_WRITE,
                                static_cast<size_t>(m.w(l)) * static_cast<size_t>(m.h(l)) * sizeof(float));
+    if (m.prefilter)
+      m.raw = cl::Buffer(ctx, CL_MEM_READ_WRITE,
+                         static_cast<size_t>(m.w(0)) * static_cast<size_t>(m.h(0)) * sizeof(float));
   } catch (const cl::Error& e) {
     throw_opencl("allocating buffers for " + size_text(camera.width, camera.height), e);
   }

@@ -36,6 +36,12 @@ inline constexpr float kInvalidIntensity = -1048576.0f;
 // coordinates (exactly remap_bilinear), kInvalidIntensity where the map is not valid.
 cv::Mat undistort_reference(const cv::Mat& gray, const UndistortMap& map);
 
+// Stage 1b, the prefilter (ImagePipelineOptions::prefilter): an intensity image -> the same
+// size, the separable [1 2 1] / 4 binomial in x then y (a Gaussian of sigma about 0.7 px), taps
+// clamped to the edge, invalid if any tap is. Float arithmetic in the kernel's order: each
+// row's (l + r) + 2c, then (top + bottom) + 2 centre, / 16.
+cv::Mat smooth_reference(const cv::Mat& level);
+
 // Stage 2, one pyramid step: level l (an intensity image) -> level l + 1 of
 // ceil(w / 2) x ceil(h / 2) pixels. Output pixel (u, v) is the 5-tap Gaussian [1 4 6 4 1] / 16
 // (separable) of level l sampled at its centre, level-l (2u + 0.5, 2v + 0.5), i.e. the mean of
@@ -51,8 +57,10 @@ cv::Mat downsample_reference(const cv::Mat& level);
 // one of its four neighbours is invalid or outside the image.
 cv::Mat gradient_reference(const cv::Mat& level);
 
-// The whole pipeline: one CV_32FC4 image per level, levels[0] at full resolution.
-std::vector<cv::Mat> pipeline_reference(const cv::Mat& gray, const UndistortMap& map, int levels);
+// The whole pipeline: one CV_32FC4 image per level, levels[0] at full resolution; with
+// prefilter, level 0's intensity is smoothed before the pyramid is built from it.
+std::vector<cv::Mat> pipeline_reference(const cv::Mat& gray, const UndistortMap& map, int levels,
+                                        bool prefilter = true);
 
 // ---------------------------------------------------------------------------------------------
 // Pyramids between host and device.
@@ -82,13 +90,17 @@ struct ImagePipelineOptions {
   int pyramid_wg_x = 0, pyramid_wg_y = 0;
   // Build with -cl-fast-relaxed-math (off: it measured no faster on PoCL; see README.md).
   bool fast_math = false;
+  // Smooth level 0 (smooth_reference) before the pyramid is built from it: pixel noise,
+  // resampled bilinearly by the alignment, otherwise biases it (src/track/README.md, "The
+  // prefilter").
+  bool prefilter = true;
 };
 
 // Host wall time of each stage when the queue is drained after each (ImagePipeline::
 // process_timed); milliseconds.
 struct PipelineTimings {
   double upload_ms = 0;     // the frame into the device buffer
-  double undistort_ms = 0;  // remap into level 0's intensity image
+  double undistort_ms = 0;  // remap into level 0's intensity image (and the prefilter)
   double pyramid_ms = 0;    // the Gaussian steps: levels 1..n-1 intensity images
   double gradient_ms = 0;   // gradients and the float4 layout of every level
   double total_ms() const { return upload_ms + undistort_ms + pyramid_ms + gradient_ms; }
@@ -120,6 +132,8 @@ class PipelineKernels {
   // intensity image.
   void undistort(const cl::Buffer& frame, const cl::Buffer& index, const cl::Buffer& weights,
                  int width, int height, const cl::Buffer& dst);
+  // src, dst: intensity images of width x height (not the same buffer).
+  void smooth(const cl::Buffer& src, int width, int height, const cl::Buffer& dst);
   // src: an intensity image of src_width x src_height; dst: the next level's
   // (level_size(src_width, 1) x level_size(src_height, 1)).
   void downsample(const cl::Buffer& src, int src_width, int src_height, const cl::Buffer& dst);
@@ -128,7 +142,7 @@ class PipelineKernels {
 
  private:
   ocl::Runtime& runtime_;
-  cl::Kernel undistort_, downsample_, gradient_;
+  cl::Kernel undistort_, smooth_, downsample_, gradient_;
   size_t undistort_wg_[2] = {1, 1}, pyramid_wg_[2] = {1, 1};
 };
 

@@ -30,6 +30,29 @@ cv::Mat undistort_reference(const cv::Mat& gray, const UndistortMap& map) {
   return out;
 }
 
+cv::Mat smooth_reference(const cv::Mat& level) {
+  check_intensity(level, "smooth_reference");
+  const int w = level.cols, h = level.rows;
+  cv::Mat out(h, w, CV_32FC1);
+  for (int v = 0; v < h; ++v) {
+    const float* rows[3];
+    for (int i = 0; i < 3; ++i) rows[i] = level.ptr<float>(std::clamp(v - 1 + i, 0, h - 1));
+    float* dst = out.ptr<float>(v);
+    for (int u = 0; u < w; ++u) {
+      const int c0 = std::max(u - 1, 0), c2 = std::min(u + 1, w - 1);
+      float s[3];
+      bool valid = true;
+      for (int i = 0; i < 3; ++i) {
+        const float a = rows[i][c0], b = rows[i][u], c = rows[i][c2];
+        valid = valid && a >= 0.0f && b >= 0.0f && c >= 0.0f;
+        s[i] = (a + c) + 2.0f * b;
+      }
+      dst[u] = valid ? ((s[0] + s[2]) + 2.0f * s[1]) * (1.0f / 16.0f) : kInvalidIntensity;
+    }
+  }
+  return out;
+}
+
 cv::Mat downsample_reference(const cv::Mat& level) {
   check_intensity(level, "downsample_reference");
   const int sw = level.cols, sh = level.rows;
@@ -80,12 +103,14 @@ cv::Mat gradient_reference(const cv::Mat& level) {
   return out;
 }
 
-std::vector<cv::Mat> pipeline_reference(const cv::Mat& gray, const UndistortMap& map, int levels) {
+std::vector<cv::Mat> pipeline_reference(const cv::Mat& gray, const UndistortMap& map, int levels,
+                                        bool prefilter) {
   if (levels < 1 || levels > kMaxPyramidLevels)
     throw_invalid_argument("pipeline_reference: levels must be 1.." +
                            std::to_string(kMaxPyramidLevels) + ", not " + std::to_string(levels));
   std::vector<cv::Mat> out;
   cv::Mat intensity = undistort_reference(gray, map);
+  if (prefilter) intensity = smooth_reference(intensity);
   for (int l = 0; l < levels; ++l) {
     if (l > 0) intensity = downsample_reference(intensity);
     out.push_back(gradient_reference(intensity));

@@ -338,7 +338,11 @@ struct Tracker::Impl {
                              std::to_string(width));
     if (width != camera.width || height != camera.height) return track(Pyramid(), t);
     const auto t0 = std::chrono::steady_clock::now();
-    if (!pipeline) pipeline = std::make_unique<ImagePipeline>(rt, camera, opt.levels);
+    if (!pipeline) {
+      ImagePipelineOptions po;
+      po.prefilter = opt.prefilter;
+      pipeline = std::make_unique<ImagePipeline>(rt, camera, opt.levels, po);
+    }
     pipeline->process(gray, width, height, stride, slots[live_slot]);
     // Waiting here costs one synchronisation (the first pass would wait anyway) and splits
     // the frame's time between the pipeline and the tracker.

@@ -74,6 +74,10 @@ struct TrackerOptions : AlignerOptions {
   // carried into this frame), so the motion's covariance is C_k + (1 - 2 rho) C_{k-1}; rho
   // measured on the simulator (0 takes the alignments as independent, 0.5 drops C_{k-1}).
   double consecutive_alignment_correlation = 0.25;
+  // The camera-frame path smooths level 0 before building the pyramid (ImagePipelineOptions::
+  // prefilter; src/track/README.md, "The prefilter"). Pyramids given to track(Pyramid) are
+  // taken as they are.
+  bool prefilter = true;
 
   static WarpReduceOptions default_kernel_options();
 };

@@ -2,7 +2,8 @@
 // after each stage), the whole pipeline without stage boundaries (median), and the plain C++
 // reference, at 640x480 and 320x240 with 4 and 3 levels, on the default device.
 //
-//   bench_pipeline [frames=200] [--fast-math] [--wg-undistort X Y] [--wg-pyramid X Y]
+//   bench_pipeline [frames=200] [--fast-math] [--no-prefilter] [--wg-undistort X Y] [--wg-pyramid X Y]
+// (the undistort column includes the prefilter when it is on, the default)
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -60,6 +61,8 @@ int main(int argc, char** argv) {
   for (int i = 1; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--fast-math")) {
       opt.fast_math = true;
+    } else if (!std::strcmp(argv[i], "--no-prefilter")) {
+      opt.prefilter = false;
     } else if (!std::strcmp(argv[i], "--wg-undistort") && i + 2 < argc) {
       opt.undistort_wg_x = std::atoi(argv[++i]);
       opt.undistort_wg_y = std::atoi(argv[++i]);
@@ -71,8 +74,9 @@ int main(int argc, char** argv) {
     }
   }
   ocl::Runtime rt;
-  std::printf("device: %s / %s; %d frames per row; options: undistort \"%s\", pyramid \"%s\"\n",
+  std::printf("device: %s / %s; %d frames per row; prefilter %s; options: undistort \"%s\", pyramid \"%s\"\n",
               rt.device_info().platform_name.c_str(), rt.device_info().device_name.c_str(), frames,
+              opt.prefilter ? "on" : "off",
               ImagePipeline::undistort_build_options(opt).c_str(),
               ImagePipeline::pyramid_build_options(opt).c_str());
   std::printf("%-9s %6s | %8s %9s %8s %8s %8s | %8s | %8s\n", "size", "levels", "upload",
@@ -106,7 +110,7 @@ int main(int argc, char** argv) {
       const int ref_frames = std::max(1, frames / 10);
       for (int k = 0; k < ref_frames; ++k) {
         const double t0 = now_ms();
-        const auto levels_ref = pipeline_reference(input[static_cast<size_t>(k) % 8], pipe.map(), levels);
+        const auto levels_ref = pipeline_reference(input[static_cast<size_t>(k) % 8], pipe.map(), levels, opt.prefilter);
         ref.push_back(now_ms() - t0);
       }
       char size[32];

@@ -10,7 +10,8 @@
 //        off by +10,-10,+10 mm and +2.5,-2.5,+2.5 deg), ext=x,y,z,roll,pitch,yaw (m, deg; instead
 //        of config), fov=deg, motion=...|car, speed=m/s, turn=rad/s, radius=m (car), noise=grey
 //        levels, select=B0,B1,.. (level l on one pixel per Bl x Bl block), prior=0|1 (a
-//        subsampled level joined with the level before it), prior_chi2=X (its consistency test; 0: off), the fused pass's lanes=1|8, pix=N,
+//        subsampled level joined with the level before it), prior_chi2=X (its consistency test; 0: off),
+//        prefilter=0|1 (level 0 smoothed before the pyramid; default 1), the fused pass's lanes=1|8, pix=N,
 //        wg=XxY; scene extras ss=N (the renderer's supersampling), mip=0|1, dist=0 (no lens distortion); BENCH_PREBLUR=sigma blurs each camera image first; BENCH_VERBOSE=1 adds per-level
 //        times, the slowest frames and the frames not tracked ok; see main())
 //   bench_track nees [key=value...]         NEES of the covariances (alignment and frame-to-frame
@@ -507,6 +508,9 @@ int bench_speed(int width, int height, double seconds, int rounds) {
   {
     track::TrackerOptions o;
     configs.push_back({"default (level 1, level 0 at 1/9)", o});
+    o.prefilter = false;
+    configs.push_back({"default without the prefilter", o});
+    o.prefilter = true;
     o.kernel.lanes = 1;  // the fused pass one pixel at a time, as before float8
     configs.push_back({"default, per-pixel pass", o});
     track::TrackerOptions h;
@@ -612,6 +616,7 @@ int main(int argc, char** argv) {
       }
       else if (k == "prior") topt.subsample_prior = std::atoi(v.c_str()) != 0;
       else if (k == "prior_chi2") topt.prior_chi2 = std::atof(v.c_str());
+      else if (k == "prefilter") topt.prefilter = v != "0";
       else if (k == "lanes") topt.kernel.lanes = std::atoi(v.c_str());
       else if (k == "pix") topt.kernel.pixels_per_item = std::atoi(v.c_str());
       else if (k == "wg") {  // wg=16x4
@@ -655,6 +660,7 @@ int main(int argc, char** argv) {
       else if (k == "noise") noise = std::atof(v.c_str());
       else if (k == "prior") topt.subsample_prior = std::atoi(v.c_str()) != 0;
       else if (k == "prior_chi2") topt.prior_chi2 = std::atof(v.c_str());
+      else if (k == "prefilter") topt.prefilter = v != "0";
       else if (k == "conv") topt.convergence_px = std::atof(v.c_str());
       else if (k == "huber") topt.huber_factor = std::atof(v.c_str());
       else if (k == "brightness") topt.estimate_brightness = std::atoi(v.c_str()) != 0;

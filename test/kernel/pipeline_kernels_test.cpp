@@ -160,6 +160,21 @@ TEST(PipelineKernels, DownsampleMatchesReference) {
   }
 }
 
+TEST(PipelineKernels, SmoothMatchesReference) {
+  ocl::Runtime rt;
+  PipelineKernels kernels(rt);
+  uint32_t seed = 150;
+  for (const auto& s : kSizes) {
+    const std::string what = std::to_string(s[0]) + "x" + std::to_string(s[1]);
+    const cv::Mat level = random_level(s[0], s[1], seed++);
+    const cl::Buffer src = upload(rt, level.ptr(), level.total() * sizeof(float));
+    const size_t n = level.total();
+    const cl::Buffer dst = poisoned(rt, n);
+    kernels.smooth(src, s[0], s[1], dst);
+    expect_intensity_matches(download(rt, dst, n), smooth_reference(level), what);
+  }
+}
+
 TEST(PipelineKernels, GradientMatchesReference) {
   ocl::Runtime rt;
   PipelineKernels kernels(rt);

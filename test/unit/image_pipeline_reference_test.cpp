@@ -108,6 +108,48 @@ TEST(ImagePipelineReference, DownsampleMatchesOpenCVFilterOnAReplicatedBorder) {
   }
 }
 
+// The prefilter: OpenCV's cv::GaussianBlur with a 3 x 3 kernel and sigma 0 (OpenCV's fixed
+// [1 2 1] / 4 kernel for that size), in double, border replicated (clamped taps); validity by a
+// 3 x 3 dilation of the invalid mask. It also damps pixel noise as a [1 2 1] / 4 binomial must:
+// independent noise's variance falls to (6/16)^2 of its value.
+TEST(ImagePipelineReference, SmoothMatchesOpenCVGaussianOnAReplicatedBorder) {
+  const int sizes[][2] = {{1, 1}, {2, 3}, {5, 4}, {17, 9}, {64, 48}, {97, 61}};
+  uint32_t seed = 31;
+  for (const auto& s : sizes) {
+    SCOPED_TRACE(std::to_string(s[0]) + "x" + std::to_string(s[1]));
+    const cv::Mat level = random_level(s[0], s[1], seed++, 0.005);
+    const cv::Mat out = smooth_reference(level);
+    ASSERT_EQ(out.size(), level.size());
+    cv::Mat values, invalid, blurred, any_invalid;
+    level.convertTo(values, CV_64F);
+    invalid = level < 0.0f;
+    invalid.convertTo(invalid, CV_64F);
+    cv::GaussianBlur(values, blurred, cv::Size(3, 3), 0, 0, cv::BORDER_REPLICATE);
+    cv::dilate(invalid, any_invalid, cv::Mat::ones(3, 3, CV_8U), cv::Point(-1, -1), 1,
+               cv::BORDER_REPLICATE);
+    int invalid_outputs = 0;
+    for (int v = 0; v < out.rows; ++v)
+      for (int u = 0; u < out.cols; ++u) {
+        const float o = out.at<float>(v, u);
+        if (any_invalid.at<double>(v, u) > 0.5) {
+          EXPECT_EQ(o, kInvalidIntensity) << u << "," << v;
+          ++invalid_outputs;
+        } else {
+          EXPECT_NEAR(o, blurred.at<double>(v, u), 1e-4) << u << "," << v;
+        }
+      }
+    if (s[0] * s[1] > 1000) {
+      EXPECT_GT(invalid_outputs, 0);
+    }
+  }
+  cv::Mat noise(200, 200, CV_32FC1);
+  cv::RNG(5).fill(noise, cv::RNG::NORMAL, 100.0, 10.0);
+  cv::Scalar mean, sd_in, sd_out;
+  cv::meanStdDev(noise, mean, sd_in);
+  cv::meanStdDev(smooth_reference(noise)(cv::Rect(1, 1, 198, 198)), mean, sd_out);
+  EXPECT_NEAR(sd_out[0] / sd_in[0], 6.0 / 16.0, 0.02);
+}
+
 // A linear ramp stays linear through the pyramid, with its value at the pixel centres of
 // pyramid.h: level-l pixel (u, v) at level-0 (2^l (u + 0.5) - 0.5, ...); and the gradients are
 // the slope, 2^l grey levels per level-l pixel per level-0 slope. Exactly, away from the borders:
