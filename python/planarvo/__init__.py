@@ -1,0 +1,34 @@
+"""planarvo: dense planar visual odometry from a downward-looking camera, and calibration of the
+camera's pose on the robot, from Python (ctypes over libplanarvo's C API, numpy in and out).
+
+    import planarvo
+    with planarvo.Context() as ctx, planarvo.Dataset("drive") as ds:
+        info = ds.info
+        with planarvo.Tracker(ctx, info.camera, info.extrinsics) as tracker:
+            for t, frame in ds.frames():
+                r = tracker.track(frame, t)   # r.status, r.motion, r.covariance, r.pose, r.ms
+
+The library: $PLANARVO_LIBRARY, else the one installed beside this package, else the system's
+(see python/README.md). Every failed call raises planarvo.Error; invalid Python input raises
+ValueError before any C call. Units: metres, radians, seconds (docs/conventions.md).
+"""
+from ._api import (EXTRINSICS_NAMES, CalibrationMethod, CalibrationOptions, CalibrationResult, CalibrationStatus,
+                   Camera, CameraCalibrationOptions, CameraCalibrationResult, CameraCalibrator, Context, Dataset,
+                   DatasetInfo, DeviceInfo, Error, Extrinsics, FrameData, MotionAccuracy, MotionPair, MotionProfile,
+                   PosegraphInit, RobustLoss, RollPitch, RollPitchOptions, RollPitchResult, SE2, SimOptions,
+                   SolverSummary, Status, Tracker, TrackerOptions, TrackResult, TrackStatus, calibrate,
+                   calibrate_dataset, default_texture, evaluate_motions, list_devices, load_motion_pairs,
+                   posegraph_optimize, save_motion_pairs, simulate, track_motions, version, write_tum)
+from ._native import lib as _lib
+
+__version__ = _lib.planarvo_version_string().decode()
+
+__all__ = [
+    "EXTRINSICS_NAMES", "CalibrationMethod", "CalibrationOptions", "CalibrationResult", "CalibrationStatus", "Camera",
+    "CameraCalibrationOptions", "CameraCalibrationResult", "CameraCalibrator", "Context", "Dataset", "DatasetInfo",
+    "DeviceInfo", "Error", "Extrinsics", "FrameData", "MotionAccuracy", "MotionPair", "MotionProfile",
+    "PosegraphInit", "RobustLoss", "RollPitch", "RollPitchOptions", "RollPitchResult", "SE2", "SimOptions",
+    "SolverSummary", "Status", "Tracker", "TrackerOptions", "TrackResult", "TrackStatus", "calibrate",
+    "calibrate_dataset", "default_texture", "evaluate_motions", "list_devices", "load_motion_pairs",
+    "posegraph_optimize", "save_motion_pairs", "simulate", "track_motions", "version", "write_tum",
+]
