@@ -11,7 +11,7 @@ packages=(
   libopencv-calib3d-dev libopencv-video-dev
   libsuitesparse-dev
   libgtest-dev libgmock-dev
-  python3
+  python3 python3-numpy python3-pytest
 )
 # Benchmark-only peer (issue 3): Ceres Solver. Installed when PLANARVO_BENCH_DEPS=1.
 if [ "${PLANARVO_BENCH_DEPS:-0}" = 1 ]; then packages+=(libceres-dev); fi
