@@ -1,0 +1,81 @@
+"""Bad input: ValueError with the reason before any C call; failed calls raise planarvo.Error
+with the status and the library's message; closed handles refuse use."""
+import numpy as np
+import pytest
+
+import planarvo
+
+CAM = planarvo.Camera(64, 48, 50.0, 50.0, 32.0, 24.0)
+
+
+@pytest.fixture
+def tracker(context):
+    with planarvo.Tracker(context, CAM, planarvo.Extrinsics(z=0.2)) as t:
+        yield t
+
+
+@pytest.mark.parametrize("frame, reason", [
+    (np.zeros((48, 64), dtype=np.uint16), "dtype"),
+    (np.zeros((48, 64), dtype=np.float64), "dtype"),
+    (np.zeros((48, 64, 4), dtype=np.uint8), "3 channels"),
+    (np.zeros((48, 64, 3), dtype=np.float32), "uint8"),
+    (np.zeros((2, 48, 64, 3), dtype=np.uint8), "shape"),
+    (np.zeros(48 * 64, dtype=np.uint8), "shape"),
+    (np.zeros((48, 128), dtype=np.uint8)[:, ::2], "contiguous"),
+    (np.zeros((48, 64, 6), dtype=np.uint8)[:, :, ::2], "contiguous"),
+    (np.zeros((64, 48), dtype=np.uint8).T, "contiguous"),
+    (np.zeros((48, 64), dtype=np.uint8)[::-1], "stride"),
+    (np.zeros((48, 63), dtype=np.uint8), "does not match"),
+    (np.zeros((47, 64, 3), dtype=np.uint8), "does not match"),
+    ([[0] * 64] * 48, "numpy array"),
+])
+def test_bad_frames_raise_value_error(tracker, frame, reason):
+    with pytest.raises(ValueError, match=reason):
+        tracker.track(frame, 0.0)
+
+
+def test_bad_path_names_the_file(tmp_path):
+    missing = tmp_path / "no-such-camera.yaml"
+    with pytest.raises(planarvo.Error, match="no-such-camera.yaml") as e:
+        planarvo.Camera.load(missing)
+    assert e.value.status == planarvo.Status.INVALID_INPUT
+    assert e.value.status_name == "PLANARVO_ERROR_INVALID_INPUT"
+    with pytest.raises(planarvo.Error, match="no-such-dataset"):
+        planarvo.Dataset(tmp_path / "no-such-dataset")
+
+
+def test_no_device():
+    with pytest.raises(planarvo.Error) as e:
+        planarvo.Context(device="no-such-device-xyz")
+    assert e.value.status == planarvo.Status.NO_DEVICE
+
+
+def test_non_increasing_timestamps_are_an_error_not_a_crash(tracker):
+    frame = np.random.default_rng(1).integers(0, 255, (48, 64), dtype=np.uint8)
+    tracker.track(frame, 1.0)
+    try:
+        tracker.track(frame, 0.5)
+    except planarvo.Error as e:
+        assert e.status == planarvo.Status.INVALID_ARGUMENT
+
+
+def test_closed_handles(context):
+    t = planarvo.Tracker(context, CAM, planarvo.Extrinsics(z=0.2))
+    t.close()
+    t.close()  # once only
+    assert t.closed
+    with pytest.raises(ValueError, match="closed"):
+        t.track(np.zeros((48, 64), dtype=np.uint8), 0.0)
+
+
+def test_other_bad_input(tmp_path):
+    with pytest.raises(ValueError, match=r"\(6, 6\)"):
+        planarvo.Extrinsics().save(tmp_path / "e.yaml", covariance=np.eye(3))
+    with pytest.raises(ValueError, match="unknown parameter"):
+        planarvo.Extrinsics().save(tmp_path / "e.yaml", estimated=["height"])
+    with pytest.raises(ValueError, match=r"\(N, 3\)"):
+        planarvo.write_tum(tmp_path / "t.txt", [0.0], [[0.0, 0.0]])
+    with pytest.raises(ValueError, match="N rows"):
+        planarvo.evaluate_motions(np.zeros((3, 3)), np.zeros((2, 3)), np.ones(3))
+    with pytest.raises(ValueError, match="no motion pairs"):
+        planarvo.calibrate([])

@@ -1,0 +1,73 @@
+"""Files: camera and extrinsics YAML, motion pairs, TUM trajectories; the extrinsics matrix
+against docs/conventions.md's definition."""
+import math
+
+import numpy as np
+import pytest
+
+import planarvo
+
+
+def test_camera_round_trip(tmp_path):
+    cam = planarvo.Camera(640, 480, 501.25, 499.5, 319.75, 241.125, -0.12, 0.03, 0.001, -0.002, 0.0004,
+                          roi=(8, 16, 600, 400))
+    cam.save(tmp_path / "camera.yaml")
+    assert planarvo.Camera.load(tmp_path / "camera.yaml") == cam
+
+
+def test_extrinsics_round_trip_and_matrix(tmp_path):
+    e = planarvo.Extrinsics(0.2441, -0.0185, 0.1787, math.radians(12.4), math.radians(17.6), math.radians(-9.2))
+    cov = np.diag([1e-6, 2e-6, 3e-6, 1e-4, 2e-4, 3e-4])
+    e.save(tmp_path / "e.yaml", covariance=cov, estimated=["x", "y", "z", "roll", "pitch", "yaw"], method="test",
+           notes="round trip")
+    loaded = planarvo.Extrinsics.load(tmp_path / "e.yaml")
+    np.testing.assert_allclose(loaded.as_array(), e.as_array(), rtol=0, atol=1e-15)
+    text = (tmp_path / "e.yaml").read_text()
+    assert "round trip" in text
+
+    def rx(a):
+        return np.array([[1, 0, 0], [0, math.cos(a), -math.sin(a)], [0, math.sin(a), math.cos(a)]])
+
+    def ry(a):
+        return np.array([[math.cos(a), 0, math.sin(a)], [0, 1, 0], [-math.sin(a), 0, math.cos(a)]])
+
+    def rz(a):
+        return np.array([[math.cos(a), -math.sin(a), 0], [math.sin(a), math.cos(a), 0], [0, 0, 1]])
+
+    r0 = np.array([[0, -1, 0], [-1, 0, 0], [0, 0, -1]])  # looking down, image top forward
+    expected = np.eye(4)
+    expected[:3, :3] = rz(e.yaw) @ ry(e.pitch) @ rx(e.roll) @ r0
+    expected[:3, 3] = [e.x, e.y, e.z]
+    np.testing.assert_allclose(e.matrix(), expected, rtol=0, atol=1e-12)
+
+
+def test_motion_pairs_round_trip(tmp_path):
+    pairs = [planarvo.MotionPair(0.1 * (i + 1), planarvo.SE2(0.01 * i, -0.002 * i, 0.003 * i),
+                                 odometry=planarvo.SE2(0.02 * i, 0.0, 0.001 * i), direction=(1, -1, 0)[i % 3])
+             for i in range(5)]
+    planarvo.save_motion_pairs(tmp_path / "pairs.csv", pairs)
+    loaded = planarvo.load_motion_pairs(tmp_path / "pairs.csv")
+    assert len(loaded) == len(pairs)
+    for a, b in zip(loaded, pairs):
+        assert a.interval == pytest.approx(b.interval, abs=1e-15)
+        np.testing.assert_allclose(a.sensor.as_array(), b.sensor.as_array(), rtol=0, atol=1e-15)
+        np.testing.assert_allclose(a.odometry.as_array(), b.odometry.as_array(), rtol=0, atol=1e-15)
+        assert a.direction == b.direction and a.sensor_covariance is None
+
+
+def test_write_tum(tmp_path):
+    t = np.array([0.0, 0.1, 0.2])
+    poses = np.array([[0, 0, 0], [0.1, 0.02, 0.3], [0.25, -0.5, -1.0]])
+    planarvo.write_tum(tmp_path / "t.txt", t, poses)
+    rows = np.loadtxt(tmp_path / "t.txt", comments="#")
+    np.testing.assert_allclose(rows[:, 0], t)
+    np.testing.assert_allclose(rows[:, 1:3], poses[:, :2], atol=1e-15)
+    np.testing.assert_allclose(2 * np.arctan2(rows[:, 6], rows[:, 7]), poses[:, 2], atol=1e-12)
+
+
+def test_devices_and_context(context):
+    devices = planarvo.list_devices()
+    assert devices, "no OpenCL device"
+    assert context.device.device_name in [d.device_name for d in devices]
+    assert isinstance(context.cache_dir, str)
+    assert planarvo.version() == planarvo.__version__

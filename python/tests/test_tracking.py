@@ -1,0 +1,119 @@
+"""The tracker from Python against the CLI, the simulator's ground truth, and itself on the same
+image passed as grey, BGR and a strided view."""
+import math
+import subprocess
+
+import numpy as np
+import pytest
+
+import planarvo
+from conftest import cli_path, true_motions
+
+
+@pytest.fixture(scope="module")
+def tracked(context, drive):
+    """Every frame of the drive tracked from Python with the true extrinsics."""
+    with planarvo.Dataset(drive) as ds:
+        info = ds.info
+        frames = list(ds.frames())
+        truth = np.array([ds.frame_data(i).groundtruth.as_array() for i in range(len(frames))])
+    with planarvo.Tracker(context, info.camera, info.extrinsics_gt) as tracker:
+        results = [tracker.track(f, t) for t, f in frames]
+    return info, frames, truth, results
+
+
+def test_statuses_and_types(tracked):
+    info, frames, _, results = tracked
+    assert info.frame_count == len(frames) == 30
+    assert frames[0][1].shape == (240, 320) and frames[0][1].dtype == np.uint8
+    assert results[0].status == planarvo.TrackStatus.FIRST
+    assert all(r.status == planarvo.TrackStatus.OK for r in results[1:]), [(r.status, r.reason) for r in results]
+    r = results[-1]
+    assert r.covariance.shape == (3, 3) and np.allclose(r.covariance, r.covariance.T)
+    assert np.all(np.linalg.eigvalsh(r.covariance) > 0)
+    assert r.ms > 0 and r.levels_used >= 1
+
+
+def test_matches_cli(tracked, drive, tmp_path):
+    """The same motions as `planarvo track --motions-out` on the same data set, to 1e-9."""
+    cli = cli_path()
+    if not cli:
+        pytest.skip("the planarvo CLI was not found (set PLANARVO_CLI)")
+    info, _, _, results = tracked
+    out = tmp_path / "motions.csv"
+    subprocess.run([cli, "track", str(drive), "--extrinsics", str(drive / "extrinsics_gt.yaml"),
+                    "--motions-out", str(out), "--quiet"], check=True, capture_output=True)
+    cli_motions = np.loadtxt(out, delimiter=",", comments="#")[:, 4:7]  # sensor_dx, sensor_dy, sensor_dtheta
+    ours = np.array([r.motion.as_array() for r in results[1:]])
+    assert cli_motions.shape == ours.shape
+    np.testing.assert_allclose(ours, cli_motions, rtol=0, atol=1e-9)
+    # ... and the same through planarvo.track_motions and load_motion_pairs.
+    loaded = planarvo.load_motion_pairs(out)
+    assert len(loaded) == len(ours) and loaded[0].odometry is not None and loaded[0].direction is not None
+    np.testing.assert_allclose([p.sensor.as_array() for p in loaded], cli_motions, rtol=0, atol=1e-15)
+
+
+def test_track_motions_matches_tracker(context, drive, tracked):
+    _, _, _, results = tracked
+    with planarvo.Dataset(drive) as ds:
+        pairs = planarvo.track_motions(context, ds, ds.info.extrinsics_gt)
+    assert len(pairs) == len(results) - 1
+    np.testing.assert_allclose([p.sensor.as_array() for p in pairs], [r.motion.as_array() for r in results[1:]],
+                               rtol=0, atol=1e-12)
+    np.testing.assert_allclose(pairs[-1].sensor_covariance, results[-1].covariance, rtol=1e-12, atol=0)
+
+
+def test_against_ground_truth(tracked):
+    """Per-frame motions within 1 mm and 0.1 deg of the simulator's truth; evaluate_motions agrees
+    with the same figures computed here."""
+    _, frames, truth, results = tracked
+    est = np.array([r.motion.as_array() for r in results[1:]])
+    gt = true_motions(truth)
+    err = np.hypot(*(est[:, :2] - gt[:, :2]).T)
+    assert err.max() < 1e-3, err.max()
+    assert np.abs(est[:, 2] - gt[:, 2]).max() < math.radians(0.1)
+    assert np.abs(np.array([r.pose.as_array() for r in results])[-1, :2] - (truth[-1, :2] - truth[0, :2])).max() < 5e-3
+    dt = np.diff([t for t, _ in frames])
+    acc = planarvo.evaluate_motions(est, gt, dt)
+    assert acc.intervals == len(est)
+    assert acc.rms_translation == pytest.approx(math.sqrt(np.mean(err ** 2)), rel=1e-9)
+    assert acc.max_translation == pytest.approx(err.max(), rel=1e-9)
+    assert acc.distance == pytest.approx(np.hypot(*gt[:, :2].T).sum(), rel=1e-6)
+
+
+def _track(context, info, frames):
+    with planarvo.Tracker(context, info.camera, info.extrinsics_gt) as tracker:
+        return np.array([tracker.track(f, t).motion.as_array() for t, f in frames])
+
+
+def test_bgr_and_strided_frames_equal_grey(context, tracked):
+    info, frames, _, _ = tracked
+    frames = frames[:6]
+    grey = _track(context, info, frames)
+    bgr = _track(context, info, [(t, np.repeat(f[:, :, None], 3, axis=2)) for t, f in frames])
+    strided = []
+    for t, f in frames:
+        big = np.zeros((f.shape[0], f.shape[1] + 37), dtype=np.uint8)
+        big[:, 10:10 + f.shape[1]] = f
+        view = big[:, 10:10 + f.shape[1]]
+        assert not view.flags.c_contiguous
+        strided.append((t, view))
+    every_other_row = []
+    for t, f in frames:
+        tall = np.zeros((2 * f.shape[0], f.shape[1]), dtype=np.uint8)
+        tall[::2] = f
+        every_other_row.append((t, tall[::2]))
+    np.testing.assert_array_equal(bgr, grey)
+    np.testing.assert_array_equal(_track(context, info, strided), grey)
+    np.testing.assert_array_equal(_track(context, info, every_other_row), grey)
+
+
+def test_reset(context, tracked):
+    info, frames, _, results = tracked
+    with planarvo.Tracker(context, info.camera, info.extrinsics_gt) as tracker:
+        tracker.track(frames[0][1], frames[0][0])
+        tracker.reset()
+        assert tracker.track(frames[1][1], frames[1][0]).status == planarvo.TrackStatus.FIRST
+        r = tracker.track(frames[2][1], frames[2][0])
+        assert r.status == planarvo.TrackStatus.OK
+        np.testing.assert_allclose(r.pose.as_array(), r.motion.as_array())
