@@ -1,0 +1,96 @@
+"""Pose graphs against the published optimum, and the calibrations against the simulator's
+true extrinsics."""
+import math
+import os
+
+import numpy as np
+import pytest
+
+import planarvo
+from conftest import shared_dir
+
+
+def test_posegraph_reaches_reference_optimum(tmp_path):
+    shared = shared_dir()
+    if shared is None:
+        pytest.skip("shared/data/posegraphs not found (set PLANARVO_SHARED_DIR)")
+    graph = os.path.join(shared, "data", "posegraphs", "ring.g2o")
+    lines = []
+    summary = planarvo.posegraph_optimize(graph, tmp_path / "out.g2o", log=lines.append)
+    assert summary.converged and summary.iterations > 0 and lines
+    assert summary.final_chi2 == pytest.approx(11.1631, rel=1e-4)  # data/posegraphs/README.md
+    with open(graph) as f:
+        vertices = sum(1 for line in f if line.startswith("VERTEX_SE2"))
+    with open(tmp_path / "out.g2o") as f:
+        assert sum(1 for line in f if line.startswith("VERTEX_SE2")) == vertices == 434
+    # Optimising the optimum again starts there.
+    again = planarvo.posegraph_optimize(tmp_path / "out.g2o")
+    assert again.initial_chi2 == pytest.approx(summary.final_chi2, rel=1e-6)
+
+
+def test_posegraph_bad_file(tmp_path):
+    bad = tmp_path / "bad.g2o"
+    bad.write_text("VERTEX_SE2 0 0 0\n")
+    with pytest.raises(planarvo.Error, match="bad.g2o"):
+        planarvo.posegraph_optimize(bad)
+
+
+@pytest.fixture(scope="module")
+def calibration_drive(context, tmp_path_factory):
+    out = tmp_path_factory.mktemp("sim") / "calib"
+    options = planarvo.SimOptions(camera=planarvo.Camera.simulator_default(320, 240, 80.0), seconds=8.0, fps=15.0,
+                                  seed=3, supersampling=1)
+    planarvo.simulate(context, out, options)
+    return out
+
+
+def test_calibrate_dataset_finds_true_extrinsics(context, calibration_drive):
+    stages = []
+    with planarvo.Dataset(calibration_drive) as ds:
+        truth = ds.info.extrinsics_gt
+        result = planarvo.calibrate_dataset(context, ds, progress=lambda f, s: stages.append(s))
+    assert result.status == planarvo.CalibrationStatus.OK, result.reason
+    assert all(result.estimated) and stages
+    err = result.extrinsics.as_array() - truth.as_array()
+    # Within 5 standard deviations, and close in absolute terms (2 cm, 1 degree).
+    assert np.all(np.abs(err) < 5 * result.sigmas + 1e-4), (err, result.sigmas)
+    assert np.all(np.abs(err[:3]) < 0.02) and np.all(np.abs(err[3:]) < math.radians(1.0)), err
+
+
+def test_graph_calibration_from_motion_pairs(context, calibration_drive):
+    """track_motions at height 1 with the true roll and pitch, then calibrate: x, y, the height as
+    the scale, and yaw."""
+    with planarvo.Dataset(calibration_drive) as ds:
+        truth = ds.info.extrinsics_gt
+        pairs = planarvo.track_motions(context, ds, planarvo.Extrinsics(z=1.0, roll=truth.roll, pitch=truth.pitch))
+    result = planarvo.calibrate(pairs)
+    assert result.ok and all(result.estimated)
+    expected = np.array([truth.x, truth.y, truth.z, truth.yaw])
+    sigma = np.sqrt(np.diag(result.covariance))
+    assert np.all(np.abs(result.value - expected) < 5 * sigma + 1e-4), (result.value - expected, sigma)
+
+
+def test_progress_callback_cancels_and_reraises(context, tmp_path):
+    def stop(fraction, stage):
+        raise KeyboardInterrupt("stop here")
+
+    options = planarvo.SimOptions(camera=planarvo.Camera.simulator_default(160, 120, 80.0), seconds=0.5, fps=10.0)
+    with pytest.raises(KeyboardInterrupt, match="stop here"):
+        planarvo.simulate(context, tmp_path / "cancelled", options, progress=stop)
+    with pytest.raises(planarvo.Error) as e:
+        planarvo.simulate(context, tmp_path / "cancelled", options, progress=lambda f, s: True)
+    assert e.value.status == planarvo.Status.CANCELLED
+
+
+def test_roll_pitch_from_frames(context, calibration_drive):
+    with planarvo.Dataset(calibration_drive) as ds:
+        info = ds.info
+        with planarvo.RollPitch(context, info.camera) as estimator:
+            for t, frame in ds.frames():
+                if estimator.add_frame(frame, t):
+                    break
+            result = estimator.estimate()
+    truth = info.extrinsics_gt
+    assert result.status == planarvo.CalibrationStatus.OK and result.covariance.shape == (2, 2)
+    err = np.array([result.roll - truth.roll, result.pitch - truth.pitch])
+    assert np.all(np.abs(err) < 5 * np.sqrt(np.diag(result.covariance)) + math.radians(0.05)), err
