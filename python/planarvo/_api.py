@@ -352,15 +352,22 @@ class _Handle:
     those, the garbage collector."""
     _destroy_name = ""
 
-    def _own(self, handle: ctypes.c_void_p, *keep_alive: Any) -> None:
+    def _own(self, handle: ctypes.c_void_p, *parents: Any) -> None:
         self._handle = handle
-        # The finalizer holds the objects this handle needs (a tracker its context), so they
-        # outlive it.
-        self._finalizer = weakref.finalize(self, _release, getattr(lib, self._destroy_name), handle, keep_alive)
+        self._children: "weakref.WeakSet[_Handle]" = weakref.WeakSet()
+        # The finalizer holds the handles this one needs (a tracker its context), so that they
+        # outlive it; closing a parent closes its children first.
+        self._finalizer = weakref.finalize(self, _release, getattr(lib, self._destroy_name), handle, parents)
+        for p in parents:
+            if isinstance(p, _Handle):
+                p._children.add(self)
 
     def close(self) -> None:
-        """Releases the handle now (later calls raise ValueError). Calling it again does nothing."""
+        """Releases the handle now, and first those that depend on it (a context's trackers);
+        later calls raise ValueError. Calling it again does nothing."""
         if getattr(self, "_finalizer", None) is not None:
+            for child in list(self._children):
+                child.close()
             self._finalizer()
 
     @property
@@ -536,7 +543,6 @@ class Tracker(_Handle):
         _check(lib.planarvo_tracker_create(context._h(), ctypes.byref(camera._to_c()), ctypes.byref(extrinsics._to_c()),
                                            ctypes.byref(o), ctypes.byref(h)))
         self._own(h, context)
-        self._context = context
         self._image = N.Image()
         self._result = N.sized(N.TrackResult)
 
@@ -544,8 +550,6 @@ class Tracker(_Handle):
         """Tracks one frame: uint8 (H, W) grey or (H, W, 3) BGR (or float32 grey), the camera's
         size, any row stride; timestamps in seconds, increasing. A frame that cannot be tracked
         is not an error: the result's status is LOST or DEGRADED with the reason."""
-        if self._context.closed:
-            raise ValueError("Tracker: its Context is closed")
         image, keep = _image(frame, self.camera.width, self.camera.height, self._image)
         r = self._result
         _check(lib.planarvo_tracker_track(self._h(), ctypes.byref(image), float(timestamp), ctypes.byref(r)))

@@ -79,3 +79,14 @@ def test_other_bad_input(tmp_path):
         planarvo.evaluate_motions(np.zeros((3, 3)), np.zeros((2, 3)), np.ones(3))
     with pytest.raises(ValueError, match="no motion pairs"):
         planarvo.calibrate([])
+
+
+def test_closing_a_context_closes_its_trackers():
+    ctx = planarvo.Context()
+    t = planarvo.Tracker(ctx, CAM, planarvo.Extrinsics(z=0.2))
+    ctx.close()
+    assert t.closed
+    with pytest.raises(ValueError, match="closed"):
+        t.track(np.zeros((48, 64), dtype=np.uint8), 0.0)
+    with pytest.raises(ValueError, match="closed"):
+        planarvo.Tracker(ctx, CAM, planarvo.Extrinsics(z=0.2))
