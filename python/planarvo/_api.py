@@ -7,7 +7,7 @@ import ctypes
 import enum
 import os
 import weakref
-from dataclasses import dataclass, field, fields
+from dataclasses import dataclass, fields
 from typing import Any, Callable, Iterator, List, Optional, Sequence, Tuple, Union
 
 import numpy as np

@@ -5,7 +5,6 @@ default: beside the library), PLANARVO_SHARED_DIR (the shared/ folder with data/
 default: /work/shared, else ../shared beside the checkout)."""
 import os
 import shutil
-import subprocess
 
 import numpy as np
 import pytest

@@ -54,7 +54,8 @@ def test_non_increasing_timestamps_are_an_error_not_a_crash(tracker):
     frame = np.random.default_rng(1).integers(0, 255, (48, 64), dtype=np.uint8)
     tracker.track(frame, 1.0)
     try:
-        tracker.track(frame, 0.5)
+        r = tracker.track(frame, 0.5)
+        assert r.status in (planarvo.TrackStatus.DEGRADED, planarvo.TrackStatus.LOST) and r.reason
     except planarvo.Error as e:
         assert e.status == planarvo.Status.INVALID_ARGUMENT
 
