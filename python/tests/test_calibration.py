@@ -94,3 +94,20 @@ def test_roll_pitch_from_frames(context, calibration_drive):
     assert result.status == planarvo.CalibrationStatus.OK and result.covariance.shape == (2, 2)
     err = np.array([result.roll - truth.roll, result.pitch - truth.pitch])
     assert np.all(np.abs(err) < 5 * np.sqrt(np.diag(result.covariance)) + math.radians(0.05)), err
+
+
+def test_streaming_calibrator_agrees_with_calibrate_dataset(context, calibration_drive):
+    with planarvo.Dataset(calibration_drive) as ds:
+        info = ds.info
+        reference = planarvo.calibrate_dataset(context, ds)
+        with planarvo.CameraCalibrator(context, info.camera) as calibrator:
+            for i in range(info.frame_count):
+                data = ds.frame_data(i)
+                calibrator.add_frame(ds.frame(i), data.timestamp, data.odometry, data.direction)
+            result = calibrator.finish()
+    assert result.status == planarvo.CalibrationStatus.OK, result.reason
+    assert result.frames == reference.frames
+    err = result.extrinsics.as_array() - info.extrinsics_gt.as_array()
+    assert np.all(np.abs(err) < 5 * result.sigmas + 1e-4), (err, result.sigmas)
+    np.testing.assert_allclose(result.extrinsics.as_array(), reference.extrinsics.as_array(), rtol=0,
+                               atol=np.max(reference.sigmas))
