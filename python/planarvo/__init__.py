@@ -16,8 +16,8 @@ from ._api import (EXTRINSICS_NAMES, CalibrationMethod, CalibrationOptions, Cali
                    Camera, CameraCalibrationOptions, CameraCalibrationResult, CameraCalibrator, Context, Dataset,
                    DatasetInfo, DeviceInfo, Error, Extrinsics, FrameData, MotionAccuracy, MotionPair, MotionProfile,
                    PosegraphInit, RobustLoss, RollPitch, RollPitchOptions, RollPitchResult, SE2, SimOptions,
-                   SolverSummary, Status, Tracker, TrackerOptions, TrackResult, TrackStatus, calibrate,
-                   calibrate_dataset, default_texture, evaluate_motions, list_devices, load_motion_pairs,
+                   SolverSummary, StatsWriter, Status, Tracker, TrackerOptions, TrackResult, TrackStatus, calibrate,
+                   calibrate_dataset, compose_extrinsics, default_texture, evaluate_motions, list_devices, load_motion_pairs,
                    posegraph_optimize, save_motion_pairs, simulate, track_motions, version, write_tum)
 from ._native import lib as _lib
 
@@ -28,7 +28,7 @@ __all__ = [
     "CameraCalibrationOptions", "CameraCalibrationResult", "CameraCalibrator", "Context", "Dataset", "DatasetInfo",
     "DeviceInfo", "Error", "Extrinsics", "FrameData", "MotionAccuracy", "MotionPair", "MotionProfile",
     "PosegraphInit", "RobustLoss", "RollPitch", "RollPitchOptions", "RollPitchResult", "SE2", "SimOptions",
-    "SolverSummary", "Status", "Tracker", "TrackerOptions", "TrackResult", "TrackStatus", "calibrate",
-    "calibrate_dataset", "default_texture", "evaluate_motions", "list_devices", "load_motion_pairs",
+    "SolverSummary", "StatsWriter", "Status", "Tracker", "TrackerOptions", "TrackResult", "TrackStatus", "calibrate",
+    "calibrate_dataset", "compose_extrinsics", "default_texture", "evaluate_motions", "list_devices", "load_motion_pairs",
     "posegraph_optimize", "save_motion_pairs", "simulate", "track_motions", "version", "write_tum",
 ]

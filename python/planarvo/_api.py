@@ -662,6 +662,43 @@ def write_tum(path: PathLike, timestamps: Sequence[float], poses: Any) -> None:
                                   p.ctypes.data_as(N.P(N.SE2)), p.shape[0]))
 
 
+class StatsWriter(_Handle):
+    """Per-frame statistics CSV (docs/formats.md): rows are flushed as they are added to
+    PATH.partial, which close() renames onto path (complete or untouched). Leaving a with-block
+    by an exception, discard(), or a writer never closed (garbage collection) removes the
+    partial file and leaves path as it was."""
+    _destroy_name = "planarvo_stats_writer_discard"
+
+    def __init__(self, path: PathLike):
+        h = ctypes.c_void_p()
+        _check(lib.planarvo_stats_writer_open(_path(path), ctypes.byref(h)))
+        self._own(h)
+
+    def add(self, timestamp: float, vx: float, vy: float, omega: float, iterations: int, final_cost: float,
+            inlier_fraction: float, ms: float, status: str) -> None:
+        """One row: the robot-frame velocity over the interval ending at the frame, and the
+        tracker's figures for it (status "first", "ok", "degraded", "lost", ...)."""
+        row = N.FrameStats(timestamp, vx, vy, omega, iterations, final_cost, inlier_fraction, ms, status.encode())
+        _check(lib.planarvo_stats_writer_add(self._h(), ctypes.byref(row)))
+
+    def close(self) -> None:
+        """Completes the file (renames it onto path); raises Error when a write failed."""
+        if not self.closed:
+            handle = self._handle
+            self._finalizer.detach()
+            _check(lib.planarvo_stats_writer_close(handle))
+
+    def discard(self) -> None:
+        """Removes the partial file and leaves path as it was."""
+        _Handle.close(self)
+
+    def __exit__(self, exc_type, *exc) -> None:
+        if exc_type is None:
+            self.close()
+        else:
+            self.discard()
+
+
 # ------------------------------------------------------------------------------------------------
 # Simulator
 
@@ -927,6 +964,18 @@ class CalibrationResult:
     total_seconds: float
     variance_factor: float
 
+    def _to_c(self) -> N.CalibrationResult:
+        r = N.sized(N.CalibrationResult)
+        r.value[:] = [float(v) for v in self.value]
+        r.covariance[:] = [float(v) for v in np.asarray(self.covariance).ravel()]
+        r.estimated[:] = [int(v) for v in self.estimated]
+        r.observable[:] = [int(v) for v in self.observable]
+        r.ambiguous, r.outliers, r.ok = int(self.ambiguous), self.outliers, int(self.ok)
+        r.unobservable_reason = self.unobservable_reason.encode()[:511]
+        r.total_iterations, r.total_seconds, r.variance_factor = (self.total_iterations, self.total_seconds,
+                                                                  self.variance_factor)
+        return r
+
     @classmethod
     def _from_c(cls, r: N.CalibrationResult) -> "CalibrationResult":
         return cls(np.array(r.value[:]), _matrix(r.covariance, 4), tuple(bool(v) for v in r.estimated),
@@ -950,6 +999,21 @@ def calibrate(pairs: Sequence[MotionPair], options: Optional[CalibrationOptions]
     result = CalibrationResult._from_c(r)
     _check(status, result)
     return result
+
+
+def compose_extrinsics(roll: float, pitch: float, roll_pitch_covariance: Optional[np.ndarray],
+                       graph: CalibrationResult) -> Tuple[Extrinsics, np.ndarray, Tuple[bool, ...]]:
+    """The camera's extrinsics from roll and pitch (with their (2, 2) covariance, or None when
+    they were given) and a graph calibration's x, y, scale (the height) and yaw: returns the
+    extrinsics, their (6, 6) covariance (order x y z roll pitch yaw) and per parameter whether it
+    was estimated."""
+    rp = None
+    if roll_pitch_covariance is not None:
+        rp = (ctypes.c_double * 4)()
+        _fill_matrix(rp, roll_pitch_covariance, 2, "roll_pitch_covariance")
+    e, cov, est = N.Extrinsics(), (ctypes.c_double * 36)(), (ctypes.c_int32 * 6)()
+    _check(lib.planarvo_compose_extrinsics(roll, pitch, rp, ctypes.byref(graph._to_c()), ctypes.byref(e), cov, est))
+    return Extrinsics._from_c(e), _matrix(cov, 6), tuple(bool(v) for v in est)
 
 
 # ------------------------------------------------------------------------------------------------

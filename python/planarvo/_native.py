@@ -82,6 +82,12 @@ class FrameData(ctypes.Structure):
                 ("direction", c_int32)]
 
 
+class FrameStats(ctypes.Structure):
+    _fields_ = [("timestamp", c_double), ("vx", c_double), ("vy", c_double), ("omega", c_double),
+                ("iterations", c_int32), ("final_cost", c_double), ("inlier_fraction", c_double), ("ms", c_double),
+                ("status", c_char_p)]
+
+
 class SimOptions(ctypes.Structure):
     _fields_ = [("struct_size", c_size_t), ("texture", c_char_p), ("texel_size", c_double),
                 ("extrinsics", Extrinsics), ("camera", Camera), ("seconds", c_double), ("fps", c_double),
@@ -211,6 +217,10 @@ _SIGNATURES = {
     "planarvo_dataset_frame_data": (S, [c_void_p, c_int64, P(FrameData)]),
     "planarvo_dataset_frame": (S, [c_void_p, c_int64, P(Image)]),
     "planarvo_write_tum": (S, [c_char_p, P(c_double), P(SE2), c_size_t]),
+    "planarvo_stats_writer_open": (S, [c_char_p, P(c_void_p)]),
+    "planarvo_stats_writer_add": (S, [c_void_p, P(FrameStats)]),
+    "planarvo_stats_writer_close": (S, [c_void_p]),
+    "planarvo_stats_writer_discard": (None, [c_void_p]),
     "planarvo_sim_options_init": (None, [P(SimOptions)]),
     "planarvo_sim_default_camera": (S, [c_int32, c_int32, c_double, P(Camera)]),
     "planarvo_simulate": (S, [c_void_p, P(SimOptions), c_char_p]),
@@ -242,6 +252,8 @@ _SIGNATURES = {
     "planarvo_camera_calibrator_finish": (S, [c_void_p, P(CameraCalibrationResult)]),
     "planarvo_track_motions": (S, [c_void_p, c_void_p, P(Extrinsics), P(TrackerOptions), P(MotionPair), c_size_t,
                                    P(c_size_t)]),
+    "planarvo_compose_extrinsics": (S, [c_double, c_double, P(c_double), P(CalibrationResult), P(Extrinsics),
+                                        P(c_double), P(c_int32)]),
 }
 
 

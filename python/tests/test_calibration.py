@@ -68,6 +68,13 @@ def test_graph_calibration_from_motion_pairs(context, calibration_drive):
     expected = np.array([truth.x, truth.y, truth.z, truth.yaw])
     sigma = np.sqrt(np.diag(result.covariance))
     assert np.all(np.abs(result.value - expected) < 5 * sigma + 1e-4), (result.value - expected, sigma)
+    # Composed with the true roll and pitch: the graph's x, y, height and yaw, roll and pitch as given.
+    rp_cov = np.diag([1e-6, 2e-6])
+    e, cov, estimated = planarvo.compose_extrinsics(truth.roll, truth.pitch, rp_cov, result)
+    np.testing.assert_allclose([e.x, e.y, e.z, e.yaw], result.value, rtol=0, atol=1e-12)
+    assert (e.roll, e.pitch) == (truth.roll, truth.pitch) and all(estimated)
+    np.testing.assert_allclose(cov[3:5, 3:5], rp_cov, rtol=1e-12)
+    np.testing.assert_allclose(cov[np.ix_([0, 1, 2, 5], [0, 1, 2, 5])], result.covariance, rtol=1e-9, atol=1e-18)
 
 
 def test_progress_callback_cancels_and_reraises(context, tmp_path):

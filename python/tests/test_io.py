@@ -71,3 +71,21 @@ def test_devices_and_context(context):
     assert context.device.device_name in [d.device_name for d in devices]
     assert isinstance(context.cache_dir, str)
     assert planarvo.version() == planarvo.__version__
+
+
+def test_stats_writer(tmp_path):
+    path = tmp_path / "stats.csv"
+    with planarvo.StatsWriter(path) as w:
+        w.add(0.0, 0.0, 0.0, 0.0, 0, 0.0, 1.0, 3.5, "first")
+        w.add(0.1, 0.5, -0.01, 0.2, 7, 0.25, 0.9, 4.25, "ok")
+        assert not path.exists()  # written as stats.csv.partial until closed
+    lines = path.read_text().splitlines()
+    assert lines[0].startswith("timestamp") and len(lines) == 3
+    assert lines[2].split(",")[-1] == "ok" and float(lines[2].split(",")[1]) == 0.5
+    # An exception inside the block discards: the complete file stays as it was.
+    with pytest.raises(RuntimeError):
+        with planarvo.StatsWriter(path) as w:
+            w.add(0.0, 0.0, 0.0, 0.0, 0, 0.0, 1.0, 3.5, "first")
+            raise RuntimeError("stop")
+    assert path.read_text().splitlines() == lines
+    assert not (tmp_path / "stats.csv.partial").exists()
