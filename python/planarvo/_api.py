@@ -479,7 +479,7 @@ class Context(_Handle):
 # Options: dataclasses whose None fields keep the library's defaults
 
 
-def _c_options(struct_type, init_name: str, options: Any, renames: Optional[dict] = None):
+def _c_options(struct_type, init_name: str, options: Any, skip: Sequence[str] = ()):
     """The C option struct: the library's defaults (init), then every field of options that is
     not None."""
     c = N.sized(struct_type)
@@ -487,7 +487,7 @@ def _c_options(struct_type, init_name: str, options: Any, renames: Optional[dict
     if options is not None:
         for f in fields(options):
             v = getattr(options, f.name)
-            if v is None or (renames and f.name in renames):
+            if v is None or f.name in skip:
                 continue
             setattr(c, f.name, int(v) if isinstance(v, (bool, enum.IntEnum)) else v)
     return c
@@ -642,7 +642,8 @@ class Dataset(_Handle):
         img = N.Image()
         _check(lib.planarvo_dataset_frame(self._h(), index, ctypes.byref(img)))
         if img.format != 0 or img.stride < img.width:
-            raise Error(Status.INTERNAL, "planarvo_dataset_frame returned format %d, stride %d" % (img.format, img.stride))
+            raise Error(Status.INTERNAL, "planarvo_dataset_frame returned format %d, stride %d"
+                        % (img.format, img.stride))
         buf = (ctypes.c_uint8 * (img.stride * img.height)).from_address(img.data)
         return np.frombuffer(buf, dtype=np.uint8).reshape(img.height, img.stride)[:, :img.width].copy()
 
@@ -743,7 +744,7 @@ def simulate(context: Context, out_directory: PathLike, options: Optional[SimOpt
     frames.txt, odometry.txt, direction.txt, groundtruth.txt, extrinsics_gt.yaml."""
     options = options or SimOptions()
     c = _c_options(N.SimOptions, "planarvo_sim_options_init", options,
-                   renames={"texture": 1, "extrinsics": 1, "camera": 1})
+                   skip=("texture", "extrinsics", "camera"))
     c.texture = _path(options.texture if options.texture is not None else default_texture())
     if options.extrinsics is not None:
         c.extrinsics = options.extrinsics._to_c()
@@ -783,7 +784,8 @@ def evaluate_motions(estimated: Any, truth: Any, dt: Sequence[float], valid: Opt
     e, t = _se2_array(estimated, "estimated"), _se2_array(truth, "truth")
     d = np.ascontiguousarray(dt, dtype=np.float64)
     if t.shape != e.shape or d.shape != (e.shape[0],):
-        raise ValueError("evaluate_motions: estimated %s, truth %s and dt %s must have N rows" % (e.shape, t.shape, d.shape))
+        raise ValueError("evaluate_motions: estimated %s, truth %s and dt %s must have N rows"
+                         % (e.shape, t.shape, d.shape))
     v = None
     if valid is not None:
         v = np.ascontiguousarray(valid, dtype=np.int32)
@@ -936,7 +938,7 @@ class CalibrationOptions:
 
 
 def _calibration_options(options: Optional[CalibrationOptions], log: Optional[_Callback]) -> N.CalibrationOptions:
-    c = _c_options(N.CalibrationOptions, "planarvo_calibration_options_init", options, renames={"initial": 1})
+    c = _c_options(N.CalibrationOptions, "planarvo_calibration_options_init", options, skip=("initial",))
     if options is not None and options.initial is not None:
         if len(options.initial) != 4:
             raise ValueError("initial: expected (x, y, scale, yaw)")
@@ -1068,7 +1070,8 @@ class RollPitch(_Handle):
         """Feeds one frame (as Tracker.track takes it); True once the map is complete."""
         image, keep = _image(frame, self.camera.width, self.camera.height)
         complete = ctypes.c_int32(0)
-        _check(lib.planarvo_roll_pitch_add_frame(self._h(), ctypes.byref(image), float(timestamp), ctypes.byref(complete)))
+        _check(lib.planarvo_roll_pitch_add_frame(self._h(), ctypes.byref(image), float(timestamp),
+                                                 ctypes.byref(complete)))
         del keep
         return bool(complete.value)
 
@@ -1141,7 +1144,7 @@ class _CameraCalibrationC:
     def __init__(self, options: Optional[CameraCalibrationOptions], progress: Optional[ProgressFn]):
         o = options or CameraCalibrationOptions()
         c = _c_options(N.CameraCalibrationOptions, "planarvo_camera_calibration_options_init", o,
-                       renames={"initial": 1, "graph": 1, "tracker": 1})
+                       skip=("initial", "graph", "tracker"))
         if o.initial is not None:
             c.has_initial, c.initial = 1, o.initial._to_c()
         self.graph = _calibration_options(o.graph, None) if o.graph is not None else None
