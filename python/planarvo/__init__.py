@@ -12,23 +12,23 @@ The library: $PLANARVO_LIBRARY, else the one installed beside this package, else
 (see python/README.md). Every failed call raises planarvo.Error; invalid Python input raises
 ValueError before any C call. Units: metres, radians, seconds (docs/conventions.md).
 """
-from ._api import (EXTRINSICS_NAMES, CalibrationMethod, CalibrationOptions, CalibrationResult, CalibrationStatus,
-                   Camera, CameraCalibrationOptions, CameraCalibrationResult, CameraCalibrator, Context, Dataset,
-                   DatasetInfo, DeviceInfo, Error, Extrinsics, FrameData, MotionAccuracy, MotionPair, MotionProfile,
-                   PosegraphInit, RobustLoss, RollPitch, RollPitchOptions, RollPitchResult, SE2, SimOptions,
-                   SolverSummary, StatsWriter, Status, Tracker, TrackerOptions, TrackResult, TrackStatus, calibrate,
-                   calibrate_dataset, compose_extrinsics, default_texture, evaluate_motions, list_devices, load_motion_pairs,
+from ._api import (EXTRINSICS_NAMES, CalibrationMethod, CalibrationOptions, CalibrationResult,
+                   CalibrationStatus, Camera, CameraCalibrationOptions, CameraCalibrationResult,
+                   CameraCalibrator, Context, Dataset, DatasetInfo, DeviceInfo, Error, Extrinsics, FrameData,
+                   MotionAccuracy, MotionPair, MotionProfile, PosegraphInit, RobustLoss, RollPitch,
+                   RollPitchOptions, RollPitchResult, SE2, SimOptions, SolverSummary, StatsWriter, Status,
+                   Tracker, TrackerOptions, TrackResult, TrackStatus, calibrate, calibrate_dataset,
+                   compose_extrinsics, default_texture, evaluate_motions, list_devices, load_motion_pairs,
                    posegraph_optimize, save_motion_pairs, simulate, track_motions, version, write_tum)
 from ._native import lib as _lib
 
 __version__ = _lib.planarvo_version_string().decode()
 
-__all__ = [
-    "EXTRINSICS_NAMES", "CalibrationMethod", "CalibrationOptions", "CalibrationResult", "CalibrationStatus", "Camera",
-    "CameraCalibrationOptions", "CameraCalibrationResult", "CameraCalibrator", "Context", "Dataset", "DatasetInfo",
-    "DeviceInfo", "Error", "Extrinsics", "FrameData", "MotionAccuracy", "MotionPair", "MotionProfile",
-    "PosegraphInit", "RobustLoss", "RollPitch", "RollPitchOptions", "RollPitchResult", "SE2", "SimOptions",
-    "SolverSummary", "StatsWriter", "Status", "Tracker", "TrackerOptions", "TrackResult", "TrackStatus", "calibrate",
-    "calibrate_dataset", "compose_extrinsics", "default_texture", "evaluate_motions", "list_devices", "load_motion_pairs",
-    "posegraph_optimize", "save_motion_pairs", "simulate", "track_motions", "version", "write_tum",
-]
+__all__ = ["EXTRINSICS_NAMES", "CalibrationMethod", "CalibrationOptions", "CalibrationResult",
+    "CalibrationStatus", "Camera", "CameraCalibrationOptions", "CameraCalibrationResult", "CameraCalibrator",
+    "Context", "Dataset", "DatasetInfo", "DeviceInfo", "Error", "Extrinsics", "FrameData", "MotionAccuracy",
+    "MotionPair", "MotionProfile", "PosegraphInit", "RobustLoss", "RollPitch", "RollPitchOptions",
+    "RollPitchResult", "SE2", "SimOptions", "SolverSummary", "StatsWriter", "Status", "Tracker",
+    "TrackerOptions", "TrackResult", "TrackStatus", "calibrate", "calibrate_dataset", "compose_extrinsics",
+    "default_texture", "evaluate_motions", "list_devices", "load_motion_pairs", "posegraph_optimize",
+    "save_motion_pairs", "simulate", "track_motions", "version", "write_tum"]

@@ -26,13 +26,15 @@ def test_installed_package_finds_its_library(tmp_path):
     if not build:
         pytest.skip("PLANARVO_BUILD_DIR not set (CTest sets it)")
     prefix = tmp_path / "prefix"
-    subprocess.run([os.environ.get("CMAKE", "cmake"), "--install", build, "--prefix", str(prefix)], check=True, capture_output=True)
+    subprocess.run([os.environ.get("CMAKE", "cmake"), "--install", build, "--prefix", str(prefix)], check=True,
+                   capture_output=True)
     site = prefix / "lib" / "python3" / "dist-packages"
     assert (site / "planarvo" / "py.typed").exists()
     env = {k: v for k, v in os.environ.items() if k not in ("PLANARVO_LIBRARY", "PYTHONPATH", "LD_LIBRARY_PATH")}
     env["PYTHONPATH"] = str(site)
-    out = subprocess.run([sys.executable, "-c", "import planarvo, planarvo._native as n; "
-                          "print(planarvo.__file__); print(n.lib._name); print(planarvo.default_texture())"],
+    code = "import planarvo, planarvo._native as n; print(planarvo.__file__); print(n.lib._name); " \
+           "print(planarvo.default_texture())"
+    out = subprocess.run([sys.executable, "-c", code],
                          cwd=str(tmp_path), env=env, capture_output=True, text=True, check=True)
     package, library, texture = out.stdout.split("\n")[:3]
     assert package.startswith(str(site)) and library.startswith(str(prefix)), out.stdout
