@@ -1,5 +1,6 @@
 # Installation: the library with an exported target planarvo::planarvo, a CMake package
-# (planarvoConfig.cmake + version file), a pkg-config file, the CLI and the built-in texture.
+# (planarvoConfig.cmake + version file), a pkg-config file, the CLI, the built-in texture and the
+# Python package.
 include(CMakePackageConfigHelpers)
 
 install(TARGETS planarvo EXPORT planarvoTargets
@@ -25,6 +26,12 @@ install(FILES ${PROJECT_SOURCE_DIR}/LICENSE ${PROJECT_SOURCE_DIR}/README.md DEST
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/docs/ DESTINATION ${CMAKE_INSTALL_DOCDIR})
 install(FILES ${PROJECT_SOURCE_DIR}/data/textures/asphalt_01.png
         DESTINATION ${CMAKE_INSTALL_DATADIR}/planarvo/textures)
+# The Python package (python/README.md) where Debian's python3 finds packages of a prefix:
+# <prefix>/lib/python3/dist-packages (PYTHONPATH for a prefix other than /usr and /usr/local). It
+# loads the library from <prefix>/lib or <prefix>/lib/<multiarch>, relative to itself.
+install(DIRECTORY ${PROJECT_SOURCE_DIR}/python/planarvo/
+        DESTINATION lib/python3/dist-packages/planarvo
+        FILES_MATCHING PATTERN "*.py" PATTERN "py.typed" PATTERN "__pycache__" EXCLUDE)
 
 set(PLANARVO_CMAKE_DIR ${CMAKE_INSTALL_LIBDIR}/cmake/planarvo)
 install(EXPORT planarvoTargets NAMESPACE planarvo:: DESTINATION ${PLANARVO_CMAKE_DIR})
