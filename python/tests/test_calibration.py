@@ -48,7 +48,12 @@ def test_calibrate_dataset_finds_true_extrinsics(context, calibration_drive):
     stages = []
     with planarvo.Dataset(calibration_drive) as ds:
         truth = ds.info.extrinsics_gt
-        result = planarvo.calibrate_dataset(context, ds, progress=lambda f, s: stages.append(s))
+        # Explicit options (the defaults) exercise the nested option structs.
+        options = planarvo.CameraCalibrationOptions(
+            method=planarvo.CalibrationMethod.ODOMETRY, tracker=planarvo.TrackerOptions(levels=4),
+            graph=planarvo.CalibrationOptions(loss=planarvo.RobustLoss.CAUCHY, gate_sigma=5.0,
+                                              estimate_odometry_noise=True))
+        result = planarvo.calibrate_dataset(context, ds, options, progress=lambda f, s: stages.append(s))
     assert result.status == planarvo.CalibrationStatus.OK, result.reason
     assert all(result.estimated) and stages
     err = result.extrinsics.as_array() - truth.as_array()
@@ -118,3 +123,14 @@ def test_streaming_calibrator_agrees_with_calibrate_dataset(context, calibration
     assert np.all(np.abs(err) < 5 * result.sigmas + 1e-4), (err, result.sigmas)
     np.testing.assert_allclose(result.extrinsics.as_array(), reference.extrinsics.as_array(), rtol=0,
                                atol=np.max(reference.sigmas))
+
+
+def test_unobservable_calibration_raises_with_result():
+    """Driving straight only: x and y are unobservable; the Error carries the filled-in result."""
+    pairs = [planarvo.MotionPair(0.1, planarvo.SE2(0.01, 0, 0), odometry=planarvo.SE2(0.01, 0, 0), direction=1)
+             for _ in range(20)]
+    with pytest.raises(planarvo.Error, match="not observable") as e:
+        planarvo.calibrate(pairs)
+    assert e.value.status == planarvo.Status.FAILED
+    assert isinstance(e.value.result, planarvo.CalibrationResult) and not e.value.result.ok
+    assert "observable" in e.value.result.unobservable_reason
