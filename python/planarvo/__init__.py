@@ -12,14 +12,21 @@ The library: $PLANARVO_LIBRARY, else the one installed beside this package, else
 (see python/README.md). Every failed call raises planarvo.Error; invalid Python input raises
 ValueError before any C call. Units: metres, radians, seconds (docs/conventions.md).
 """
-from ._api import (EXTRINSICS_NAMES, CalibrationMethod, CalibrationOptions, CalibrationResult,
-                   CalibrationStatus, Camera, CameraCalibrationOptions, CameraCalibrationResult,
-                   CameraCalibrator, Context, Dataset, DatasetInfo, DeviceInfo, Error, Extrinsics, FrameData,
-                   MotionAccuracy, MotionPair, MotionProfile, PosegraphInit, RobustLoss, RollPitch,
-                   RollPitchOptions, RollPitchResult, SE2, SimOptions, SolverSummary, StatsWriter, Status,
-                   Tracker, TrackerOptions, TrackResult, TrackStatus, calibrate, calibrate_dataset,
-                   compose_extrinsics, default_texture, evaluate_motions, list_devices, load_motion_pairs,
-                   posegraph_optimize, save_motion_pairs, simulate, track_motions, version, write_tum)
+from ._calibration import (CalibrationMethod, CalibrationOptions, CalibrationResult, RobustLoss, calibrate,
+                           compose_extrinsics)
+from ._camera import EXTRINSICS_NAMES, Camera, Extrinsics
+from ._camera_calibration import (CalibrationStatus, CameraCalibrationOptions, CameraCalibrationResult,
+                                  CameraCalibrator, RollPitch, RollPitchOptions, RollPitchResult, calibrate_dataset)
+from ._context import Context, DeviceInfo, list_devices, version
+from ._dataset import Dataset, DatasetInfo, FrameData
+from ._errors import Error, Status
+from ._evaluation import MotionAccuracy, evaluate_motions
+from ._motion_pairs import MotionPair, load_motion_pairs, save_motion_pairs, track_motions
+from ._output import StatsWriter, write_tum
+from ._posegraph import PosegraphInit, SolverSummary, posegraph_optimize
+from ._se2 import SE2
+from ._simulate import MotionProfile, SimOptions, default_texture, simulate
+from ._tracking import Tracker, TrackerOptions, TrackResult, TrackStatus
 from ._native import lib as _lib
 
 __version__ = _lib.planarvo_version_string().decode()

@@ -20,7 +20,7 @@ import time
 import numpy as np
 
 import planarvo
-import planarvo._api
+import planarvo._tracking
 
 
 class TimedLibrary:
@@ -61,8 +61,8 @@ def main(argv):
         rows = []
         for name, convert in (("grey", lambda f: f), ("bgr", lambda f: np.repeat(f[:, :, None], 3, axis=2))):
             inputs = [(t, convert(f)) for t, f in frames]
-            timed = TimedLibrary(planarvo._api.lib)
-            planarvo._api.lib = timed
+            timed = TimedLibrary(planarvo._tracking.lib)
+            planarvo._tracking.lib = timed
             try:
                 with planarvo.Tracker(ctx, info.camera, extrinsics) as tracker:
                     tracker.track(inputs[0][1], inputs[0][0])  # the first frame (kernels, buffers)
@@ -74,7 +74,7 @@ def main(argv):
                         wall.append((time.perf_counter() - start) * 1e3)
                         engine.append(r.ms)
             finally:
-                planarvo._api.lib = timed._lib
+                planarvo._tracking.lib = timed._lib
             c_call = [s * 1e3 for s in timed.seconds]
             python = [w - c for w, c in zip(wall, c_call)]
             capi = [c - e for c, e in zip(c_call, engine)]
@@ -82,9 +82,9 @@ def main(argv):
             rows.append((name, len(wall), med(wall), med(engine), med(capi), med(python) * 1e3,
                          100.0 * med(python) / med(engine), 100.0 * sum(python) / sum(engine)))
         # The Python side alone with warm caches: the same calls with the C call stubbed out.
-        stub = TimedLibrary(planarvo._api.lib)
+        stub = TimedLibrary(planarvo._tracking.lib)
         stub.planarvo_tracker_track = lambda *args: 0
-        planarvo._api.lib = stub
+        planarvo._tracking.lib = stub
         try:
             with planarvo.Tracker(ctx, info.camera, extrinsics) as tracker:
                 frame = frames[0][1]
@@ -93,7 +93,7 @@ def main(argv):
                     tracker.track(frame, float(i))
                 hot_us = (time.perf_counter() - start) / 2000 * 1e6
         finally:
-            planarvo._api.lib = stub._lib
+            planarvo._tracking.lib = stub._lib
         print("%dx%d, %d frames per row, device %s" % (info.camera.width, info.camera.height, len(frames) - 1,
                                                         ctx.device.device_name))
         print("medians per call; python % = Python-side time / engine time (median; and totals)")

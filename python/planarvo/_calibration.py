@@ -1,0 +1,136 @@
+"""The graph calibration: a sensor's x, y, scale and yaw from motion pairs, and the camera's
+extrinsics composed from it and roll and pitch."""
+from __future__ import annotations
+
+import ctypes
+import enum
+from dataclasses import dataclass
+from typing import Optional, Sequence, Tuple
+
+import numpy as np
+
+from . import _native as N
+from ._camera import Extrinsics
+from ._errors import _check
+from ._motion_pairs import MotionPair, _pairs_array
+from ._native import lib
+from ._posegraph import SolverSummary
+from ._util import LogFn, _c_options, _Callback, _fill_matrix, _matrix
+
+
+class CalibrationMethod(enum.IntEnum):
+    """planarvo_calibration_method."""
+    ODOMETRY = 0
+    NONHOLONOMIC = 1
+
+
+class RobustLoss(enum.IntEnum):
+    """planarvo_robust_loss."""
+    NONE = 0
+    HUBER = 1
+    CAUCHY = 2
+    TUKEY = 3
+
+
+@dataclass
+class CalibrationOptions:
+    """planarvo_calibration_options (the graph calibration); None keeps the library's default.
+    initial: (x, y, scale, yaw) to start from instead of the built-in initialisation."""
+    method: Optional[CalibrationMethod] = None
+    fix_scale: Optional[bool] = None
+    fixed_scale: Optional[float] = None
+    initial: Optional[Tuple[float, float, float, float]] = None
+    velocity_form: Optional[bool] = None
+    max_iterations: Optional[int] = None
+    sensor_sigma_relative: Optional[float] = None
+    sensor_sigma_floor: Optional[float] = None
+    sensor_sigma_theta: Optional[float] = None
+    odometry_sigma_relative: Optional[float] = None
+    odometry_sigma_floor: Optional[float] = None
+    odometry_sigma_theta: Optional[float] = None
+    loss: Optional[RobustLoss] = None
+    loss_scale: Optional[float] = None
+    gate_sigma: Optional[float] = None
+    still_speed: Optional[float] = None
+    estimate_odometry_noise: Optional[bool] = None
+
+
+def _calibration_options(options: Optional[CalibrationOptions], log: Optional[_Callback]) -> N.CalibrationOptions:
+    c = _c_options(N.CalibrationOptions, "planarvo_calibration_options_init", options, skip=("initial",))
+    if options is not None and options.initial is not None:
+        if len(options.initial) != 4:
+            raise ValueError("initial: expected (x, y, scale, yaw)")
+        c.has_initial = 1
+        c.initial[:] = [float(v) for v in options.initial]
+    if log is not None:
+        c.log = log.c
+    return c
+
+
+@dataclass
+class CalibrationResult:
+    """A graph calibration: value (x, y, scale, yaw), its (4, 4) covariance; per parameter
+    estimated and observable; ok when converged, observable and not ambiguous."""
+    value: np.ndarray
+    covariance: np.ndarray
+    estimated: Tuple[bool, ...]
+    observable: Tuple[bool, ...]
+    ambiguous: bool
+    outliers: int
+    ok: bool
+    unobservable_reason: str
+    summary: SolverSummary
+    total_iterations: int
+    total_seconds: float
+    variance_factor: float
+
+    def _to_c(self) -> N.CalibrationResult:
+        r = N.sized(N.CalibrationResult)
+        r.value[:] = [float(v) for v in self.value]
+        r.covariance[:] = [float(v) for v in np.asarray(self.covariance).ravel()]
+        r.estimated[:] = [int(v) for v in self.estimated]
+        r.observable[:] = [int(v) for v in self.observable]
+        r.ambiguous, r.outliers, r.ok = int(self.ambiguous), self.outliers, int(self.ok)
+        r.unobservable_reason = self.unobservable_reason.encode()[:511]
+        r.total_iterations, r.total_seconds, r.variance_factor = (self.total_iterations, self.total_seconds,
+                                                                  self.variance_factor)
+        return r
+
+    @classmethod
+    def _from_c(cls, r: N.CalibrationResult) -> "CalibrationResult":
+        return cls(np.array(r.value[:]), _matrix(r.covariance, 4), tuple(bool(v) for v in r.estimated),
+                   tuple(bool(v) for v in r.observable), bool(r.ambiguous), r.outliers, bool(r.ok),
+                   r.unobservable_reason.decode(errors="replace"), SolverSummary._from_c(r.summary),
+                   r.total_iterations, r.total_seconds, r.variance_factor)
+
+
+def calibrate(pairs: Sequence[MotionPair], options: Optional[CalibrationOptions] = None,
+              log: Optional[LogFn] = None) -> CalibrationResult:
+    """Graph calibration of a sensor's x, y, scale and yaw from motion pairs. Raises Error
+    (Status.FAILED, .result the CalibrationResult) when the result is not ok."""
+    if not pairs:
+        raise ValueError("calibrate: no motion pairs")
+    cb = _Callback(log, N.LOG_FN) if log is not None else None
+    o = _calibration_options(options, cb)
+    r = N.sized(N.CalibrationResult)
+    status = lib.planarvo_calibrate(_pairs_array(pairs), len(pairs), ctypes.byref(o), ctypes.byref(r))
+    if cb is not None:
+        cb.reraise()
+    result = CalibrationResult._from_c(r)
+    _check(status, result)
+    return result
+
+
+def compose_extrinsics(roll: float, pitch: float, roll_pitch_covariance: Optional[np.ndarray],
+                       graph: CalibrationResult) -> Tuple[Extrinsics, np.ndarray, Tuple[bool, ...]]:
+    """The camera's extrinsics from roll and pitch (with their (2, 2) covariance, or None when
+    they were given) and a graph calibration's x, y, scale (the height) and yaw: returns the
+    extrinsics, their (6, 6) covariance (order x y z roll pitch yaw) and per parameter whether it
+    was estimated."""
+    rp = None
+    if roll_pitch_covariance is not None:
+        rp = (ctypes.c_double * 4)()
+        _fill_matrix(rp, roll_pitch_covariance, 2, "roll_pitch_covariance")
+    e, cov, est = N.Extrinsics(), (ctypes.c_double * 36)(), (ctypes.c_int32 * 6)()
+    _check(lib.planarvo_compose_extrinsics(roll, pitch, rp, ctypes.byref(graph._to_c()), ctypes.byref(e), cov, est))
+    return Extrinsics._from_c(e), _matrix(cov, 6), tuple(bool(v) for v in est)

@@ -1,0 +1,101 @@
+"""Data sets (docs/formats.md): a directory read and validated on open, frames decoded on demand."""
+from __future__ import annotations
+
+import ctypes
+import os
+from dataclasses import dataclass
+from typing import Iterator, Optional, Tuple
+
+import numpy as np
+
+from . import _native as N
+from ._camera import Camera, Extrinsics
+from ._errors import Error, Status, _check
+from ._handle import _Handle
+from ._native import lib
+from ._se2 import SE2
+from ._util import PathLike, ProgressFn, _Callback, _path
+
+
+@dataclass
+class DatasetInfo:
+    """What a data set holds; extrinsics / extrinsics_gt None when it has none."""
+    frame_count: int
+    first_timestamp: float
+    last_timestamp: float
+    camera: Camera
+    has_odometry: bool
+    has_direction: bool
+    has_groundtruth: bool
+    extrinsics: Optional[Extrinsics]
+    extrinsics_gt: Optional[Extrinsics]
+
+
+@dataclass
+class FrameData:
+    """A frame's time stamp, and its odometry pose, true pose and direction label (+1 forwards,
+    -1 backwards, 0 no linear motion) where the data set has them (else None)."""
+    timestamp: float
+    odometry: Optional[SE2]
+    groundtruth: Optional[SE2]
+    direction: Optional[int]
+
+
+class Dataset(_Handle):
+    """A data set directory (docs/formats.md), read and validated on open; frames are decoded on
+    demand. video: a video file standing in for frames.txt + images/."""
+    _destroy_name = "planarvo_dataset_destroy"
+
+    def __init__(self, directory: PathLike, video: Optional[PathLike] = None, verify_images: bool = False,
+                 allow_missing_images: bool = False, progress: Optional[ProgressFn] = None):
+        o = N.sized(N.DatasetOptions)
+        lib.planarvo_dataset_options_init(ctypes.byref(o))
+        o.video = None if video is None else _path(video)
+        o.verify_images = int(verify_images)
+        o.allow_missing_images = int(allow_missing_images)
+        cb = _Callback(progress, N.PROGRESS_FN)
+        o.progress = cb.c
+        h = ctypes.c_void_p()
+        status = lib.planarvo_dataset_open(_path(directory), ctypes.byref(o), ctypes.byref(h))
+        cb.reraise()
+        _check(status)
+        self._own(h)
+        self.path = os.fspath(directory)
+
+    @property
+    def info(self) -> DatasetInfo:
+        i = N.sized(N.DatasetInfo)
+        _check(lib.planarvo_dataset_info_get(self._h(), ctypes.byref(i)))
+        return DatasetInfo(i.frame_count, i.first_timestamp, i.last_timestamp, Camera._from_c(i.camera),
+                           bool(i.has_odometry), bool(i.has_direction), bool(i.has_groundtruth),
+                           Extrinsics._from_c(i.extrinsics) if i.has_extrinsics else None,
+                           Extrinsics._from_c(i.extrinsics_gt) if i.has_extrinsics_gt else None)
+
+    def __len__(self) -> int:
+        return self.info.frame_count
+
+    def set_roi(self, roi: Optional[Tuple[int, int, int, int]]) -> None:
+        """Replaces the camera's region of interest (x, y, width, height); None: the whole image."""
+        _check(lib.planarvo_dataset_set_roi(self._h(), None if roi is None else ctypes.byref(N.Region(*roi))))
+
+    def frame_data(self, index: int) -> FrameData:
+        d = N.FrameData()
+        _check(lib.planarvo_dataset_frame_data(self._h(), index, ctypes.byref(d)))
+        return FrameData(d.timestamp, SE2._from_c(d.odometry) if d.has_odometry else None,
+                         SE2._from_c(d.groundtruth) if d.has_groundtruth else None,
+                         d.direction if d.has_direction else None)
+
+    def frame(self, index: int) -> np.ndarray:
+        """Frame index decoded as 8-bit grey: a new (H, W) uint8 array."""
+        img = N.Image()
+        _check(lib.planarvo_dataset_frame(self._h(), index, ctypes.byref(img)))
+        if img.format != 0 or img.stride < img.width:
+            raise Error(Status.INTERNAL, "planarvo_dataset_frame returned format %d, stride %d"
+                        % (img.format, img.stride))
+        buf = (ctypes.c_uint8 * (img.stride * img.height)).from_address(img.data)
+        return np.frombuffer(buf, dtype=np.uint8).reshape(img.height, img.stride)[:, :img.width].copy()
+
+    def frames(self) -> Iterator[Tuple[float, np.ndarray]]:
+        """(timestamp, grey frame) for every frame in order."""
+        for i in range(len(self)):
+            yield self.frame_data(i).timestamp, self.frame(i)

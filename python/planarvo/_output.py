@@ -1,0 +1,61 @@
+"""Result files (docs/formats.md): TUM trajectories and the per-frame statistics CSV."""
+from __future__ import annotations
+
+import ctypes
+from typing import Any, Sequence
+
+import numpy as np
+
+from . import _native as N
+from ._errors import _check
+from ._handle import _Handle
+from ._native import lib
+from ._se2 import _se2_array
+from ._util import PathLike, _path
+
+
+def write_tum(path: PathLike, timestamps: Sequence[float], poses: Any) -> None:
+    """Writes a TUM trajectory: timestamps (N,), poses (N, 3) of (x, y, theta) or a list of SE2."""
+    t = np.ascontiguousarray(timestamps, dtype=np.float64)
+    p = _se2_array(poses, "poses")
+    if t.ndim != 1 or t.shape[0] != p.shape[0]:
+        raise ValueError("timestamps: expected shape (%d,), got %s" % (p.shape[0], t.shape))
+    _check(lib.planarvo_write_tum(_path(path), t.ctypes.data_as(N.P(ctypes.c_double)),
+                                  p.ctypes.data_as(N.P(N.SE2)), p.shape[0]))
+
+
+class StatsWriter(_Handle):
+    """Per-frame statistics CSV (docs/formats.md): rows are flushed as they are added to
+    PATH.partial, which close() renames onto path (complete or untouched). Leaving a with-block
+    by an exception, discard(), or a writer never closed (garbage collection) removes the
+    partial file and leaves path as it was."""
+    _destroy_name = "planarvo_stats_writer_discard"
+
+    def __init__(self, path: PathLike):
+        h = ctypes.c_void_p()
+        _check(lib.planarvo_stats_writer_open(_path(path), ctypes.byref(h)))
+        self._own(h)
+
+    def add(self, timestamp: float, vx: float, vy: float, omega: float, iterations: int, final_cost: float,
+            inlier_fraction: float, ms: float, status: str) -> None:
+        """One row: the robot-frame velocity over the interval ending at the frame, and the
+        tracker's figures for it (status "first", "ok", "degraded", "lost", ...)."""
+        row = N.FrameStats(timestamp, vx, vy, omega, iterations, final_cost, inlier_fraction, ms, status.encode())
+        _check(lib.planarvo_stats_writer_add(self._h(), ctypes.byref(row)))
+
+    def close(self) -> None:
+        """Completes the file (renames it onto path); raises Error when a write failed."""
+        if not self.closed:
+            handle = self._handle
+            self._finalizer.detach()
+            _check(lib.planarvo_stats_writer_close(handle))
+
+    def discard(self) -> None:
+        """Removes the partial file and leaves path as it was."""
+        _Handle.close(self)
+
+    def __exit__(self, exc_type, *exc) -> None:
+        if exc_type is None:
+            self.close()
+        else:
+            self.discard()

@@ -1,0 +1,77 @@
+"""The simulator: renders a data set of a drive over a textured ground plane."""
+from __future__ import annotations
+
+import ctypes
+import enum
+import os
+from dataclasses import dataclass
+from typing import Optional
+
+from . import _native as N
+from ._camera import Camera, Extrinsics
+from ._context import Context
+from ._errors import _check
+from ._native import lib
+from ._util import PathLike, ProgressFn, _c_options, _Callback, _path
+
+
+class MotionProfile(enum.IntEnum):
+    """planarvo_motion_profile (the simulator's drive)."""
+    MIXED = 0
+    STRAIGHT = 1
+    CIRCLE = 2
+    SPIN = 3
+    CAR = 4
+
+
+@dataclass
+class SimOptions:
+    """planarvo_sim_options; None keeps the library's default (planarvo.h). texture None: the
+    C API requires one, so the installed or source tree's asphalt_01.png is looked up."""
+    texture: Optional[PathLike] = None
+    texel_size: Optional[float] = None
+    extrinsics: Optional[Extrinsics] = None
+    camera: Optional[Camera] = None
+    seconds: Optional[float] = None
+    fps: Optional[float] = None
+    seed: Optional[int] = None
+    motion: Optional[MotionProfile] = None
+    max_speed: Optional[float] = None
+    max_turn_rate: Optional[float] = None
+    pixel_noise: Optional[float] = None
+    gain_variation: Optional[float] = None
+    odometry_noise: Optional[float] = None
+    supersampling: Optional[int] = None
+    min_turn_radius: Optional[float] = None
+
+
+def default_texture() -> str:
+    """The built-in ground texture asphalt_01.png: installed (<prefix>/share/planarvo/textures) or
+    in the source tree (data/textures). Raises FileNotFoundError when neither exists."""
+    here = os.path.dirname(os.path.abspath(__file__))
+    candidates = [os.path.join(here, "..", "..", "..", "..", "share", "planarvo", "textures", "asphalt_01.png"),
+                  os.path.join(here, "..", "..", "data", "textures", "asphalt_01.png")]
+    for c in candidates:
+        if os.path.exists(c):
+            return os.path.normpath(c)
+    raise FileNotFoundError("asphalt_01.png not found (looked in %s): give SimOptions.texture"
+                            % ", ".join(os.path.normpath(c) for c in candidates))
+
+
+def simulate(context: Context, out_directory: PathLike, options: Optional[SimOptions] = None,
+             progress: Optional[ProgressFn] = None) -> None:
+    """Renders a data set into out_directory (created if missing): camera.yaml, images/,
+    frames.txt, odometry.txt, direction.txt, groundtruth.txt, extrinsics_gt.yaml."""
+    options = options or SimOptions()
+    c = _c_options(N.SimOptions, "planarvo_sim_options_init", options,
+                   skip=("texture", "extrinsics", "camera"))
+    c.texture = _path(options.texture if options.texture is not None else default_texture())
+    if options.extrinsics is not None:
+        c.extrinsics = options.extrinsics._to_c()
+    if options.camera is not None:
+        c.camera = options.camera._to_c()
+    cb = _Callback(progress, N.PROGRESS_FN)
+    c.progress = cb.c
+    status = lib.planarvo_simulate(context._h(), ctypes.byref(c), _path(out_directory))
+    cb.reraise()
+    _check(status)

@@ -1,0 +1,88 @@
+"""Small helpers shared by the modules: path and string arguments, Python callbacks as C
+callbacks, matrices to and from C arrays, and option structs from dataclasses."""
+from __future__ import annotations
+
+import ctypes
+import enum
+import os
+from dataclasses import fields
+from typing import Any, Callable, Optional, Sequence, Union
+
+import numpy as np
+
+from . import _native as N
+from ._native import lib
+
+try:
+    # Resolved here, so that typing.get_type_hints works in every module that uses it.
+    PathLike = Union[str, os.PathLike[str]]
+except TypeError:  # Python 3.8: os.PathLike is not subscriptable at run time
+    PathLike = Union[str, "os.PathLike[str]"]
+ProgressFn = Callable[[float, str], Optional[bool]]  # return True to cancel
+LogFn = Callable[[str], None]
+
+
+def _path(p: PathLike) -> bytes:
+    return os.fsencode(p)
+
+
+def _opt(s: Optional[str]) -> Optional[bytes]:
+    return None if s is None else s.encode()
+
+
+class _Callback:
+    """A Python progress or log function as a C callback, kept alive for the call; an exception
+    raised in it cancels the call (progress) and is re-raised after it."""
+
+    def __init__(self, fn: Optional[Callable], kind):
+        self.fn, self.error = fn, None
+        if fn is None:
+            self.c = kind()  # NULL
+        elif kind is N.PROGRESS_FN:
+            self.c = kind(self._progress)
+        else:
+            self.c = kind(self._log)
+
+    def _progress(self, _user, fraction, stage):
+        try:
+            return 1 if self.fn(fraction, stage.decode(errors="replace") if stage else "") else 0
+        except BaseException as e:  # noqa: B902 - never let an exception unwind through C
+            self.error = e
+            return 1
+
+    def _log(self, _user, line):
+        if self.error is None:
+            try:
+                self.fn(line.decode(errors="replace") if line else "")
+            except BaseException as e:  # noqa: B902
+                self.error = e
+
+    def reraise(self) -> None:
+        if self.error is not None:
+            raise self.error
+
+
+def _matrix(values, n: int) -> np.ndarray:
+    return np.array(values[:n * n], dtype=np.float64).reshape(n, n)
+
+
+def _fill_matrix(dst, value, n: int, what: str) -> None:
+    a = np.asarray(value, dtype=np.float64)
+    if a.shape != (n, n):
+        raise ValueError("%s: expected a (%d, %d) array, got shape %s" % (what, n, n, a.shape))
+    for i, v in enumerate(a.ravel()):
+        dst[i] = v
+
+
+def _c_options(struct_type, init_name: str, options: Any, skip: Sequence[str] = ()):
+    """The C option struct: the library's defaults (init), then every field of options that is
+    not None."""
+    c = N.sized(struct_type)
+    getattr(lib, init_name)(ctypes.byref(c))
+    if options is not None:
+        for f in fields(options):
+            v = getattr(options, f.name)
+            if v is None or f.name in skip:
+                continue
+            setattr(c, f.name, int(v) if isinstance(v, (bool, enum.IntEnum)) else v)
+    return c
