@@ -3,6 +3,7 @@
 //                                          work-item / lanes / fast math, median ms per pass
 //   bench_track kernel w h wx wy pix hist fast lanes [rounds]   one configuration
 //   bench_track speed [w h] [seconds] [rounds]   ms per frame through the camera-frame API
+//                                          (median, mean, and the p99 and maximum over the median)
 //   bench_track accuracy [key=value...]     simulated sequences tracked against ground truth
 //       (seconds, w, h, seed, motion=mixed|straight|circle|spin, levels, finest, refine_kf, conv,
 //        huber, overlap, maxit=l0,l1,.., textures=a.png,b.png or textures=all,
@@ -75,6 +76,23 @@ double cpu_ms() {
 double median(std::vector<double> v) {
   std::sort(v.begin(), v.end());
   return v.empty() ? 0.0 : v[v.size() / 2];
+}
+
+// The tail of per-frame times: the 99th percentile and the maximum, each over the median.
+struct Tail {
+  double median = 0, p99_over_median = 0, max_over_median = 0;
+};
+Tail tail(std::vector<double> ms) {
+  Tail t;
+  if (ms.empty()) return t;
+  std::sort(ms.begin(), ms.end());
+  t.median = ms[ms.size() / 2];
+  const double p99 = ms[std::min(ms.size() - 1, static_cast<size_t>(0.99 * static_cast<double>(ms.size())))];
+  if (t.median > 0) {
+    t.p99_over_median = p99 / t.median;
+    t.max_over_median = ms.back() / t.median;
+  }
+  return t;
 }
 
 constexpr int kMaxLevelsBench = track::kMaxLevels;
@@ -283,11 +301,8 @@ int bench_accuracy(const std::vector<std::string>& textures, double seconds, int
                 tex.c_str(), config, perturb ? "p" : " ", r.frames, r.ok, r.degraded, r.lost, r.keyframes, r.acc.slope_linear, r.acc.slope_angular,
                 r.acc.rms_translation * 1e3, r.acc.max_translation * 1e3, r.acc.rms_rotation * 180 / M_PI,
                 r.acc.gross_errors, r.acc.endpoint_drift * 100, r.ms_frame / n, r.ms_pipeline / n, r.cpu_frame / n);
-    std::vector<double> ms = r.ms;
-    std::sort(ms.begin(), ms.end());
-    const double med = ms.empty() ? 0.0 : ms[ms.size() / 2];
-    const double p99 = ms.empty() ? 0.0 : ms[std::min(ms.size() - 1, static_cast<size_t>(0.99 * static_cast<double>(ms.size())))];
-    std::printf("%6.2f %6.2f %6.2f ", med, med > 0 ? p99 / med : 0.0, med > 0 && !ms.empty() ? ms.back() / med : 0.0);
+    const Tail t = tail(r.ms);
+    std::printf("%6.2f %6.2f %6.2f ", t.median, t.p99_over_median, t.max_over_median);
     for (int l = topt.levels - 1; l >= 0; --l) std::printf(" %.2f", r.passes[l] / n);
     std::printf("\n");
     if (verbose)
@@ -555,15 +570,17 @@ int bench_speed(int width, int height, double seconds, int rounds) {
     }
   std::printf("%dx%d, %zu frames of asphalt_01 (mixed motion) x %d rounds, camera-frame API (upload, undistortion, "
               "pyramid, tracking)\n", width, height, frames.size(), rounds);
-  std::printf("%-26s %9s %9s %9s %9s %9s %8s %7s\n", "configuration", "med_frame", "mean_frame", "med_pipe",
-              "med_track", "cpu/frame", "passes", "fps");
+  std::printf("%-26s %9s %9s %9s %9s %9s %8s %7s %7s %7s\n", "configuration", "med_frame", "mean_frame", "med_pipe",
+              "med_track", "cpu/frame", "passes", "fps", "p99/md", "max/md");
   for (size_t c = 0; c < configs.size(); ++c) {
     const Stats& s = stats[c];
     double mean = 0;
     for (double v : s.frame) mean += v;
     mean /= std::max<size_t>(1, s.frame.size());
-    std::printf("%-26s %9.2f %9.2f %9.2f %9.2f %9.2f %8.2f %7.0f\n", configs[c].name, median(s.frame), mean,
-                median(s.pipe), median(s.track), s.cpu / s.n, s.passes / s.n, 1000.0 / mean);
+    const Tail t = tail(s.frame);
+    std::printf("%-26s %9.2f %9.2f %9.2f %9.2f %9.2f %8.2f %7.0f %7.2f %7.2f\n", configs[c].name, t.median, mean,
+                median(s.pipe), median(s.track), s.cpu / s.n, s.passes / s.n, 1000.0 / mean, t.p99_over_median,
+                t.max_over_median);
   }
   return 0;
 }
