@@ -1,7 +1,7 @@
 // The per-frame image pipeline: an 8-bit grey camera frame in, the device pyramid of pyramid.h
-// out (upload -> undistortion -> Gaussian pyramid -> gradients, all on the OpenCL device), plus
-// the plain C++ reference of every stage, and helpers that move pyramids between host and device
-// (for tests, and for the tracker's tests). See README.md, "The image pipeline".
+// out (upload -> undistortion -> prefilter -> Gaussian pyramid -> gradients, all on the OpenCL
+// device), plus the plain C++ reference of every stage, and helpers that move pyramids between
+// host and device (for tests, and for the tracker's tests). See README.md, "The image pipeline".
 #pragma once
 #include <cstddef>
 #include <cstdint>
