@@ -144,7 +144,7 @@ PLANARVO_API planarvo_status planarvo_camera_load(const char* path, planarvo_cam
 PLANARVO_API planarvo_status planarvo_camera_save(const char* path, const planarvo_camera* camera);
 
 /* Reads extrinsics YAML (x y z roll pitch yaw required; a T_robot_camera that disagrees with them
- * is an error). covariance (6x6 row-major, order x y z roll pitch yaw) may be NULL. */
+ * is an error). The covariance and notes that planarvo_extrinsics_save writes are not read. */
 PLANARVO_API planarvo_status planarvo_extrinsics_load(const char* path, planarvo_extrinsics* e);
 /* Writes extrinsics YAML (docs/formats.md). covariance: 36 doubles or NULL (zeros); estimated:
  * comma-separated names such as "x,yaw" or NULL; method and notes may be NULL. */
@@ -459,7 +459,8 @@ PLANARVO_API void planarvo_tracker_destroy(planarvo_tracker* tracker);
 /* Tracks one frame (any planarvo_pixel_format; colour is converted to grey). A frame that cannot
  * be tracked (wrong size, black, saturated, textureless, after a gap) is not an error: the call
  * returns PLANARVO_OK with status LOST or DEGRADED, and tracking recovers on the next good frame.
- * Timestamps are in seconds and must increase. */
+ * Timestamps are in seconds and should increase; one that is not finite or not after the last is
+ * not an error either (the usual interval is assumed; the status is at best DEGRADED). */
 PLANARVO_API planarvo_status planarvo_tracker_track(planarvo_tracker* tracker,
                                                     const planarvo_image* image, double timestamp,
                                                     planarvo_track_result* result);
