@@ -74,14 +74,19 @@ def plot(poses, truth, path):
     c, s = math.cos(truth[0, 2]), math.sin(truth[0, 2])
     d = truth[:, :2] - truth[0, :2]
     rel = np.stack([c * d[:, 0] + s * d[:, 1], -s * d[:, 0] + c * d[:, 1]], axis=1)
-    fig, ax = plt.subplots(figsize=(6, 6))
+    # A figure of the drive's own shape (equal axes), so the plot fills it.
+    span = np.ptp(np.vstack([rel, poses[:, :2]]), axis=0) + 1e-3
+    width = 7.0
+    height = min(7.0, max(2.5, width * span[1] / span[0] + 1.0))
+    fig, ax = plt.subplots(figsize=(width, height))
     ax.plot(rel[:, 0], rel[:, 1], "k-", label="true")
     ax.plot(poses[:, 0], poses[:, 1], "r--", label="tracked (calibrated extrinsics)")
     ax.set_xlabel("x (m)")
     ax.set_ylabel("y (m)")
-    ax.set_aspect("equal")
-    ax.legend()
-    fig.savefig(path, dpi=100)
+    ax.set_aspect("equal", adjustable="datalim")
+    ax.grid(True, alpha=0.3)
+    ax.legend(loc="best")
+    fig.savefig(path, dpi=100, bbox_inches="tight")
     print("wrote %s" % path)
 
 
