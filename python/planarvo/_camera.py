@@ -88,6 +88,8 @@ class Extrinsics:
         if covariance is not None:
             cov = (ctypes.c_double * 36)()
             _fill_matrix(cov, covariance, 6, "covariance")
+        if isinstance(estimated, str):
+            estimated = [n.strip() for n in estimated.split(",") if n.strip()]
         bad = [n for n in estimated if n not in EXTRINSICS_NAMES]
         if bad:
             raise ValueError("estimated: unknown parameter names %s (known: %s)" % (bad, ", ".join(EXTRINSICS_NAMES)))

@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import ctypes
+import os
 from dataclasses import dataclass, fields
 from typing import List, Optional, Sequence, Union
 
@@ -9,7 +10,7 @@ from . import _native as N
 from ._errors import Status, _check
 from ._handle import _Handle
 from ._native import lib
-from ._util import PathLike, _path
+from ._util import PathLike, _names, _path
 
 
 def version() -> str:
@@ -91,16 +92,17 @@ class Context(_Handle):
     @property
     def cache_dir(self) -> str:
         """The kernel program cache directory; "" when the cache is off."""
-        return lib.planarvo_context_cache_dir(self._h()).decode()
+        return os.fsdecode(lib.planarvo_context_cache_dir(self._h()))
 
     def prepare_kernels(self) -> None:
         """Builds (or loads) every kernel program now, so that the first frame does not pay for it."""
         _check(lib.planarvo_context_prepare_kernels(self._h()))
 
-    def export_kernels(self, directory: PathLike, uses: Optional[Sequence[str]] = None) -> int:
+    def export_kernels(self, directory: PathLike, uses: Union[None, str, Sequence[str]] = None) -> int:
         """Writes the kernel binaries for this device into directory (for kernel_binaries_dir):
-        all of them, or those that uses ("track", "calibrate", "simulate") need. Returns the count."""
+        all of them, or those that uses ("track", "calibrate", "simulate"; one name or several)
+        need. Returns the count."""
         n = ctypes.c_size_t(0)
         _check(lib.planarvo_context_export_kernels_for(self._h(), _path(directory),
-                                                        ",".join(uses).encode() if uses else None, ctypes.byref(n)))
+                                                        _names(uses), ctypes.byref(n)))
         return n.value

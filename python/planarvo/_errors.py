@@ -34,6 +34,11 @@ class Error(Exception):
         self.result = result
         super().__init__("%s: %s" % (self.status_name, message))
 
+    def __reduce__(self):
+        # Pickled with its own arguments, so that it crosses processes (multiprocessing,
+        # concurrent.futures) as itself.
+        return (Error, (int(self.status), self.message, self.result))
+
 
 def _check(status: int, result: Any = None) -> None:
     if status != 0:

@@ -16,7 +16,7 @@ class SE2:
     y: float = 0.0
     theta: float = 0.0
 
-    def __array__(self, dtype=None):
+    def __array__(self, dtype=None, copy=None):  # copy: numpy 2's protocol (always a new array)
         return np.array([self.x, self.y, self.theta], dtype=dtype or np.float64)
 
     def as_array(self) -> np.ndarray:

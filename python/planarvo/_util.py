@@ -26,6 +26,13 @@ def _path(p: PathLike) -> bytes:
     return os.fsencode(p)
 
 
+def _names(names: Union[None, str, Sequence[str]]) -> Optional[bytes]:
+    """One name or several as the C API's comma-separated list; None (or empty) for none."""
+    if not names:
+        return None
+    return (names if isinstance(names, str) else ",".join(names)).encode()
+
+
 def _opt(s: Optional[str]) -> Optional[bytes]:
     return None if s is None else s.encode()
 
@@ -58,8 +65,10 @@ class _Callback:
                 self.error = e
 
     def reraise(self) -> None:
-        if self.error is not None:
-            raise self.error
+        # Raised once: a callback reused by later calls (CameraCalibrator) starts clean again.
+        err, self.error = self.error, None
+        if err is not None:
+            raise err
 
 
 def _matrix(values, n: int) -> np.ndarray:

@@ -91,3 +91,31 @@ def test_closing_a_context_closes_its_trackers():
         t.track(np.zeros((48, 64), dtype=np.uint8), 0.0)
     with pytest.raises(ValueError, match="closed"):
         planarvo.Tracker(ctx, CAM, planarvo.Extrinsics(z=0.2))
+
+
+def test_error_survives_pickling_with_its_status_and_message(tmp_path):
+    import pickle
+    with pytest.raises(planarvo.Error) as info:
+        planarvo.Camera.load(tmp_path / "missing.yaml")
+    copy = pickle.loads(pickle.dumps(info.value))
+    assert isinstance(copy, planarvo.Error)
+    assert (copy.status, copy.message, str(copy)) == (info.value.status, info.value.message, str(info.value))
+    assert "missing.yaml" in copy.message
+
+
+def test_one_name_is_a_name_not_its_letters(context, tmp_path):
+    one = context.export_kernels(tmp_path / "one", uses="track")
+    listed = context.export_kernels(tmp_path / "listed", uses=["track"])
+    assert one == listed > 0
+    planarvo.Extrinsics(z=0.2).save(tmp_path / "e.yaml", estimated="x,yaw")
+    assert "yaw" in (tmp_path / "e.yaml").read_text()
+
+
+def test_a_callback_error_is_raised_once():
+    import planarvo._native
+    from planarvo._util import _Callback
+    cb = _Callback(lambda *a: None, planarvo._native.PROGRESS_FN)
+    cb.error = RuntimeError("from the callback")
+    with pytest.raises(RuntimeError):
+        cb.reraise()
+    cb.reraise()  # nothing left to raise
