@@ -39,6 +39,9 @@ def _image(frame: Any, width: Optional[int] = None, height: Optional[int] = None
     h, w = frame.shape[0], frame.shape[1]
     if h == 0 or w == 0:
         raise ValueError("frame: empty (shape %s)" % (frame.shape,))
+    if frame.ndim == 2 and (frame.strides[0] % bpp or not frame.flags.aligned):
+        raise ValueError("frame: a float32 frame's rows must be aligned to 4 bytes (row stride %d bytes); "
+                         "pass np.ascontiguousarray(frame)" % frame.strides[0])
     if frame.strides[0] < w * bpp:
         raise ValueError("frame: rows must be in increasing memory order without overlap (row stride %d bytes)"
                          % frame.strides[0])

@@ -16,7 +16,7 @@ from ._errors import _check
 from ._native import lib
 from ._se2 import SE2
 from ._tracking import TrackerOptions, _tracker_options
-from ._util import PathLike, _fill_matrix, _matrix, _path
+from ._util import PathLike, _fill_matrix, _matrix, _path, _require
 
 
 @dataclass
@@ -82,6 +82,7 @@ def track_motions(context: Context, dataset: Dataset, extrinsics: Extrinsics,
     """Tracks every frame of dataset with extrinsics and returns one motion pair per tracked
     interval (lost ones left out): the tracker's motion and covariance as the sensor's, with the
     data set's odometry and direction labels where it has them."""
+    _require(extrinsics, Extrinsics, "extrinsics")
     capacity = max(len(dataset) - 1, 1)
     a = (N.MotionPair * capacity)()
     count = ctypes.c_size_t(0)

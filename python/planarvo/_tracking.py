@@ -16,7 +16,7 @@ from ._frame import _image
 from ._handle import _Handle
 from ._native import lib
 from ._se2 import SE2
-from ._util import _c_options
+from ._util import _c_options, _require
 
 
 class TrackStatus(enum.IntEnum):
@@ -70,8 +70,8 @@ class Tracker(_Handle):
 
     def __init__(self, context: Context, camera: Camera, extrinsics: Extrinsics,
                  options: Optional[TrackerOptions] = None):
-        self.camera = camera
-        self.extrinsics = extrinsics
+        self.camera = _require(camera, Camera, "camera")
+        self.extrinsics = _require(extrinsics, Extrinsics, "extrinsics")
         o = _tracker_options(options)
         h = ctypes.c_void_p()
         _check(lib.planarvo_tracker_create(context._h(), ctypes.byref(camera._to_c()), ctypes.byref(extrinsics._to_c()),

@@ -33,6 +33,14 @@ def _names(names: Union[None, str, Sequence[str]]) -> Optional[bytes]:
     return (names if isinstance(names, str) else ",".join(names)).encode()
 
 
+def _require(value: Any, cls: type, what: str) -> Any:
+    """value itself when it is a cls, else ValueError naming what was expected (a data set
+    without extrinsics.yaml gives info.extrinsics None, for example)."""
+    if not isinstance(value, cls):
+        raise ValueError("%s: expected a planarvo.%s, got %s" % (what, cls.__name__, type(value).__name__))
+    return value
+
+
 def _opt(s: Optional[str]) -> Optional[bytes]:
     return None if s is None else s.encode()
 

@@ -119,3 +119,16 @@ def test_a_callback_error_is_raised_once():
     with pytest.raises(RuntimeError):
         cb.reraise()
     cb.reraise()  # nothing left to raise
+
+
+def test_missing_extrinsics_are_a_value_error(context):
+    with pytest.raises(ValueError, match="extrinsics"):
+        planarvo.Tracker(context, CAM, None)
+
+
+def test_a_float32_frame_with_unaligned_rows_is_a_value_error(tracker):
+    from numpy.lib.stride_tricks import as_strided
+    buf = np.zeros(258 * 48 + 4, dtype=np.uint8)
+    frame = as_strided(buf[2:].view(np.uint8), shape=(48, 64 * 4), strides=(258, 1)).view(np.float32)
+    with pytest.raises(ValueError, match="aligned"):
+        tracker.track(frame, 0.0)
