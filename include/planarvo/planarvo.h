@@ -459,8 +459,7 @@ PLANARVO_API void planarvo_tracker_destroy(planarvo_tracker* tracker);
 /* Tracks one frame (any planarvo_pixel_format; colour is converted to grey). A frame that cannot
  * be tracked (wrong size, black, saturated, textureless, after a gap) is not an error: the call
  * returns PLANARVO_OK with status LOST or DEGRADED, and tracking recovers on the next good frame.
- * Timestamps are in seconds and should increase; one that is not finite or not after the last is
- * not an error either (the usual interval is assumed; the status is at best DEGRADED). */
+ * Timestamps (seconds) should increase; one that does not is not an error: at best DEGRADED. */
 PLANARVO_API planarvo_status planarvo_tracker_track(planarvo_tracker* tracker,
                                                     const planarvo_image* image, double timestamp,
                                                     planarvo_track_result* result);

@@ -36,14 +36,18 @@ def context():
         yield ctx
 
 
-@pytest.fixture(scope="session")
-def drive(context, tmp_path_factory):
-    """A 2 s mixed drive at 15 fps, 320x240, rendered by planarvo.simulate."""
-    out = tmp_path_factory.mktemp("sim") / "drive"
-    options = planarvo.SimOptions(camera=planarvo.Camera.simulator_default(320, 240, 80.0), seconds=2.0, fps=15.0,
-                                  seed=7, supersampling=2)
+def simulate_drive(context, out, seconds, seed, supersampling):
+    """A mixed drive at 15 fps, 320x240, rendered by planarvo.simulate into out; returns out."""
+    options = planarvo.SimOptions(camera=planarvo.Camera.simulator_default(320, 240, 80.0), seconds=seconds,
+                                  fps=15.0, seed=seed, supersampling=supersampling)
     planarvo.simulate(context, out, options)
     return out
+
+
+@pytest.fixture(scope="session")
+def drive(context, tmp_path_factory):
+    """A 2 s mixed drive at 15 fps, 320x240."""
+    return simulate_drive(context, tmp_path_factory.mktemp("sim") / "drive", 2.0, seed=7, supersampling=2)
 
 
 def true_motions(poses):

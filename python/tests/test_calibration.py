@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 import planarvo
-from conftest import shared_dir
+from conftest import shared_dir, simulate_drive
 
 
 def test_posegraph_reaches_reference_optimum(tmp_path):
@@ -37,11 +37,7 @@ def test_posegraph_bad_file(tmp_path):
 
 @pytest.fixture(scope="module")
 def calibration_drive(context, tmp_path_factory):
-    out = tmp_path_factory.mktemp("sim") / "calib"
-    options = planarvo.SimOptions(camera=planarvo.Camera.simulator_default(320, 240, 80.0), seconds=8.0, fps=15.0,
-                                  seed=3, supersampling=1)
-    planarvo.simulate(context, out, options)
-    return out
+    return simulate_drive(context, tmp_path_factory.mktemp("sim") / "calib", 8.0, seed=3, supersampling=1)
 
 
 def test_calibrate_dataset_finds_true_extrinsics(context, calibration_drive):
