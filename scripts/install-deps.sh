@@ -10,6 +10,7 @@ packages=(
   libopencv-core-dev libopencv-imgproc-dev libopencv-imgcodecs-dev libopencv-videoio-dev
   libopencv-calib3d-dev libopencv-video-dev
   libsuitesparse-dev
+  libzstd-dev liblz4-dev libbz2-dev
   libgtest-dev libgmock-dev
   python3 python3-numpy python3-pytest
 )

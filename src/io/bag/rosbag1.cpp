@@ -1,0 +1,7 @@
+// STUB: replaced by the ROS 1 bag reader.
+#include "core/error.h"
+#include "io/bag/bag.h"
+
+namespace planarvo::io::bag {
+std::unique_ptr<BagFile> open_rosbag1(const std::string& path) { throw_invalid_input(path + ": not implemented"); }
+}  // namespace planarvo::io::bag
