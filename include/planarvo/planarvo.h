@@ -250,103 +250,10 @@ PLANARVO_API planarvo_status planarvo_context_export_kernels_for(planarvo_contex
 /* Builds (or loads) every kernel program now, so that the first frame does not pay for it. */
 PLANARVO_API planarvo_status planarvo_context_prepare_kernels(planarvo_context* context);
 
-/* ------------------------------------------------------------------------------------------ */
-/* Data sets (docs/formats.md)                                                                 */
-
-/* A data set directory (camera.yaml, frames.txt + images/, or a video; optional odometry.txt,
- * direction.txt, groundtruth.txt, extrinsics.yaml, extrinsics_gt.yaml), read and validated on
- * open. Image files are decoded on demand by planarvo_dataset_frame. Thread safety: one thread at
- * a time. */
-typedef struct planarvo_dataset planarvo_dataset;
-
-typedef struct planarvo_dataset_options {
-  size_t struct_size;
-  /* A video file standing in for images/ + frames.txt; NULL to use frames.txt. */
-  const char* video;
-  /* Non-zero: decode every image while opening, so that an unreadable image or one of the wrong
-   * size is reported now rather than when its frame is read. */
-  int32_t verify_images;
-  planarvo_progress_fn progress;
-  void* progress_user_data;
-  /* Non-zero: an image that frames.txt lists but that does not exist is not an error at open
-   * (it is by default, found by one file-system check per image); reading its frame fails with
-   * PLANARVO_ERROR_INVALID_INPUT, like an undecodable image, for callers that skip bad frames
-   * (planarvo track --skip-bad-frames). Ignored with verify_images. */
-  int32_t allow_missing_images;
-} planarvo_dataset_options;
-
-/* What a data set holds. */
-typedef struct planarvo_dataset_info {
-  size_t struct_size;
-  int64_t frame_count;
-  double first_timestamp, last_timestamp;
-  planarvo_camera camera;
-  int32_t has_odometry, has_direction, has_groundtruth;
-  int32_t has_extrinsics, has_extrinsics_gt;
-  planarvo_extrinsics extrinsics;    /* valid when has_extrinsics */
-  planarvo_extrinsics extrinsics_gt; /* valid when has_extrinsics_gt */
-} planarvo_dataset_info;
-
-typedef struct planarvo_frame_data {
-  double timestamp;
-  /* Robot pose in the odometry frame, interpolated to the frame's time; valid when has_odometry
-   * (a frame outside the odometry's time span has none). */
-  int32_t has_odometry;
-  planarvo_se2 odometry;
-  /* True robot pose (groundtruth.txt); valid when has_groundtruth. */
-  int32_t has_groundtruth;
-  planarvo_se2 groundtruth;
-  /* Direction of the interval from the previous frame to this one: +1 forwards, -1 backwards,
-   * 0 no linear motion; valid when has_direction (never for frame 0). */
-  int32_t has_direction;
-  int32_t direction;
-} planarvo_frame_data;
-
-PLANARVO_API void planarvo_dataset_options_init(planarvo_dataset_options* options);
-PLANARVO_API planarvo_status planarvo_dataset_open(const char* directory,
-                                                   const planarvo_dataset_options* options,
-                                                   planarvo_dataset** dataset);
-PLANARVO_API void planarvo_dataset_destroy(planarvo_dataset* dataset);
-PLANARVO_API planarvo_status planarvo_dataset_info_get(const planarvo_dataset* dataset,
-                                                       planarvo_dataset_info* info);
-/* Replaces the data set camera's region of interest (camera.yaml's region_of_interest) for
- * everything that reads the data set from now on (planarvo_dataset_info_get, the calibration);
- * roi NULL or all zero: the whole image. PLANARVO_ERROR_INVALID_INPUT, changing nothing, when it
- * does not lie inside the image or is smaller than 16 pixels on a side. */
-PLANARVO_API planarvo_status planarvo_dataset_set_roi(planarvo_dataset* dataset, const planarvo_region* roi);
-PLANARVO_API planarvo_status planarvo_dataset_frame_data(const planarvo_dataset* dataset,
-                                                         int64_t index, planarvo_frame_data* data);
-/* Decodes frame index as 8-bit grey. *image points into memory owned by the data set, valid until
- * the next call on it or its destruction. */
-PLANARVO_API planarvo_status planarvo_dataset_frame(planarvo_dataset* dataset, int64_t index,
-                                                    planarvo_image* image);
-
-/* Writes a TUM trajectory (t x y z qx qy qz qw, z = 0, rotation about z). */
-PLANARVO_API planarvo_status planarvo_write_tum(const char* path, const double* timestamps,
-                                                const planarvo_se2* poses, size_t count);
-
-/* Per-frame statistics CSV (timestamp, vx, vy, omega, iterations, final_cost, inlier_fraction,
- * ms, status): the header on open, then one row per call, flushed. Written as PATH.partial and
- * renamed onto PATH by planarvo_stats_writer_close, so PATH is complete or untouched:
- * planarvo_stats_writer_discard (after an error, say) removes the partial file and leaves an
- * existing PATH as it was; a crash leaves the rows written so far in PATH.partial. */
-typedef struct planarvo_stats_writer planarvo_stats_writer;
-typedef struct planarvo_frame_stats {
-  double timestamp;
-  double vx, vy, omega;  /* robot-frame velocity over the interval ending at this frame */
-  int32_t iterations;    /* alignment steps, all levels */
-  double final_cost, inlier_fraction;
-  double ms;             /* engine time for the frame */
-  const char* status;    /* "first", "ok", "degraded", "lost", ... */
-} planarvo_frame_stats;
-PLANARVO_API planarvo_status planarvo_stats_writer_open(const char* path, planarvo_stats_writer** writer);
-PLANARVO_API planarvo_status planarvo_stats_writer_add(planarvo_stats_writer* writer,
-                                                       const planarvo_frame_stats* row);
-/* Completes the file (renames it onto PATH, reporting a failed write) and releases the writer;
- * NULL is allowed. */
-PLANARVO_API planarvo_status planarvo_stats_writer_close(planarvo_stats_writer* writer);
-/* Removes the partial file, leaves PATH as it was, and releases the writer; NULL is allowed. */
-PLANARVO_API void planarvo_stats_writer_discard(planarvo_stats_writer* writer);
+/* Data sets, bags and the files a run writes: planarvo/dataset.h (part of this header). */
+#define PLANARVO_INSIDE_PLANARVO_H
+#include "dataset.h" /* include/planarvo/dataset.h */
+#undef PLANARVO_INSIDE_PLANARVO_H
 
 /* ------------------------------------------------------------------------------------------ */
 /* Simulator                                                                                   */

@@ -29,6 +29,9 @@ class DatasetInfo:
     has_groundtruth: bool
     extrinsics: Optional[Extrinsics]
     extrinsics_gt: Optional[Extrinsics]
+    time_origin_ns: int = 0
+    """A bag's first frame's stamp (integer ns since the Unix epoch); times are seconds after it."""
+    is_bag: bool = False
 
 
 @dataclass
@@ -42,17 +45,30 @@ class FrameData:
 
 
 class Dataset(_Handle):
-    """A data set directory (docs/formats.md), read and validated on open; frames are decoded on
-    demand. video: a video file standing in for frames.txt + images/."""
+    """A data set directory (docs/formats.md), or a ROS 1 bag or MCAP file, read and validated on
+    open; frames are decoded on demand. video: a video file standing in for frames.txt + images/.
+    For a bag: image_topic (None: the bag's only image topic), camera_info_topic or camera_yaml
+    (None for both: the only CameraInfo topic), odometry_topic and groundtruth_topic
+    (nav_msgs/Odometry), use_receive_time (time by the recorder's clock, not header stamps)."""
     _destroy_name = "planarvo_dataset_destroy"
 
     def __init__(self, directory: PathLike, video: Optional[PathLike] = None, verify_images: bool = False,
-                 allow_missing_images: bool = False, progress: Optional[ProgressFn] = None):
+                 allow_missing_images: bool = False, progress: Optional[ProgressFn] = None, *,
+                 image_topic: Optional[str] = None, camera_info_topic: Optional[str] = None,
+                 camera_yaml: Optional[PathLike] = None, odometry_topic: Optional[str] = None,
+                 groundtruth_topic: Optional[str] = None, use_receive_time: bool = False):
         o = N.sized(N.DatasetOptions)
         lib.planarvo_dataset_options_init(ctypes.byref(o))
         o.video = None if video is None else _path(video)
         o.verify_images = int(verify_images)
         o.allow_missing_images = int(allow_missing_images)
+        for name, value in (("image_topic", image_topic), ("camera_info_topic", camera_info_topic),
+                            ("odometry_topic", odometry_topic), ("groundtruth_topic", groundtruth_topic)):
+            if value is not None and not isinstance(value, str):
+                raise ValueError(f"{name} must be a str, not {type(value).__name__}")
+            setattr(o, name, None if value is None else value.encode())
+        o.camera_yaml = None if camera_yaml is None else _path(camera_yaml)
+        o.use_receive_time = int(bool(use_receive_time))
         cb = _Callback(progress, N.PROGRESS_FN)
         o.progress = cb.c
         h = ctypes.c_void_p()
@@ -69,7 +85,8 @@ class Dataset(_Handle):
         return DatasetInfo(i.frame_count, i.first_timestamp, i.last_timestamp, Camera._from_c(i.camera),
                            bool(i.has_odometry), bool(i.has_direction), bool(i.has_groundtruth),
                            Extrinsics._from_c(i.extrinsics) if i.has_extrinsics else None,
-                           Extrinsics._from_c(i.extrinsics_gt) if i.has_extrinsics_gt else None)
+                           Extrinsics._from_c(i.extrinsics_gt) if i.has_extrinsics_gt else None,
+                           int(i.time_origin_ns), bool(i.is_bag))
 
     def __len__(self) -> int:
         return self.info.frame_count

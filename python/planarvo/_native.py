@@ -66,14 +66,17 @@ class ContextOptions(ctypes.Structure):
 
 class DatasetOptions(ctypes.Structure):
     _fields_ = [("struct_size", c_size_t), ("video", c_char_p), ("verify_images", c_int32),
-                ("progress", PROGRESS_FN), ("progress_user_data", c_void_p), ("allow_missing_images", c_int32)]
+                ("progress", PROGRESS_FN), ("progress_user_data", c_void_p), ("allow_missing_images", c_int32),
+                ("image_topic", c_char_p), ("camera_info_topic", c_char_p), ("camera_yaml", c_char_p),
+                ("odometry_topic", c_char_p), ("groundtruth_topic", c_char_p), ("use_receive_time", c_int32)]
 
 
 class DatasetInfo(ctypes.Structure):
     _fields_ = [("struct_size", c_size_t), ("frame_count", c_int64), ("first_timestamp", c_double),
                 ("last_timestamp", c_double), ("camera", Camera), ("has_odometry", c_int32),
                 ("has_direction", c_int32), ("has_groundtruth", c_int32), ("has_extrinsics", c_int32),
-                ("has_extrinsics_gt", c_int32), ("extrinsics", Extrinsics), ("extrinsics_gt", Extrinsics)]
+                ("has_extrinsics_gt", c_int32), ("extrinsics", Extrinsics), ("extrinsics_gt", Extrinsics),
+                ("time_origin_ns", c_int64), ("is_bag", c_int32)]
 
 
 class FrameData(ctypes.Structure):

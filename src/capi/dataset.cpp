@@ -2,6 +2,7 @@
 #include <cstring>
 #include <memory>
 #include <string>
+#include <utility>
 
 #include "capi/convert.h"
 #include "capi/handles.h"
@@ -35,6 +36,16 @@ PLANARVO_API planarvo_status planarvo_dataset_open(const char* directory, const 
       o.verify_images = options->verify_images != 0;
       if (options->struct_size >= offsetof(planarvo_dataset_options, allow_missing_images) + sizeof(int32_t))
         o.allow_missing_images = options->allow_missing_images != 0 && !o.verify_images;
+      if (options->struct_size >= offsetof(planarvo_dataset_options, use_receive_time) + sizeof(int32_t)) {
+        planarvo::io::BagDatasetOptions& b = o.bag;
+        for (auto [in, out] : {std::pair{options->image_topic, &b.image_topic},
+                               std::pair{options->camera_info_topic, &b.camera_info_topic},
+                               std::pair{options->camera_yaml, &b.camera_yaml},
+                               std::pair{options->odometry_topic, &b.odometry_topic},
+                               std::pair{options->groundtruth_topic, &b.groundtruth_topic}})
+          if (in) *out = in;
+        b.use_receive_time = options->use_receive_time != 0;
+      }
       if (options->progress) {
         const planarvo_progress_fn fn = options->progress;
         void* user = options->progress_user_data;
@@ -61,7 +72,8 @@ PLANARVO_API planarvo_status planarvo_dataset_set_roi(planarvo_dataset* dataset,
 PLANARVO_API planarvo_status planarvo_dataset_info_get(const planarvo_dataset* dataset, planarvo_dataset_info* info) {
   return guard([&] {
     require(dataset != nullptr && info != nullptr, "planarvo_dataset_info_get: NULL argument");
-    planarvo::capi::require_struct_size(info->struct_size, sizeof(planarvo_dataset_info), "planarvo_dataset_info");
+    planarvo::capi::require_struct_size(info->struct_size, offsetof(planarvo_dataset_info, time_origin_ns),
+                                        "planarvo_dataset_info");
     const planarvo::io::Dataset& d = *dataset->dataset;
     planarvo_dataset_info out;
     std::memset(&out, 0, sizeof out);
@@ -81,7 +93,9 @@ PLANARVO_API planarvo_status planarvo_dataset_info_get(const planarvo_dataset* d
       out.has_extrinsics_gt = 1;
       out.extrinsics_gt = planarvo::capi::to_c(d.extrinsics_gt()->value);
     }
-    *info = out;
+    out.time_origin_ns = d.time_origin_ns();
+    out.is_bag = d.is_bag() ? 1 : 0;
+    planarvo::capi::write_versioned(out, info);
   });
 }
 

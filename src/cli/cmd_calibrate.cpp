@@ -79,16 +79,18 @@ int cmd_calibrate_dataset(const Args& args, const planarvo_calibration_options& 
   const std::string out = args.get("output");
   ContextPtr ctx = make_context(args);
   Progress progress(!args.has("quiet"));
-  DatasetPtr ds = open_dataset(dir, args.get("video"), false, &progress);
+  DatasetPtr ds = open_dataset(dir, args, false, &progress);
   apply_roi(roi, ds.get());
   planarvo_dataset_info info{};
   info.struct_size = sizeof info;
   check(planarvo_dataset_info_get(ds.get(), &info));
   if (o.method == PLANARVO_CALIBRATE_ODOMETRY && !info.has_odometry)
-    throw UsageError(dir + " has no odometry.txt: the odometry method needs wheel odometry (or use --method "
-                           "nonholonomic with direction.txt and --height)");
+    throw UsageError(dir + (info.is_bag ? ": no --odom-topic given" : " has no odometry.txt") +
+                     ": the odometry method needs wheel odometry (or use --method nonholonomic with direction labels "
+                     "and --height)");
   if (o.method == PLANARVO_CALIBRATE_NONHOLONOMIC && !info.has_direction)
-    throw UsageError(dir + " has no direction.txt: the nonholonomic method needs the direction labels");
+    throw UsageError(dir + (info.is_bag ? ": a bag has no direction labels" : " has no direction.txt") +
+                     ": the nonholonomic method needs them");
   planarvo_camera_calibration_result r{};
   const planarvo_status st = calibrate_dataset(ctx.get(), ds.get(), &o, &progress, &r);
 

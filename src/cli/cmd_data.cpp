@@ -162,9 +162,13 @@ void print_dataset(planarvo_dataset* ds, const std::string& dir) {
   check(planarvo_dataset_info_get(ds, &info));
   const auto& c = info.camera;
   const double span = info.last_timestamp - info.first_timestamp;
-  std::printf("data set %s\n", dir.c_str());
+  std::printf("%s %s\n", info.is_bag ? "bag" : "data set", dir.c_str());
   std::printf("  frames      %lld over %.3f s (%.2f fps)\n", static_cast<long long>(info.frame_count), span,
               info.frame_count > 1 ? static_cast<double>(info.frame_count - 1) / span : 0.0);
+  if (info.is_bag)
+    std::printf("  first frame %lld.%09lld s (its stamp; times are counted from it)\n",
+                static_cast<long long>(info.time_origin_ns / 1000000000),
+                static_cast<long long>(info.time_origin_ns % 1000000000));
   std::printf("  camera      %dx%d, fx %.2f fy %.2f cx %.2f cy %.2f, distortion %.4g %.4g %.4g %.4g %.4g\n",
               c.width, c.height, c.fx, c.fy, c.cx, c.cy, c.k1, c.k2, c.p1, c.p2, c.k3);
   if (c.roi.width > 0)
@@ -229,17 +233,20 @@ int cmd_info(int argc, char** argv) {
       {"verify", "", "decode every image now (sizes, unreadable files)", ""},
       {"quiet", "", "no progress bar", ""},
       {"help", "", "show this help", ""}};
-  Args args(specs, argc, argv, 1);
+  std::vector<OptionSpec> all = specs;
+  for (auto& b : bag_options()) all.push_back(b);
+  Args args(all, argc, argv, 1);
   if (args.has("help")) {
-    std::printf("usage: planarvo info DATASET [--verify] [--video FILE]\n\n"
+    std::printf("usage: planarvo info DATASET [--verify] [--video FILE]\n"
+                "       planarvo info BAG [--image-topic T] [--camera-info-topic T | --camera FILE] [--odom-topic T]\n\n"
                 "Reads a data set (docs/formats.md: camera.yaml, frames.txt, images/, optional odometry.txt,\n"
                 "direction.txt, groundtruth.txt, extrinsics.yaml), checks it and prints what it holds.\n\n%s",
-                format_options(specs).c_str());
+                format_options(all).c_str());
     return kExitOk;
   }
-  args.expect_positionals(1, "DATASET, the data set folder");
+  args.expect_positionals(1, "DATASET, the data set folder or a bag");
   Progress progress(!args.has("quiet"));
-  DatasetPtr ds = open_dataset(args.positionals()[0], args.get("video"), args.has("verify"), &progress);
+  DatasetPtr ds = open_dataset(args.positionals()[0], args, args.has("verify"), &progress);
   progress.finish();
   print_dataset(ds.get(), args.positionals()[0]);
   if (args.has("verify")) std::printf("  every image decoded and checked\n");

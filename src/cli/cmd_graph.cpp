@@ -108,12 +108,15 @@ int cmd_calibrate(int argc, char** argv) {
       {"output", "FILE", "write the extrinsics YAML to FILE (also -o)", ""},
       {"verbose", "", "print the solver's iteration table", ""},
       {"help", "", "show this help", ""}};
+  for (auto& b : bag_options()) specs.push_back(b);
   for (auto& d : device_options()) specs.push_back(d);
   Args args(specs, argc, argv, 1);
   const bool dataset = !args.positionals().empty();
   if (args.has("help")) {
     std::printf("usage: planarvo calibrate DATASET [--method odometry|nonholonomic] [--height METRES] [--frames N]\n"
                 "                          [--initial-extrinsics FILE] -o extrinsics.yaml\n"
+                "       planarvo calibrate BAG --odom-topic T [--image-topic T] [--camera-info-topic T | --camera FILE]\n"
+                "                          -o extrinsics.yaml\n"
                 "       planarvo calibrate --motions FILE.csv [--method odometry|nonholonomic] [--fix-scale | "
                 "--height H] [-o extrinsics.yaml]\n\n"
                 "Calibrates the camera's pose on the robot. From a data set: roll and pitch from the images, then\n"

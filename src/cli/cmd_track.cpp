@@ -154,6 +154,9 @@ TrackRun track_dataset(planarvo_context* ctx, planarvo_dataset* ds, const planar
     check(planarvo_stats_writer_open(outputs.stats.c_str(), &w));
     stats.reset(w);
   }
+  // A bag's times are seconds after its first frame (exact differences); the files get the
+  // stamps back (to about 0.2 microseconds at today's epoch).
+  const double origin = static_cast<double>(info.time_origin_ns) * 1e-9;
   TrackRun run;
   Tracked k;
   std::vector<planarvo_motion_pair> pairs;
@@ -172,7 +175,7 @@ TrackRun track_dataset(planarvo_context* ctx, planarvo_dataset* ds, const planar
       ++run.skipped;
       if (stats) {
         planarvo_frame_stats row{};
-        row.timestamp = fd.timestamp;
+        row.timestamp = origin + fd.timestamp;
         row.status = "skipped";
         check(planarvo_stats_writer_add(stats.get(), &row));
       }
@@ -185,7 +188,8 @@ TrackRun track_dataset(planarvo_context* ctx, planarvo_dataset* ds, const planar
     count(r, &run);
     const bool first = k.t.empty();
     if (stats) {
-      const planarvo_frame_stats row = stats_row(fd, first ? 0 : fd.timestamp - k.t.back(), r);
+      planarvo_frame_stats row = stats_row(fd, first ? 0 : fd.timestamp - k.t.back(), r);
+      row.timestamp += origin;
       check(planarvo_stats_writer_add(stats.get(), &row));
     }
     planarvo_motion_pair p;
@@ -200,8 +204,11 @@ TrackRun track_dataset(planarvo_context* ctx, planarvo_dataset* ds, const planar
   }
   if (progress) Progress::callback(progress, 1.0, "tracking");
   if (stats) check(planarvo_stats_writer_close(stats.release()));
-  if (!outputs.trajectory.empty())
-    check(planarvo_write_tum(outputs.trajectory.c_str(), k.t.data(), k.pose.data(), k.t.size()));
+  if (!outputs.trajectory.empty()) {
+    std::vector<double> stamps(k.t);
+    for (double& t : stamps) t += origin;
+    check(planarvo_write_tum(outputs.trajectory.c_str(), stamps.data(), k.pose.data(), k.t.size()));
+  }
   if (!outputs.motions.empty()) check(planarvo_motion_pairs_save(outputs.motions.c_str(), pairs.data(), pairs.size()));
   account_lost(k, &run);
   evaluate(k, &run);
@@ -272,16 +279,19 @@ int cmd_track(int argc, char** argv) {
                               "lost", "5"},
       {"quiet", "", "no progress bar", ""},
       {"help", "", "show this help", ""}};
+  for (auto& b : bag_options()) specs.push_back(b);
   for (auto& d : device_options()) specs.push_back(d);
   Args args(specs, argc, argv, 1);
   if (args.has("help")) {
-    std::printf("usage: planarvo track DATASET [--extrinsics FILE] [-o trajectory.txt] [--stats stats.csv]\n\n"
-                "Dense planar visual odometry over a data set: prints a summary, and the accuracy against\n"
-                "groundtruth.txt when the data set has one.\n\n%s",
+    std::printf("usage: planarvo track DATASET [--extrinsics FILE] [-o trajectory.txt] [--stats stats.csv]\n"
+                "       planarvo track BAG --extrinsics FILE [--image-topic T] [--camera-info-topic T | --camera FILE]\n"
+                "                          [--odom-topic T] [--groundtruth-topic T] [-o trajectory.txt]\n\n"
+                "Dense planar visual odometry over a data set folder, a ROS 1 bag or an MCAP file (ROS 2): prints\n"
+                "a summary, and the accuracy against the ground truth when there is one.\n\n%s",
                 format_options(specs).c_str());
     return kExitOk;
   }
-  args.expect_positionals(1, "DATASET, the data set folder");
+  args.expect_positionals(1, "DATASET, the data set folder or a bag");
   const std::string dir = args.positionals()[0];
   // The options first: a usage error is reported before any file is read.
   args.expect_output_files({"output", "stats", "motions-out"});
@@ -296,6 +306,8 @@ int cmd_track(int argc, char** argv) {
   if (!(max_lost >= 0.0 && max_lost <= 100.0))
     throw UsageError("--max-lost must be a percentage within 0..100, not " + args.get("max-lost"));
   std::string extr = args.get("extrinsics");
+  if (extr.empty() && is_bag_path(dir))
+    throw UsageError("a bag carries no extrinsics: give --extrinsics FILE (planarvo calibrate writes one)");
   if (extr.empty()) {
     extr = (std::filesystem::path(dir) / "extrinsics.yaml").string();
     if (!std::filesystem::exists(extr))
@@ -305,7 +317,7 @@ int cmd_track(int argc, char** argv) {
   check(planarvo_extrinsics_load(extr.c_str(), &e));
   ContextPtr ctx = make_context(args);
   Progress progress(!args.has("quiet"));
-  DatasetPtr ds = open_dataset(dir, args.get("video"), false, &progress, args.has("skip-bad-frames"));
+  DatasetPtr ds = open_dataset(dir, args, false, &progress, args.has("skip-bad-frames"));
   apply_roi(roi, ds.get());
   const TrackRun run = track_dataset(ctx.get(), ds.get(), e, o, {args.get("output"), args.get("stats"), args.get("motions-out"), args.has("skip-bad-frames")}, &progress);
   progress.finish();

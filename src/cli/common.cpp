@@ -1,5 +1,7 @@
 #include "common.h"
 
+#include <filesystem>
+
 #include <cmath>
 #include <cstdio>
 #include <unistd.h>
@@ -82,6 +84,49 @@ std::optional<planarvo_region> parse_roi(const Args& args) {
 
 void apply_roi(const std::optional<planarvo_region>& roi, planarvo_dataset* dataset) {
   if (roi) check(planarvo_dataset_set_roi(dataset, &*roi));
+}
+
+std::vector<OptionSpec> bag_options() {
+  return {{"image-topic", "TOPIC", "bag: the images (sensor_msgs/Image or CompressedImage)", "the bag's only image topic"},
+          {"camera-info-topic", "TOPIC", "bag: the camera (sensor_msgs/CameraInfo, plumb_bob)",
+           "the bag's only CameraInfo topic, unless --camera"},
+          {"camera", "FILE", "bag: the camera from an OpenCV calibration YAML instead of a CameraInfo topic", ""},
+          {"odom-topic", "TOPIC", "bag: wheel odometry (nav_msgs/Odometry)", "none"},
+          {"groundtruth-topic", "TOPIC", "bag: true poses (nav_msgs/Odometry), for accuracy figures", "none"},
+          {"receive-time", "", "bag: time messages by when they were recorded, not by their header stamps", ""}};
+}
+
+bool is_bag_path(const std::string& path) {
+  std::error_code ec;
+  return std::filesystem::is_regular_file(path, ec);
+}
+
+DatasetPtr open_dataset(const std::string& path, const Args& args, bool verify, Progress* progress,
+                        bool allow_missing) {
+  if (!is_bag_path(path)) {
+    for (const OptionSpec& b : bag_options())
+      if (args.has(b.name))
+        throw UsageError("--" + b.name + " applies to a ROS bag or MCAP file, and " + path + " is not a file");
+    return open_dataset(path, args.get("video"), verify, progress, allow_missing);
+  }
+  if (args.has("video")) throw UsageError("--video applies to a data set folder, not to the bag " + path);
+  planarvo_dataset_options o;
+  planarvo_dataset_options_init(&o);
+  const std::string image = args.get("image-topic"), info = args.get("camera-info-topic"),
+                    camera = args.get("camera"), odom = args.get("odom-topic"), gt = args.get("groundtruth-topic");
+  if (!info.empty() && !camera.empty()) throw UsageError("give --camera-info-topic or --camera, not both");
+  o.image_topic = image.empty() ? nullptr : image.c_str();
+  o.camera_info_topic = info.empty() ? nullptr : info.c_str();
+  o.camera_yaml = camera.empty() ? nullptr : camera.c_str();
+  o.odometry_topic = odom.empty() ? nullptr : odom.c_str();
+  o.groundtruth_topic = gt.empty() ? nullptr : gt.c_str();
+  o.use_receive_time = args.has("receive-time") ? 1 : 0;
+  o.verify_images = verify ? 1 : 0;
+  o.progress = &Progress::callback;
+  o.progress_user_data = progress;
+  planarvo_dataset* d = nullptr;
+  check(planarvo_dataset_open(path.c_str(), &o, &d));
+  return DatasetPtr(d);
 }
 
 DatasetPtr open_dataset(const std::string& dir, const std::string& video, bool verify, Progress* progress,

@@ -65,6 +65,13 @@ std::optional<planarvo_region> parse_roi(const Args& args);
 void apply_roi(const std::optional<planarvo_region>& roi, planarvo_dataset* dataset);
 
 // allow_missing: a missing image is found when its frame is read, not at open (--skip-bad-frames).
+// The options that read a ROS 1 bag or MCAP file given as DATASET: topics, camera, timing.
+std::vector<OptionSpec> bag_options();
+// DATASET opened with the options of args that apply to it (--video, bag_options()).
+DatasetPtr open_dataset(const std::string& path, const Args& args, bool verify, Progress* progress,
+                        bool allow_missing = false);
+// True when path is a file (a bag), not a data set folder.
+bool is_bag_path(const std::string& path);
 DatasetPtr open_dataset(const std::string& dir, const std::string& video, bool verify, Progress* progress,
                         bool allow_missing = false);
 

@@ -22,11 +22,16 @@
 #include <opencv2/videoio/registry.hpp>
 
 #include "core/error.h"
+#include "io/bag/bag.h"
+#include "io/frame_image.h"
 #include "io/text.h"
 
 namespace planarvo::io {
 
 namespace fs = std::filesystem;
+
+using detail::BagSource;
+using detail::to_grey_checked;
 
 namespace {
 
@@ -43,32 +48,6 @@ class Progress {
  private:
   const ProgressCallback& cb_;
 };
-
-std::string size_text(int w, int h) { return std::to_string(w) + "x" + std::to_string(h); }
-
-// An 8-bit image of any channel count to CV_8UC1 of the camera's size; `name` and `context`
-// (e.g. "frame 3, frames.txt:5") go into the messages.
-cv::Mat to_grey_checked(const cv::Mat& img, const CameraModel& camera, const std::string& name,
-                        const std::string& context) {
-  if (img.depth() != CV_8U)
-    throw_invalid_input(name + ": " + (img.depth() == CV_16U ? "a 16-bit" : "a non-8-bit") +
-                        " image (" + context + "); planarvo reads 8-bit grey or colour images, "
-                        "convert it to 8 bits first");
-  if (img.cols != camera.width || img.rows != camera.height)
-    throw_invalid_input(name + ": " + size_text(img.cols, img.rows) + " pixels (" + context +
-                        "), but camera.yaml says " + size_text(camera.width, camera.height));
-  cv::Mat grey;
-  switch (img.channels()) {
-    case 1: grey = img; break;
-    case 2: cv::extractChannel(img, grey, 0); break;  // grey + alpha
-    case 3: cv::cvtColor(img, grey, cv::COLOR_BGR2GRAY); break;
-    case 4: cv::cvtColor(img, grey, cv::COLOR_BGRA2GRAY); break;
-    default:
-      throw_invalid_input(name + ": an image with " + std::to_string(img.channels()) +
-                          " channels (" + context + ")");
-  }
-  return grey;
-}
 
 cv::Mat read_image(const fs::path& file, const CameraModel& camera, const std::string& context) {
   const std::string name = file.string();
@@ -244,6 +223,7 @@ struct Dataset::Impl {
   std::vector<DirectionLabel> direction;
   std::optional<ExtrinsicsFile> extrinsics, extrinsics_gt;
   std::unique_ptr<VideoSource> video;
+  std::unique_ptr<BagSource> bag;
 
   std::string context(int64_t i) const {
     return "frame " + std::to_string(i) + ", " + detail::where(frames_file, frames[static_cast<size_t>(i)].line);
@@ -281,7 +261,17 @@ Dataset::Dataset(const std::string& directory, DatasetOptions options) : impl_(s
   d.dir = fs::path(directory);
   std::error_code ec;
   if (!fs::exists(d.dir, ec)) throw_invalid_input(directory + ": the data set directory does not exist");
-  if (!fs::is_directory(d.dir, ec)) throw_invalid_input(directory + ": not a directory");
+  if (fs::is_regular_file(d.dir, ec) && bag::looks_like_bag(directory)) {
+    open_bag(options);
+    return;
+  }
+  if (!fs::is_directory(d.dir, ec))
+    throw_invalid_input(directory + ": neither a data set directory nor a ROS 1 bag or MCAP file");
+  const BagDatasetOptions& b = options.bag;
+  if (!b.image_topic.empty() || !b.camera_info_topic.empty() || !b.camera_yaml.empty() ||
+      !b.odometry_topic.empty() || !b.groundtruth_topic.empty() || b.use_receive_time)
+    throw_invalid_input(directory + ": a data set directory, but topics, a camera file or receive times were given, "
+                        "which apply to bags only");
 
   d.camera = read_camera_yaml((d.dir / "camera.yaml").string());
 
@@ -341,6 +331,32 @@ Dataset::Dataset(const std::string& directory, DatasetOptions options) : impl_(s
   progress.report(1.0, "done");
 }
 
+void Dataset::open_bag(const DatasetOptions& options) {
+  Impl& d = *impl_;
+  const Progress progress(options.progress);
+  d.bag = std::make_unique<BagSource>(d.directory, options.bag, options.verify_images,
+                                      [&](double f, const char* stage) { progress.report(f, stage); });
+  d.camera = d.bag->camera();
+  d.frames = d.bag->frames();
+  d.odometry = d.bag->odometry();
+  d.groundtruth = d.bag->groundtruth();
+  const int64_t n = static_cast<int64_t>(d.frames.size());
+  const char* topics[] = {"--odom-topic", "--groundtruth-topic"};
+  int which = 0;
+  for (auto [samples, has] : {std::pair{&d.odometry, &d.has_odometry}, std::pair{&d.groundtruth, &d.has_groundtruth}}) {
+    const char* option = topics[which++];
+    *has = !samples->empty();
+    if (!*has) continue;
+    bool any = false;
+    for (int64_t i = 0; i < n && !any; ++i) any = interpolate_pose(*samples, d.frames[static_cast<size_t>(i)].t).has_value();
+    if (!any)
+      throw_invalid_input(d.directory + ": the " + option + " messages' times [" +
+                          detail::format_exact(samples->front().t) + ", " + detail::format_exact(samples->back().t) +
+                          "] s after the first frame apply to no frame; are both stamped on the same clock?");
+  }
+  progress.report(1.0, "done");
+}
+
 Dataset::~Dataset() = default;
 Dataset::Dataset(Dataset&&) noexcept = default;
 Dataset& Dataset::operator=(Dataset&&) noexcept = default;
@@ -361,6 +377,8 @@ void Dataset::set_region_of_interest(const PixelRegion& roi) {
   impl_->camera = c;
 }
 bool Dataset::is_video() const { return impl_->video != nullptr; }
+bool Dataset::is_bag() const { return impl_->bag != nullptr; }
+int64_t Dataset::time_origin_ns() const { return impl_->bag ? impl_->bag->time_origin_ns() : 0; }
 int64_t Dataset::frame_count() const { return static_cast<int64_t>(impl_->frames.size()); }
 const std::vector<FrameEntry>& Dataset::frames() const { return impl_->frames; }
 
@@ -372,12 +390,14 @@ double Dataset::timestamp(int64_t i) const {
 std::string Dataset::frame_source(int64_t i) const {
   check_index(i, "Dataset::frame_source");
   if (impl_->video) return impl_->video->name(i);
+  if (impl_->bag) return impl_->bag->name(i);
   return (impl_->dir / impl_->frames[static_cast<size_t>(i)].path).string();
 }
 
 cv::Mat Dataset::frame(int64_t i) {
   check_index(i, "Dataset::frame");
   if (impl_->video) return impl_->video->frame(i);
+  if (impl_->bag) return impl_->bag->frame(i);
   return read_image(impl_->dir / impl_->frames[static_cast<size_t>(i)].path, impl_->camera,
                     impl_->context(i));
 }

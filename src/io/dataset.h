@@ -14,6 +14,7 @@
 
 #include "core/se2.h"
 #include "image/camera.h"
+#include "io/dataset_bag.h"
 #include "io/formats.h"
 
 namespace planarvo::io {
@@ -33,6 +34,9 @@ struct DatasetOptions {
   // default); reading its frame throws InvalidInput, like an undecodable image.
   bool allow_missing_images = false;
   ProgressCallback progress;  // may be empty
+  // When the path is a ROS 1 bag or an MCAP file: its topics and camera (io/dataset_bag.h).
+  // Given any of them for a data set directory, opening fails (they would be ignored).
+  BagDatasetOptions bag;
 };
 
 // Pose samples interpolated to time t (SE(2), linear in x, y and theta, the angle the shorter
@@ -46,8 +50,9 @@ std::optional<int> direction_at(const std::vector<DirectionLabel>& labels, doubl
 
 class Dataset {
  public:
-  // Opens and validates the data set in `directory`. Throws Error(InvalidInput) naming the
-  // file for anything missing or malformed, Error(Cancelled) when the progress callback says so.
+  // Opens and validates the data set in `directory`, or the ROS 1 bag or MCAP file at that path
+  // (recognised by its first bytes). Throws Error(InvalidInput) naming the file for anything
+  // missing or malformed, Error(Cancelled) when the progress callback says so.
   explicit Dataset(const std::string& directory, DatasetOptions options = {});
   ~Dataset();
   Dataset(Dataset&&) noexcept;
@@ -61,6 +66,10 @@ class Dataset {
   // image). Throws InvalidInput, changing nothing, when it is not inside the image.
   void set_region_of_interest(const PixelRegion& roi);
   bool is_video() const;
+  bool is_bag() const;
+  // A bag's first frame's stamp in integer nanoseconds; timestamps are seconds after it. 0 for
+  // a directory, whose timestamps are frames.txt's (or the video's).
+  int64_t time_origin_ns() const;
 
   int64_t frame_count() const;  // at least 1
   double timestamp(int64_t i) const;
@@ -99,6 +108,7 @@ class Dataset {
  private:
   struct Impl;
   void check_index(int64_t i, const char* what) const;
+  void open_bag(const DatasetOptions& options);
   std::unique_ptr<Impl> impl_;
 };
 
