@@ -1,0 +1,279 @@
+// A simulated data set written as ROS 1 bags by Debian's python3-rosbag and as MCAP files by the
+// official MCAP TypeScript library (test/tools/), then read back through the C API and the tool:
+// the same frames, times, odometry and ground truth as the folder, so the same per-frame motions
+// to 1e-9 (the figure of issue 10), whatever the chunk compression or the image encoding. And
+// what bad bags get: exit 2 naming what is wrong. Skipped, saying why, when a writer is missing
+// (scripts/install-deps.sh installs both).
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "common/capi_util.h"
+#include "common/test_util.h"
+#include "io/formats.h"
+
+namespace planarvo {
+namespace {
+
+namespace fs = std::filesystem;
+using ::testing::HasSubstr;
+using test::run_cli;
+using test::run_command;
+using test::TrackedFrame;
+
+constexpr int64_t kBaseNs = 1700000000000000000;  // the converters' default base time
+
+const fs::path& scratch() {
+  static const fs::path p = fs::path(PLANARVO_BINARY_DIR) / "test-scratch" / "BagDataset";
+  return p;
+}
+fs::path dataset_dir() { return scratch() / "dataset"; }
+
+std::string rosbag_writer() { return (test::source_dir() / "test/tools/rosbag/dataset_to_rosbag.py").string(); }
+std::string mcap_writer() { return (test::source_dir() / "test/tools/mcap/dataset_to_mcap.mjs").string(); }
+
+// Why a writer cannot run here, or "" when it can.
+std::string rosbag_missing() {
+  if (run_command("/usr/bin/python3 -c 'import rosbag, sensor_msgs.msg, nav_msgs.msg'").exit_code != 0)
+    return "Debian's python3-rosbag (with python3-sensor-msgs and python3-nav-msgs) is not installed; run "
+           "scripts/install-deps.sh";
+  return "";
+}
+std::string mcap_missing() {
+  if (run_command("node --version").exit_code != 0) return "node is not installed; run scripts/install-deps.sh";
+  if (!fs::exists(test::source_dir() / "test/tools/mcap/node_modules/@mcap/core"))
+    return "test/tools/mcap/node_modules is missing; run scripts/install-deps.sh (npm ci there)";
+  return "";
+}
+
+class BagDataset : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    fs::remove_all(scratch());
+    fs::create_directories(scratch());
+    // 2 s at 30 Hz, lens distortion, gain drift, noise: the simulator's default drive, small.
+    const auto r = run_cli("simulate --quiet --out " + dataset_dir().string() +
+                           " --seconds 2 --width 320 --height 240 --seed 3");
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    io::ExtrinsicsFile e = io::read_extrinsics_yaml((dataset_dir() / "extrinsics_gt.yaml").string());
+    extrinsics_ = {e.value.x, e.value.y, e.value.z, e.value.roll, e.value.pitch, e.value.yaw};
+    folder_ = track(dataset_dir().string(), nullptr);
+  }
+
+  // Writes the data set as a bag with the given writer options; fails the test when it cannot.
+  static fs::path write_rosbag(const std::string& name, const std::string& options) {
+    const fs::path out = scratch() / name;
+    if (!fs::exists(out)) {
+      const auto r = run_command("/usr/bin/python3 " + rosbag_writer() + " " + dataset_dir().string() + " " +
+                                 out.string() + " " + options);
+      EXPECT_EQ(r.exit_code, 0) << r.output;
+    }
+    return out;
+  }
+  static fs::path write_mcap(const std::string& name, const std::string& options) {
+    const fs::path out = scratch() / name;
+    if (!fs::exists(out)) {
+      const auto r = run_command("node " + mcap_writer() + " " + dataset_dir().string() + " " + out.string() + " " +
+                                 options);
+      EXPECT_EQ(r.exit_code, 0) << r.output;
+    }
+    return out;
+  }
+
+  // Every frame tracked through the C API with the true extrinsics; options NULL for a folder.
+  static std::vector<TrackedFrame> track(const std::string& path, const planarvo_dataset_options* options,
+                                         planarvo_dataset_info* info_out = nullptr) {
+    std::vector<TrackedFrame> frames;
+    test::ApiContext context = test::api_context();
+    planarvo_dataset* d = nullptr;
+    EXPECT_EQ(planarvo_dataset_open(path.c_str(), options, &d), PLANARVO_OK) << planarvo_last_error();
+    test::ApiDataset dataset(d);
+    if (!context || !dataset) return frames;
+    const planarvo_dataset_info info = test::api_info(dataset.get());
+    if (info_out) *info_out = info;
+    planarvo_tracker* t = nullptr;
+    EXPECT_EQ(planarvo_tracker_create(context.get(), &info.camera, &extrinsics_, nullptr, &t), PLANARVO_OK)
+        << planarvo_last_error();
+    test::ApiTracker tracker(t);
+    for (int64_t i = 0; tracker && i < info.frame_count; ++i) {
+      TrackedFrame f{};
+      EXPECT_EQ(planarvo_dataset_frame_data(dataset.get(), i, &f.data), PLANARVO_OK) << planarvo_last_error();
+      planarvo_image image{};
+      EXPECT_EQ(planarvo_dataset_frame(dataset.get(), i, &image), PLANARVO_OK) << planarvo_last_error();
+      f.result.struct_size = sizeof f.result;
+      EXPECT_EQ(planarvo_tracker_track(tracker.get(), &image, f.data.timestamp, &f.result), PLANARVO_OK)
+          << planarvo_last_error();
+      frames.push_back(f);
+    }
+    return frames;
+  }
+
+  static planarvo_dataset_options bag_options(bool receive_time = false) {
+    planarvo_dataset_options o;
+    planarvo_dataset_options_init(&o);
+    o.image_topic = nullptr;  // the only image topic
+    o.camera_info_topic = "/camera/camera_info";
+    o.odometry_topic = "/odom";
+    o.groundtruth_topic = "/ground_truth";
+    o.use_receive_time = receive_time ? 1 : 0;
+    return o;
+  }
+
+  // The bag's frames against the folder's: times after the first frame, odometry and ground
+  // truth at each frame, and the tracker's motion and pose, all to 1e-9.
+  static void expect_same_as_folder(const fs::path& bag, bool receive_time = false) {
+    const planarvo_dataset_options o = bag_options(receive_time);
+    planarvo_dataset_info info{};
+    const std::vector<TrackedFrame> frames = track(bag.string(), &o, &info);
+    ASSERT_EQ(frames.size(), folder_.size());
+    EXPECT_EQ(info.is_bag, 1);
+    // The converters stamp frame i at base + round(t_i * 1e9) ns, received 5 ms later.
+    const double t0 = folder_.front().data.timestamp;
+    EXPECT_EQ(info.time_origin_ns, kBaseNs + std::llround(t0 * 1e9) + (receive_time ? 5000000 : 0));
+    double worst_motion = 0, worst_time = 0, worst_pose = 0;
+    for (size_t i = 0; i < frames.size(); ++i) {
+      const planarvo_frame_data &b = frames[i].data, &f = folder_[i].data;
+      worst_time = std::max(worst_time, std::abs(b.timestamp - (f.timestamp - t0)));
+      ASSERT_EQ(b.has_odometry, f.has_odometry) << i;
+      ASSERT_EQ(b.has_groundtruth, f.has_groundtruth) << i;
+      for (auto [x, y] : {std::pair{b.odometry, f.odometry}, std::pair{b.groundtruth, f.groundtruth}})
+        worst_pose = std::max({worst_pose, std::abs(x.x - y.x), std::abs(x.y - y.y),
+                               std::abs(std::remainder(x.theta - y.theta, 2 * M_PI))});
+      EXPECT_EQ(frames[i].result.status, folder_[i].result.status) << i;
+      const planarvo_se2 &m = frames[i].result.motion, &n = folder_[i].result.motion;
+      worst_motion = std::max({worst_motion, std::abs(m.x - n.x), std::abs(m.y - n.y), std::abs(m.theta - n.theta)});
+    }
+    EXPECT_LE(worst_time, 1e-9);
+    EXPECT_LE(worst_pose, 1e-9);
+    EXPECT_LE(worst_motion, 1e-9) << "the figure: per-frame motions equal to 1e-9 m and 1e-9 rad";
+  }
+
+  static inline planarvo_extrinsics extrinsics_{};
+  static inline std::vector<TrackedFrame> folder_;
+};
+
+#define SKIP_WITHOUT(why)            \
+  do {                               \
+    const std::string w = (why);     \
+    if (!w.empty()) GTEST_SKIP() << w; \
+  } while (0)
+
+TEST_F(BagDataset, Ros1BagsGiveTheFoldersMotions) {
+  SKIP_WITHOUT(rosbag_missing());
+  for (const char* c : {"none", "bz2", "lz4"}) {
+    SCOPED_TRACE(c);
+    expect_same_as_folder(write_rosbag(std::string("mono8_") + c + ".bag", std::string("--compression ") + c));
+  }
+}
+
+TEST_F(BagDataset, Ros1BagsOfColourAndPngImagesGiveTheFoldersMotions) {
+  SKIP_WITHOUT(rosbag_missing());
+  for (const char* e : {"bgr8", "rgb8", "png"}) {
+    SCOPED_TRACE(e);
+    expect_same_as_folder(write_rosbag(std::string(e) + ".bag", std::string("--compression lz4 --encoding ") + e));
+  }
+}
+
+TEST_F(BagDataset, McapFilesGiveTheFoldersMotions) {
+  SKIP_WITHOUT(mcap_missing());
+  const std::pair<const char*, const char*> cases[] = {{"none.mcap", "--compression none"},
+                                                       {"zstd.mcap", "--compression zstd"},
+                                                       {"lz4.mcap", "--compression lz4"},
+                                                       {"nochunks.mcap", "--no-chunks"},
+                                                       {"png.mcap", "--compression zstd --encoding png"},
+                                                       {"bgr8.mcap", "--compression lz4 --encoding bgr8"}};
+  for (const auto& [name, options] : cases) {
+    SCOPED_TRACE(name);
+    expect_same_as_folder(write_mcap(name, options));
+  }
+}
+
+TEST_F(BagDataset, ReceiveTimesShiftTheOriginOnly) {
+  SKIP_WITHOUT(rosbag_missing());
+  expect_same_as_folder(write_rosbag("mono8_none.bag", "--compression none"), true);
+}
+
+// The tool on a bag: the trajectory it writes carries the bag's stamps, and its poses are the
+// folder's.
+TEST_F(BagDataset, TrackWritesTheBagsStamps) {
+  SKIP_WITHOUT(rosbag_missing());
+  const fs::path bag = write_rosbag("mono8_lz4.bag", "--compression lz4");
+  const fs::path traj = scratch() / "bag_traj.txt";
+  const auto r = run_cli("track --quiet " + bag.string() + " --extrinsics " +
+                         (dataset_dir() / "extrinsics_gt.yaml").string() +
+                         " --odom-topic /odom --groundtruth-topic /ground_truth -o " + traj.string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const std::vector<io::StampedPose> tum = io::read_tum(traj.string());
+  ASSERT_EQ(tum.size(), folder_.size());
+  for (size_t i = 0; i < tum.size(); ++i) {
+    const double stamp = static_cast<double>(kBaseNs) * 1e-9 + folder_[i].data.timestamp;
+    EXPECT_NEAR(tum[i].t, stamp, 1e-6) << i;  // a double at 1.7e9 s resolves 0.24 us
+    EXPECT_NEAR(tum[i].pose.x, folder_[i].result.pose.x, 1e-9) << i;
+    EXPECT_NEAR(tum[i].pose.y, folder_[i].result.pose.y, 1e-9) << i;
+  }
+}
+
+TEST_F(BagDataset, CalibrateReadsTheOdometryTopic) {
+  SKIP_WITHOUT(rosbag_missing());
+  const fs::path bag = write_rosbag("mono8_lz4.bag", "--compression lz4");
+  // Without the odometry topic the odometry method has nothing to calibrate against: exit 2.
+  const auto none = run_cli("calibrate --quiet " + bag.string() + " -o " + (scratch() / "x.yaml").string());
+  EXPECT_EQ(none.exit_code, 2) << none.output;
+  EXPECT_THAT(none.output, HasSubstr("--odom-topic"));
+}
+
+// Bad input: a topic that is not there (exit 2, listing the topics there are with their types),
+// a topic of the wrong type, a file that is no bag, a truncated bag, a camera info whose size
+// disagrees with the images.
+TEST_F(BagDataset, BadBagsAreExit2NamingTheProblem) {
+  SKIP_WITHOUT(rosbag_missing());
+  const fs::path bag = write_rosbag("mono8_none.bag", "--compression none");
+  const std::string extr = " --extrinsics " + (dataset_dir() / "extrinsics_gt.yaml").string();
+  const auto missing = run_cli("track --quiet " + bag.string() + extr + " --image-topic /front/image");
+  EXPECT_EQ(missing.exit_code, 2);
+  for (const char* t : {"/camera/image_raw", "sensor_msgs/Image", "/odom", "nav_msgs/Odometry", "/camera/camera_info"})
+    EXPECT_THAT(missing.output, HasSubstr(t));
+  const auto wrong = run_cli("track --quiet " + bag.string() + extr + " --image-topic /odom");
+  EXPECT_EQ(wrong.exit_code, 2);
+  EXPECT_THAT(wrong.output, HasSubstr("nav_msgs/Odometry"));
+
+  const fs::path junk = scratch() / "junk.bag";
+  std::ofstream(junk) << "not a bag at all\n";
+  EXPECT_EQ(run_cli("track --quiet " + junk.string() + extr).exit_code, 2);
+
+  // Cut in the middle: the reader says where, the tool exits 2.
+  const fs::path cut = scratch() / "cut.bag";
+  fs::copy_file(bag, cut, fs::copy_options::overwrite_existing);
+  fs::resize_file(cut, fs::file_size(bag) / 2);
+  const auto truncated = run_cli("track --quiet " + cut.string() + extr);
+  EXPECT_EQ(truncated.exit_code, 2) << truncated.output;
+  EXPECT_THAT(truncated.output, HasSubstr("byte"));
+
+  // A camera info 2 pixels wider than the images.
+  const fs::path wide = scratch() / "wide";
+  fs::remove_all(wide);
+  fs::copy(dataset_dir(), wide, fs::copy_options::recursive);
+  std::string yaml = test::read_file(wide / "camera.yaml");
+  const size_t at = yaml.find("image_width: 320");
+  ASSERT_NE(at, std::string::npos);
+  yaml.replace(at, 16, "image_width: 322");
+  std::ofstream(wide / "camera.yaml") << yaml;
+  const fs::path wide_bag = scratch() / "wide.bag";
+  const auto w = run_command("/usr/bin/python3 " + rosbag_writer() + " " + wide.string() + " " + wide_bag.string());
+  ASSERT_EQ(w.exit_code, 0) << w.output;
+  const auto size = run_cli("track --quiet " + wide_bag.string() + extr);
+  EXPECT_EQ(size.exit_code, 2);
+  EXPECT_THAT(size.output, HasSubstr("322x240"));
+
+  // Bag options for a folder are a usage error, not silently ignored.
+  EXPECT_EQ(run_cli("track --quiet " + dataset_dir().string() + " --image-topic /camera/image_raw").exit_code, 2);
+}
+
+}  // namespace
+}  // namespace planarvo
