@@ -91,6 +91,31 @@ def _fill_matrix(dst, value, n: int, what: str) -> None:
         dst[i] = v
 
 
+_INT_RANGES = {ctypes.c_int32: (-2**31, 2**31 - 1), ctypes.c_int64: (-2**63, 2**63 - 1),
+               ctypes.c_uint32: (0, 2**32 - 1), ctypes.c_size_t: (0, 2**64 - 1)}
+
+
+def _set_field(c, name: str, v: Any) -> None:
+    """Sets one field of a C struct, refusing (ValueError) what ctypes would silently truncate:
+    an integer out of the field's range, or a non-integer for an integer field."""
+    ctype = dict(c._fields_)[name]
+    if ctype in _INT_RANGES:
+        if isinstance(v, (bool, enum.IntEnum)):
+            v = int(v)
+        elif isinstance(v, (int, np.integer)):
+            v = int(v)
+        else:
+            raise ValueError("%s: expected an integer, got %r" % (name, v))
+        lo, hi = _INT_RANGES[ctype]
+        if not lo <= v <= hi:
+            raise ValueError("%s: %d is outside the C field's range [%d, %d]" % (name, v, lo, hi))
+    elif ctype is ctypes.c_double:
+        if isinstance(v, (bool, str, bytes)) or not isinstance(v, (int, float, np.integer, np.floating)):
+            raise ValueError("%s: expected a number, got %r" % (name, v))
+        v = float(v)
+    setattr(c, name, v)
+
+
 def _c_options(struct_type, init_name: str, options: Any, skip: Sequence[str] = ()):
     """The C option struct: the library's defaults (init), then every field of options that is
     not None."""
@@ -101,5 +126,5 @@ def _c_options(struct_type, init_name: str, options: Any, skip: Sequence[str] = 
             v = getattr(options, f.name)
             if v is None or f.name in skip:
                 continue
-            setattr(c, f.name, int(v) if isinstance(v, (bool, enum.IntEnum)) else v)
+            _set_field(c, f.name, v)
     return c

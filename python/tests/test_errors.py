@@ -132,3 +132,17 @@ def test_a_float32_frame_with_unaligned_rows_is_a_value_error(tracker):
     frame = as_strided(buf[2:].view(np.uint8), shape=(48, 64 * 4), strides=(258, 1)).view(np.float32)
     with pytest.raises(ValueError, match="aligned"):
         tracker.track(frame, 0.0)
+
+
+@pytest.mark.parametrize("value", [2**40, -2**31 - 1, 2.5, "3"])
+def test_an_option_ctypes_would_truncate_is_a_value_error(context, value):
+    # ctypes would store 2**40 in an int32 as 0 and refuse 2.5 with a TypeError; both are
+    # a ValueError naming the option, before any C call.
+    with pytest.raises(ValueError, match="levels"):
+        planarvo.Tracker(context, CAM, planarvo.Extrinsics(z=0.2), planarvo.TrackerOptions(levels=value))
+
+
+def test_an_option_in_range_is_passed_on(context):
+    # numpy integers are integers: 3 levels from np.int64(3) (the tracker accepts 1..8).
+    with planarvo.Tracker(context, CAM, planarvo.Extrinsics(z=0.2), planarvo.TrackerOptions(levels=np.int64(3))) as t:
+        assert t.camera.width == 64
