@@ -1,7 +1,8 @@
 #!/usr/bin/env node
 // Writes the MCAP files that test planarvo's MCAP reader (test/unit/io_bag_mcap_test.cpp) with the
 // official writer, @mcap/core's McapWriter, and CDR from @foxglove/cdr. Usage:
-//   node write_test_mcaps.mjs OUT_DIR
+//   node write_test_mcaps.mjs OUT_DIR [--frames N]
+// (N frames of messages, default 8; fuzz/seeds/mcap/ holds files of --frames 1.)
 // For each NAME.mcap it writes NAME.json (every message's expected values; integers of 64 bits
 // as decimal strings) and NAME.expected.txt (the same, one tab-separated line per record, for
 // C++ to parse). Each file is read back with @mcap/core's stream reader as a check of the writer.
@@ -21,7 +22,7 @@ import {
 } from "./ros2.mjs";
 
 const BASE_NS = 1700000000123456789n;  // log times near 1.7e18 ns: a double would lose the last digits
-const FRAMES = 8;
+let FRAMES = 8;
 
 // A small deterministic generator, so that every file holds the same values.
 function lcg(seed) {
@@ -252,9 +253,10 @@ async function emit(dir, name, bytes, info) {
 }
 
 async function main() {
-  const dir = process.argv[2];
-  if (!dir) {
-    console.error("usage: node write_test_mcaps.mjs OUT_DIR");
+  const [dir, flag, frames] = process.argv.slice(2);
+  if (flag === "--frames" && Number(frames) >= 1) FRAMES = Number(frames);
+  if (!dir || (flag !== undefined && FRAMES !== Number(frames))) {
+    console.error("usage: node write_test_mcaps.mjs OUT_DIR [--frames N]");
     process.exit(2);
   }
   await mkdir(dir, { recursive: true });
