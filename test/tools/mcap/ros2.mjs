@@ -2,7 +2,7 @@
 // @foxglove/cdr: the schemas as rosbag2 stores them (encoding "ros2msg", the .msg text with its
 // dependencies), CDR encoders for the four message types planarvo reads, and small helpers
 // shared by write_test_mcaps.mjs and dataset_to_mcap.mjs.
-import { writeFile } from "node:fs/promises";
+import { open, writeFile } from "node:fs/promises";
 
 import { CdrWriter, EncapsulationKind } from "@foxglove/cdr";
 import lz4js from "lz4js";
@@ -118,6 +118,27 @@ export class MemoryWritable {
   }
   bytes() {
     return Buffer.concat(this.parts);
+  }
+}
+
+// An IWritable that writes to a file as it goes.
+export class FileWritable {
+  static async open(path) {
+    const w = new FileWritable();
+    w.handle = await open(path, "w");
+    w.size = 0n;
+    return w;
+  }
+  position() {
+    return this.size;
+  }
+  async write(buffer) {
+    let done = 0;
+    while (done < buffer.byteLength) done += (await this.handle.write(buffer, done, buffer.byteLength - done)).bytesWritten;
+    this.size += BigInt(buffer.byteLength);
+  }
+  async close() {
+    await this.handle.close();
   }
 }
 
