@@ -82,6 +82,35 @@ struct McapBytes {
     c.insert(c.end(), records.begin(), records.end());
     record(0x06, c);
   }
+  // A Chunk Index of the chunk record at `offset` (`length` bytes), without message indexes.
+  void chunk_index(uint64_t offset, uint64_t length, uint64_t records_size) {
+    std::vector<uint8_t> c;
+    put_le(c, 0, 8);
+    put_le(c, 0, 8);
+    put_le(c, offset, 8);
+    put_le(c, length, 8);
+    put_le(c, 0, 4);  // message_index_offsets: none
+    put_le(c, 0, 8);
+    put_string(c, "");
+    put_le(c, records_size, 8);
+    put_le(c, records_size, 8);
+    record(0x08, c);
+  }
+  void statistics(uint16_t channel, uint64_t count) {
+    std::vector<uint8_t> c;
+    put_le(c, count, 8);
+    put_le(c, 1, 2);
+    put_le(c, 1, 4);
+    put_le(c, 0, 4);  // attachment_count
+    put_le(c, 0, 4);  // metadata_count
+    put_le(c, 0, 4);  // chunk_count
+    put_le(c, 0, 8);
+    put_le(c, 0, 8);
+    put_le(c, 10, 4);
+    put_le(c, channel, 2);
+    put_le(c, count, 8);
+    record(0x0B, c);
+  }
   void footer(uint64_t summary_start, uint64_t summary_offset_start, uint32_t crc) {
     std::vector<uint8_t> c;
     put_le(c, summary_start, 8);

@@ -429,6 +429,54 @@ TEST(McapHandmade, UnknownRecordsAreSkipped) {
   EXPECT_EQ(refs[1].receive_time_ns, 20);
 }
 
+// A summary with Chunk Index records, and a message outside the chunks that the Statistics count:
+// the chunk indexes alone would miss it, so the data section is scanned.
+TEST(McapHandmade, AMessageOutsideTheIndexedChunksIsFoundThroughTheStatistics) {
+  for (const bool with_statistics : {true, false}) {
+    SCOPED_TRACE(with_statistics);
+    McapBytes records;
+    records.message(1, 5, {5});
+    McapBytes f = McapBytes::file();
+    f.schema(1, "std_msgs/msg/String");
+    f.channel(1, 1, "/a");
+    const uint64_t chunk = f.bytes.size();
+    f.chunk(records.bytes, true);
+    const uint64_t chunk_length = f.bytes.size() - chunk;
+    f.message(1, 3, {3});
+    f.record(0x0F, {0, 0, 0, 0});
+    const uint64_t summary = f.bytes.size();
+    f.schema(1, "std_msgs/msg/String");
+    f.channel(1, 1, "/a");
+    f.chunk_index(chunk, chunk_length, records.bytes.size());
+    if (with_statistics) f.statistics(1, 2);
+    f.footer(summary, 0, 0);
+    const auto bag = open_mcap(write_scratch("outside_chunks.mcap", f.bytes));
+    EXPECT_EQ(bag->topics()[0].count, with_statistics ? 2 : -1);
+    const std::vector<MessageRef> refs = bag->index({0});
+    // Without statistics the index is trusted, as the spec's indexed readers do (mcap_reader.h).
+    ASSERT_EQ(refs.size(), with_statistics ? 2u : 1u);
+    EXPECT_EQ(refs.front().receive_time_ns, with_statistics ? 3 : 5);
+    EXPECT_EQ(refs.back().receive_time_ns, 5);
+  }
+}
+
+TEST(McapHandmade, TwoChunkIndexesOfOneChunkAreRefused) {
+  McapBytes records;
+  records.message(1, 5, {5});
+  McapBytes f = McapBytes::file();
+  const uint64_t chunk = f.bytes.size();
+  f.chunk(records.bytes, true);
+  const uint64_t chunk_length = f.bytes.size() - chunk;
+  const uint64_t summary = f.bytes.size();
+  f.schema(1, "std_msgs/msg/String");
+  f.channel(1, 1, "/a");
+  f.chunk_index(chunk, chunk_length, records.bytes.size());
+  f.chunk_index(chunk, chunk_length, records.bytes.size());
+  f.footer(summary, 0, 0);
+  EXPECT_NE(error_of(write_scratch("two_indexes.mcap", f.bytes)).find("inside the chunk that another"),
+            std::string::npos);
+}
+
 TEST(McapHandmade, BadFilesAreInvalidInputWithTheByte) {
   {
     McapBytes f = McapBytes::file();

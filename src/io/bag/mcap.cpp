@@ -120,6 +120,12 @@ bool Reader::read_summary() {
   std::stable_sort(chunk_indexes.begin(), chunk_indexes.end(), [](const ChunkIndex& a, const ChunkIndex& b) {
     return a.chunk_start_offset < b.chunk_start_offset;
   });
+  // One index per chunk, chunks apart (else one chunk could be read again and again).
+  for (size_t i = 1; i < chunk_indexes.size(); ++i)
+    if (chunk_indexes[i].chunk_start_offset - chunk_indexes[i - 1].chunk_start_offset < chunk_indexes[i - 1].chunk_length)
+      throw_invalid_input(where(at_file(chunk_indexes[i].record_pos), 0) + "a chunk index points at byte " +
+                          std::to_string(chunk_indexes[i].chunk_start_offset) +
+                          ", inside the chunk that another chunk index points at");
   chunk_indexes_ = std::move(chunk_indexes);
   return true;
 }
