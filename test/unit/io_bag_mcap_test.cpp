@@ -460,6 +460,49 @@ TEST(McapHandmade, AMessageOutsideTheIndexedChunksIsFoundThroughTheStatistics) {
   }
 }
 
+// Found by fuzz_mcap (374k runs): a summary without chunk indexes makes index() scan; a channel
+// the summary lacks was defined before the scan failed (or was cancelled), and the next index()
+// read its topic, which it did not have yet, as an index (a crash).
+McapBytes summary_without_channel_b(bool bad_record) {
+  McapBytes f = McapBytes::file();
+  f.schema(1, "std_msgs/msg/String");
+  f.channel(1, 1, "/a");
+  f.channel(2, 1, "/b");
+  f.message(1, 4, {4});
+  f.message(bad_record ? 9 : 2, 5, {5});
+  f.record(0x0F, {0, 0, 0, 0});
+  const uint64_t summary = f.bytes.size();
+  f.schema(1, "std_msgs/msg/String");
+  f.channel(1, 1, "/a");
+  f.footer(summary, 0, 0);
+  return f;
+}
+
+TEST(McapHandmade, AnIndexAfterAFailedScanFailsAlike) {
+  const auto bag = open_mcap(write_scratch("failed_scan.mcap", summary_without_channel_b(true).bytes));
+  ASSERT_EQ(bag->topics().size(), 1u);
+  for (int i = 0; i < 2; ++i) {
+    try {
+      bag->index({0});
+      ADD_FAILURE() << "no error";
+    } catch (const Error& e) {
+      EXPECT_EQ(e.code(), ErrorCode::InvalidInput);
+      EXPECT_NE(std::string(e.what()).find("a message on channel 9"), std::string::npos) << e.what();
+    }
+  }
+}
+
+TEST(McapHandmade, AnIndexAfterACancelledScanScansAgain) {
+  const auto bag = open_mcap(write_scratch("cancelled_scan.mcap", summary_without_channel_b(false).bytes));
+  int calls = 0;
+  EXPECT_THROW(bag->index({0}, [&](double) { return ++calls < 4; }), Error);  // after /b's channel
+  const std::vector<MessageRef> refs = bag->index({0});
+  ASSERT_EQ(bag->topics().size(), 2u);  // /b, which only the data section defines
+  EXPECT_EQ(bag->topics()[1].name, "/b");
+  ASSERT_EQ(refs.size(), 1u);
+  EXPECT_EQ(bag->index({1}).size(), 1u);
+}
+
 TEST(McapHandmade, TwoChunkIndexesOfOneChunkAreRefused) {
   McapBytes records;
   records.message(1, 5, {5});

@@ -231,13 +231,15 @@ bool Reader::statistics_agree(const std::vector<Found>& found, const std::vector
 }
 
 std::vector<MessageRef> Reader::index(const std::vector<uint32_t>& topics, const IndexProgress& progress) {
+  if (!scan_error_.empty()) throw_invalid_input(scan_error_);
   std::vector<bool> asked(topics_.size(), false);
   for (const uint32_t t : topics) {
     check_asked(t);
     asked[t] = true;
   }
   std::vector<bool> wanted(size_t{UINT16_MAX} + 1, false);
-  for (const auto& [id, info] : channels_) wanted[id] = asked[info.topic];
+  for (const auto& [id, info] : channels_)  // a channel of a cancelled scan has no topic yet
+    if (info.topic != kNoTopic) wanted[id] = asked[info.topic];
 
   std::vector<Found> found;
   bool need_scan = !scanned_;
@@ -246,8 +248,14 @@ std::vector<MessageRef> Reader::index(const std::vector<uint32_t>& topics, const
     need_scan = !statistics_agree(found, wanted);
   }
   if (need_scan) {  // no chunk indexes, or they disagree with the statistics
-    scan(progress);
-    assign_topics();
+    try {
+      scan(progress);
+      assign_topics();
+    } catch (const Error& e) {
+      // Channels found before the bad record are half defined: every later index() fails alike.
+      if (e.code() == ErrorCode::InvalidInput) scan_error_ = e.what();
+      throw;
+    }
     asked.resize(topics_.size(), false);  // channels the scan found that the summary lacked
   }
   if (scanned_) {

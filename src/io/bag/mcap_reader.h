@@ -18,7 +18,8 @@
 //   is decompressed and its records walked. When the summary's Statistics count a different
 //   number of messages for an asked channel than the chunk indexes gave (messages outside chunks,
 //   or an incomplete index), the data section is scanned instead. Without Chunk Index records
-//   index() scans the data section (once; the result is kept).
+//   index() scans the data section (once; the result is kept; when it finds the file bad, every
+//   later index() gives the same error).
 // - Unknown record opcodes are skipped by their length, as the spec requires.
 //
 // MessageRef: location is the Chunk record's file offset and offset the message data's offset in
@@ -117,6 +118,7 @@ class Reader final : public BagFile {
   std::vector<ChunkIndex> chunk_indexes_;       // sorted by chunk_start_offset
   std::map<uint16_t, uint64_t> stat_counts_;    // Statistics' channel_message_counts (may be empty)
   bool scanned_ = false;
+  std::string scan_error_;                      // why the scan in index() failed, if it did
   std::vector<Found> all_;                      // every message, after a scan
 
   std::map<uint64_t, ChunkPlace> chunks_;       // by the Chunk record's file offset
