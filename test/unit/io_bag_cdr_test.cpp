@@ -1,4 +1,4 @@
-// The ROS 2 CDR decoders (src/io/bag/messages_cdr.cpp) on hand-built bytes (bag_test_bytes.h):
+// The ROS 2 CDR decoders (src/io/bag/messages_cdr.cpp) on hand-built bytes (io_bag_mcap_bytes.h):
 // both byte orders, alignment, and every way the bytes can be short or wrong. The files written
 // by the official CDR writer are decoded in io_bag_mcap_test.cpp.
 #include <gtest/gtest.h>
@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "bag_test_bytes.h"
+#include "io_bag_mcap_bytes.h"
 #include "core/error.h"
 #include "io/bag/messages.h"
 

@@ -16,7 +16,7 @@
 #include "core/error.h"
 #include "io/bag/bag.h"
 #include "io/bag/messages.h"
-#include "bag_test_bytes.h"
+#include "io_bag_mcap_bytes.h"
 
 namespace {
 
