@@ -13,6 +13,8 @@
 #include <string>
 #include <vector>
 
+#include <unistd.h>
+
 #include "core/error.h"
 #include "io/bag/bag.h"
 #include "io/bag/messages.h"
@@ -87,7 +89,8 @@ class McapFiles : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
     const std::string tools = std::string(PLANARVO_SOURCE_DIR) + "/test/tools/mcap";
-    dir_ = std::string(PLANARVO_BINARY_DIR) + "/test-scratch/mcap";
+    // CTest runs each test in a process of its own, two at once: a folder per process.
+    dir_ = std::string(PLANARVO_BINARY_DIR) + "/test-scratch/mcap-" + std::to_string(getpid());
     if (std::system("command -v node >/dev/null 2>&1") != 0) {
       skip_ = "node is not installed: run scripts/install-deps.sh";
       return;
@@ -100,6 +103,10 @@ class McapFiles : public ::testing::Test {
     fs::create_directories(dir_);
     const std::string command = "node '" + tools + "/write_test_mcaps.mjs' '" + dir_ + "' > '" + dir_ + "/log.txt' 2>&1";
     generated_ = std::system(command.c_str()) == 0;
+  }
+
+  static void TearDownTestSuite() {
+    if (generated_) fs::remove_all(dir_);  // kept when the generator failed: its log.txt says why
   }
 
   void SetUp() override {
@@ -381,10 +388,21 @@ TEST_F(McapFiles, ProgressRisesAndFalseCancels) {
 
 // Hand-built files: what the official writer does not produce.
 
+// This process's folder for hand-built files, removed when it exits.
+const std::string& handmade_dir() {
+  static const struct Dir {
+    std::string path = std::string(PLANARVO_BINARY_DIR) + "/test-scratch/mcap-handmade-" + std::to_string(getpid());
+    Dir() { fs::create_directories(path); }
+    ~Dir() {
+      std::error_code ec;
+      fs::remove_all(path, ec);
+    }
+  } dir;
+  return dir.path;
+}
+
 std::string write_scratch(const std::string& name, const std::vector<uint8_t>& bytes) {
-  const std::string dir = std::string(PLANARVO_BINARY_DIR) + "/test-scratch/mcap-handmade";
-  fs::create_directories(dir);
-  const std::string path = dir + "/" + name;
+  const std::string path = handmade_dir() + "/" + name;
   std::ofstream(path, std::ios::binary).write(reinterpret_cast<const char*>(bytes.data()),
                                               static_cast<std::streamsize>(bytes.size()));
   return path;
