@@ -19,7 +19,7 @@
 set -euo pipefail
 
 root=$(cd "$(dirname "$0")/.." && pwd)
-all_targets=(camera_yaml extrinsics_yaml frames tum direction motion_pairs g2o capi)
+all_targets=(camera_yaml extrinsics_yaml frames tum direction motion_pairs g2o capi mcap)
 seconds=60
 jobs=1
 build="$root/build-fuzz"
@@ -63,6 +63,7 @@ dict_for() {
   case "$1" in
     camera_yaml|extrinsics_yaml) echo "$root/fuzz/dict/yaml.dict" ;;
     capi) echo "" ;;
+    mcap) echo "$root/fuzz/dict/mcap.dict" ;;
     *) echo "$root/fuzz/dict/text.dict" ;;
   esac
 }

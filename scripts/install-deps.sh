@@ -21,12 +21,30 @@ missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
 done
-if [ ${#missing[@]} -eq 0 ]; then
-  echo "install-deps: all ${#packages[@]} packages present"
-  exit 0
-fi
-echo "install-deps: installing ${missing[*]}"
 if [ "$(id -u)" -ne 0 ]; then SUDO=sudo; else SUDO=; fi
 export DEBIAN_FRONTEND=noninteractive
-$SUDO apt-get update -qq
-$SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
+if [ ${#missing[@]} -eq 0 ]; then
+  echo "install-deps: all ${#packages[@]} packages present"
+else
+  echo "install-deps: installing ${missing[*]}"
+  $SUDO apt-get update -qq
+  $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
+fi
+
+# The writer of the MCAP reader's test files (test/tools/mcap: the official @mcap/core writer and
+# @foxglove/cdr, pinned in its package-lock.json): `npm ci` when node_modules is missing or older
+# than the lock file, with the machine's node and npm; Debian's npm (it brings nodejs) only when
+# there is no npm at all. Without them the MCAP file tests skip.
+mcap_tools="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)/test/tools/mcap"
+if ! command -v npm >/dev/null 2>&1; then
+  echo "install-deps: installing npm (Debian) for test/tools/mcap"
+  $SUDO apt-get update -qq
+  $SUDO apt-get install -y -qq --no-install-recommends npm
+fi
+if [ ! -d "$mcap_tools/node_modules" ] || [ "$mcap_tools/package-lock.json" -nt "$mcap_tools/node_modules" ]; then
+  echo "install-deps: npm ci in test/tools/mcap"
+  (cd "$mcap_tools" && npm ci --no-audit --no-fund --loglevel=error)
+  touch "$mcap_tools/node_modules"
+else
+  echo "install-deps: test/tools/mcap/node_modules up to date"
+fi
