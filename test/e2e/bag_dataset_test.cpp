@@ -11,6 +11,8 @@
 #include <string>
 #include <vector>
 
+#include <unistd.h>
+
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
@@ -29,8 +31,11 @@ using test::TrackedFrame;
 
 constexpr int64_t kBaseNs = 1700000000000000000;  // the converters' default base time
 
+// One folder per process (CTest runs each test in its own process, two at once), removed when
+// the suite ends.
 const fs::path& scratch() {
-  static const fs::path p = fs::path(PLANARVO_BINARY_DIR) / "test-scratch" / "BagDataset";
+  static const fs::path p =
+      fs::path(PLANARVO_BINARY_DIR) / "test-scratch" / ("BagDataset." + std::to_string(getpid()));
   return p;
 }
 fs::path dataset_dir() { return scratch() / "dataset"; }
@@ -64,6 +69,12 @@ class BagDataset : public ::testing::Test {
     io::ExtrinsicsFile e = io::read_extrinsics_yaml((dataset_dir() / "extrinsics_gt.yaml").string());
     extrinsics_ = {e.value.x, e.value.y, e.value.z, e.value.roll, e.value.pitch, e.value.yaw};
     folder_ = track(dataset_dir().string(), nullptr);
+  }
+  static void TearDownTestSuite() {
+    if (!std::getenv("PLANARVO_KEEP_SCRATCH")) {
+      std::error_code ec;
+      fs::remove_all(scratch(), ec);
+    }
   }
 
   // Writes the data set as a bag with the given writer options; fails the test when it cannot.
