@@ -19,7 +19,7 @@
 set -euo pipefail
 
 root=$(cd "$(dirname "$0")/.." && pwd)
-all_targets=(camera_yaml extrinsics_yaml frames tum direction motion_pairs g2o capi)
+all_targets=(camera_yaml extrinsics_yaml frames tum direction motion_pairs g2o capi rosbag1)
 seconds=60
 jobs=1
 build="$root/build-fuzz"
@@ -63,6 +63,7 @@ dict_for() {
   case "$1" in
     camera_yaml|extrinsics_yaml) echo "$root/fuzz/dict/yaml.dict" ;;
     capi) echo "" ;;
+    rosbag1) echo "$root/fuzz/dict/rosbag1.dict" ;;
     *) echo "$root/fuzz/dict/text.dict" ;;
   esac
 }

@@ -424,6 +424,54 @@ TEST_F(Rosbag1Test, ProgressRisesToOneAndCanCancel) {
   expect_error([&] { b->read(forged, out); }, ErrorCode::InvalidArgument, {"not of this bag"});
 }
 
+// Found by fuzz_rosbag1: a chunk's second index data record relabelled with the first one's
+// connection. Each record matched the chunk info on its own, so the relabelled connection's
+// messages in that chunk were silently left out of the index. Each connection the chunk info
+// lists must now have exactly one index data record.
+TEST_F(Rosbag1Test, AnIndexDataRecordGivenTwiceIsInvalidInput) {
+  const std::string dst = dir_ + "/index_twice.bag";
+  fs::copy_file(bag("none_small"), dst, fs::copy_options::overwrite_existing);
+  std::fstream f(dst, std::ios::in | std::ios::out | std::ios::binary);
+  std::string bytes((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+  const auto u32 = [&](size_t at) {
+    uint32_t v = 0;
+    for (int i = 3; i >= 0; --i) v = v << 8 | static_cast<uint8_t>(bytes.at(at + static_cast<size_t>(i)));
+    return v;
+  };
+  // Two index data records of one chunk, one after the other, with equal counts. python3-rosbag
+  // writes their header fields as op, conn, ver, count, so conn's value is 4 + 5 bytes past op.
+  const std::string op = std::string("op=") + '\x04';
+  size_t first = 0, second = 0;
+  for (size_t at = bytes.find(op); at != std::string::npos && second == 0; at = bytes.find(op, at + 1)) {
+    const size_t start = at - 8;  // header_len, then op's field length
+    const size_t header_len = u32(start);
+    const size_t next = start + 8 + header_len + u32(start + 4 + header_len);
+    const size_t count = bytes.find("count=", at);
+    if (bytes.compare(next + 8, op.size(), op) == 0 && u32(count + 6) == u32(bytes.find("count=", next) + 6)) {
+      first = at + op.size() + 9;
+      second = next + 8 + op.size() + 9;
+    }
+  }
+  ASSERT_NE(second, 0u) << "no two index data records of one chunk with equal counts";
+  ASSERT_EQ(bytes.substr(second - 5, 5), "conn=");
+  f.seekp(static_cast<std::streamoff>(second));
+  f.write(bytes.data() + first, 4);
+  f.close();
+  // Each topic alone (as the fuzzer found it: the dropped connection's topic alone indexed short).
+  const std::unique_ptr<BagFile> b = open_bag(dst);
+  std::string errors;
+  for (uint32_t t = 0; t < b->topics().size(); ++t) {
+    try {
+      EXPECT_EQ(static_cast<int64_t>(b->index({t}).size()), b->topics()[t].count) << b->topics()[t].name;
+    } catch (const Error& e) {
+      EXPECT_EQ(static_cast<int>(e.code()), static_cast<int>(ErrorCode::InvalidInput));
+      errors += std::string(e.what()) + "\n";
+    }
+  }
+  EXPECT_THAT(errors, HasSubstr(dst + ": at byte "));
+  EXPECT_THAT(errors, HasSubstr("index data for connection " + std::to_string(u32(first))));
+}
+
 // ROS 1 serialisation by hand: little-endian, no padding.
 struct Ros1Writer {
   std::vector<uint8_t> bytes;

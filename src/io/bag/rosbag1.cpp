@@ -236,6 +236,8 @@ class Rosbag1File final : public BagFile {
       if (!connections_.count(conn))
         place_.fail(r.pos, "a chunk info record names connection " + std::to_string(conn) +
                                ", which the index does not have");
+      if (std::any_of(c.counts.begin(), c.counts.end(), [&](const auto& cn) { return cn.first == conn; }))
+        place_.fail(r.pos, "a chunk info record names connection " + std::to_string(conn) + " twice");
       c.counts.emplace_back(conn, load_u32(data.data() + 8 * k + 4));
     }
     return c;
@@ -374,7 +376,8 @@ class Rosbag1File final : public BagFile {
   void index_chunk(uint32_t index, const std::unordered_map<uint32_t, uint32_t>& wanted,
                    std::vector<MessageRef>& refs) {
     uint64_t pos = chunks_[index].end;
-    for (size_t k = 0; k < chunks_[index].counts.size(); ++k) {
+    std::vector<bool> seen(chunks_[index].counts.size(), false);  // each listed connection once
+    for (size_t k = 0; k < seen.size(); ++k) {
       const FileRecord r = read_file_record(file_, pos, place_);
       const Chunk& c = chunks_[index];
       if (r.header.op() != kOpIndexData)
@@ -384,9 +387,11 @@ class Rosbag1File final : public BagFile {
       const uint32_t conn = r.header.u32("conn");
       const uint32_t count = r.header.u32("count");
       const auto listed = std::find_if(c.counts.begin(), c.counts.end(), [&](const auto& cn) { return cn.first == conn; });
-      if (listed == c.counts.end() || listed->second != count)
+      const size_t slot = static_cast<size_t>(listed - c.counts.begin());
+      if (listed == c.counts.end() || listed->second != count || seen[slot])
         place_.fail(pos, "index data for connection " + std::to_string(conn) + " with " + std::to_string(count) +
-                             " messages, which the chunk info does not list");
+                             " messages, which the chunk info does not list (or lists once)");
+      seen[slot] = true;
       if (static_cast<uint64_t>(count) * 12 != r.data_size)
         place_.fail(pos, "index data of " + std::to_string(count) + " messages with " + std::to_string(r.data_size) +
                              " bytes of data, not 12 each");

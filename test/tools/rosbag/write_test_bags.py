@@ -4,6 +4,7 @@ planarvo's reader) and, beside each, a sidecar of what it holds (BAG.expected), 
 test/unit/io_bag_rosbag1_test.cpp.
 
     /usr/bin/python3 write_test_bags.py OUT_DIR
+    /usr/bin/python3 write_test_bags.py --seeds OUT_DIR   # fuzz/seeds/rosbag1: 2 frames, no sidecars
 
 Sidecar (one record per line, fields separated by one space, no field contains a space):
     topic NAME TYPE MD5SUM COUNT
@@ -139,11 +140,11 @@ def odometry(stamp_ns, seq, frame_id):
                                   covariance=[-c for c in cov]))
 
 
-def messages():
+def messages(frames=12):
     """(topic, receive_ns, msg) in the order they are written."""
     rng = random.Random(20261125)
     out = []
-    for i in range(12):
+    for i in range(frames):
         t = BASE_NS + i * 100_000_000          # receive times, 10 Hz
         stamp = t - 7_654_321 - i * 1000       # header stamps differ from receive times
         # The image and its camera info share a receive time (ties keep file order).
@@ -158,11 +159,18 @@ def messages():
     return out
 
 
-def write_bag(path, compression, chunk_threshold, msgs, tweak=None):
+def write_bag(path, compression, chunk_threshold, msgs, tweak=None, definitions=True):
+    """definitions=False: the connection headers carry an empty message_definition (the reader
+    does not need it; the fuzz seeds stay small)."""
     bag = rosbag.Bag(path, 'w', compression=compression, chunk_threshold=chunk_threshold)
     try:
         for topic, t, msg in msgs:
-            bag.write(topic, msg, to_time(t))
+            if definitions:
+                bag.write(topic, msg, to_time(t))
+            else:
+                bag.write(topic, (msg._type, serialize(msg), msg._md5sum, type(msg)), to_time(t), raw=True,
+                          connection_header={'topic': topic, 'type': msg._type, 'md5sum': msg._md5sum,
+                                             'message_definition': ''})
         if tweak:
             tweak(bag)
     finally:
@@ -220,9 +228,23 @@ def truncated_copy(src, dst):
     return chunks[1]
 
 
+def write_seeds(out):
+    """Small bags (< 20 KB) for the fuzz target: the first two frames, each compression, and the
+    unindexed form."""
+    os.makedirs(out, exist_ok=True)
+    msgs = messages(frames=2)
+    for compression in ('none', 'bz2', 'lz4'):
+        path = os.path.join(out, compression + '.bag')
+        write_bag(path, compression, 1024, msgs, definitions=False)
+        unindexed_copy(path, os.path.join(out, compression + '_unindexed.bag'))
+
+
 def main():
+    if len(sys.argv) == 3 and sys.argv[1] == '--seeds':
+        write_seeds(sys.argv[2])
+        return
     if len(sys.argv) != 2:
-        sys.exit('usage: write_test_bags.py OUT_DIR')
+        sys.exit('usage: write_test_bags.py [--seeds] OUT_DIR')
     out = sys.argv[1]
     os.makedirs(out, exist_ok=True)
     msgs = messages()
