@@ -43,7 +43,8 @@ void decode(MessageKind kind, const std::vector<uint8_t>& raw) {
       case MessageKind::Other: decode_header(Serialization::Ros1, p, n); break;
     }
   } catch (const planarvo::Error& e) {
-    if (e.code() != planarvo::ErrorCode::InvalidInput) planarvo_fuzz::broken("a decoder gave an error other than InvalidInput");
+    if (e.code() != planarvo::ErrorCode::InvalidInput)
+      planarvo_fuzz::broken("a decoder gave an error other than InvalidInput");
   }
 }
 

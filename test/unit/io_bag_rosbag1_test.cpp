@@ -364,6 +364,14 @@ TEST_F(Rosbag1Test, ATruncatedBagNamesTheChunkItEndsIn) {
   }
 }
 
+TEST_F(Rosbag1Test, ARecordingKilledInsideAChunkNamesTheChunk) {
+  const Expected e = read_sidecar(bag("none_killed") + ".expected");
+  ASSERT_GT(e.error_byte, 0);
+  expect_error([&] { open_bag(bag("none_killed")); }, ErrorCode::InvalidInput,
+               {bag("none_killed") + ": at byte " + std::to_string(e.error_byte), "length was never written",
+                "rosbag reindex"});
+}
+
 TEST_F(Rosbag1Test, OpenBagGoesByContentNotName) {
   const std::string renamed = dir_ + "/looks_like.mcap";
   fs::copy_file(bag("none_large"), renamed, fs::copy_options::overwrite_existing);

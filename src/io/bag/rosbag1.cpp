@@ -175,8 +175,11 @@ class Rosbag1File final : public BagFile {
     c.data_pos = r.data_pos;
     c.data_size = r.data_size;
     c.end = r.end;
-    if (c.data_size == 0 && c.size != 0)
-      place_.fail(pos, "a chunk whose data length was never written (the recording stopped while writing it?)");
+    // rosbag writes a chunk's header with both lengths 0 and fills them in when the chunk is
+    // complete; no writer leaves a chunk empty. Its records follow, but where they end is unknown.
+    if (c.data_size == 0)
+      place_.fail(pos, "a chunk whose length was never written: the recording stopped inside it (truncated?); "
+                       "`rosbag reindex` keeps the chunks before it");
     if (c.compression == "none" && c.size != c.data_size)
       place_.fail(pos, "an uncompressed chunk of " + std::to_string(c.data_size) + " bytes whose header says " +
                            std::to_string(c.size));
@@ -386,7 +389,8 @@ class Rosbag1File final : public BagFile {
         place_.fail(pos, "index data version " + std::to_string(r.header.u32("ver")) + "; planarvo reads version 1");
       const uint32_t conn = r.header.u32("conn");
       const uint32_t count = r.header.u32("count");
-      const auto listed = std::find_if(c.counts.begin(), c.counts.end(), [&](const auto& cn) { return cn.first == conn; });
+      const auto listed =
+          std::find_if(c.counts.begin(), c.counts.end(), [&](const auto& cn) { return cn.first == conn; });
       const size_t slot = static_cast<size_t>(listed - c.counts.begin());
       if (listed == c.counts.end() || listed->second != count || seen[slot])
         place_.fail(pos, "index data for connection " + std::to_string(conn) + " with " + std::to_string(count) +

@@ -70,7 +70,8 @@ void decompress_bz2(const uint8_t* data, size_t n, Output& out, const std::strin
     const int ret = BZ2_bzDecompress(&s);
     out.advance(room - s.avail_out);
     if (ret == BZ_STREAM_END) break;
-    if (ret != BZ_OK) throw_invalid_input(where + ": the bz2 data are corrupt (libbz2 error " + std::to_string(ret) + ")");
+    if (ret != BZ_OK)
+      throw_invalid_input(where + ": the bz2 data are corrupt (libbz2 error " + std::to_string(ret) + ")");
     if (s.avail_in == in_before && s.avail_out == room)
       throw_invalid_input(where + ": the bz2 stream ends before its end marker");
   }
@@ -98,7 +99,8 @@ void decompress_lz4(const uint8_t* data, size_t n, Output& out, const std::strin
     if (ret == 0) break;  // the frame is complete
     if (src == 0 && dst == 0) throw_invalid_input(where + ": the lz4 frame ends early");
   }
-  if (in_pos != n) throw_invalid_input(where + ": " + std::to_string(n - in_pos) + " bytes after the end of the lz4 frame");
+  if (in_pos != n)
+    throw_invalid_input(where + ": " + std::to_string(n - in_pos) + " bytes after the end of the lz4 frame");
 }
 #endif
 

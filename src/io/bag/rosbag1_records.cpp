@@ -51,8 +51,9 @@ Fields::Fields(const uint8_t* data, size_t size, const Place& place, uint64_t st
     const uint32_t len = load_u32(data + pos);
     pos += 4;
     if (len > size - pos)
-      place_.fail(start + pos - 4, "a header field of " + std::to_string(len) + " bytes runs past the end of the header (" +
-                                       std::to_string(size - pos) + " bytes left)");
+      place_.fail(start + pos - 4, "a header field of " + std::to_string(len) +
+                                       " bytes runs past the end of the header (" + std::to_string(size - pos) +
+                                       " bytes left)");
     const char* field = reinterpret_cast<const char*>(data + pos);
     const void* eq = std::memchr(field, '=', len);
     if (!eq) place_.fail(start + pos - 4, "a header field without '=' (not name=value)");

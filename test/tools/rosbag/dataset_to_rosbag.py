@@ -150,8 +150,9 @@ def odometry_messages(path, frame_id, base_ns):
             fail('%s:%d: not `t x y z qx qy qz qw`' % (path, number))
         ns = stamp_ns(fields[0], base_ns, '%s:%d' % (path, number))
         x, y, z, qx, qy, qz, qw = (float(v) for v in fields[1:])
+        pose = Pose(position=Point(x, y, z), orientation=Quaternion(qx, qy, qz, qw))
         msg = Odometry(header=Header(seq=len(out), stamp=ros_time(ns), frame_id=frame_id), child_frame_id='base_link',
-                       pose=PoseWithCovariance(pose=Pose(position=Point(x, y, z), orientation=Quaternion(qx, qy, qz, qw))),
+                       pose=PoseWithCovariance(pose=pose),
                        twist=TwistWithCovariance(twist=Twist(linear=Vector3(), angular=Vector3())))
         out.append((ns, msg))
     return out

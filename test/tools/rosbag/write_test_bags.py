@@ -34,13 +34,14 @@ Bags (every one with the same messages unless said):
         when it starts a bag; the header is rewritten only on close).
     none_truncated.bag, lz4_truncated.bag: the *_small bags cut in the middle of their second
         chunk's data (index_pos still points past the end).
+    none_killed.bag  a copy taken while the writer is inside a chunk (never closed): index_pos 0,
+        the last chunk's lengths still 0 as rosbag writes them until the chunk is complete.
     conflict.bag     /odom recorded twice: nav_msgs/Odometry and, on a second connection, std_msgs/String
     md5_mismatch.bag /camera/image_raw as sensor_msgs/Image with another definition's md5sum
 """
 import io
 import os
 import random
-import struct
 import sys
 
 import genpy
@@ -261,6 +262,24 @@ def main():
         write_sidecar(os.path.join(out, name + '_unindexed.bag.expected'), msgs, topics)
         dst = os.path.join(out, name.replace('_small', '_truncated') + '.bag')
         write_sidecar(dst + '.expected', msgs, topics, error_byte=truncated_copy(src, dst))
+
+    # A recording killed inside its third chunk: copy the file while the writer is still open.
+    bag = rosbag.Bag(os.path.join(out, 'none_killed.bag.tmp'), 'w', chunk_threshold=2048)
+    written = 0
+    while written < 18 or not bag._chunk_open:  # stop inside a chunk, after at least 3 frames
+        topic, t, msg = msgs[written]
+        bag.write(topic, msg, to_time(t))
+        written += 1
+    bag._file.flush()
+    with open(os.path.join(out, 'none_killed.bag.tmp'), 'rb') as f:
+        killed = f.read()
+    open_chunk = bag._curr_chunk_info.pos
+    bag.close()
+    os.remove(os.path.join(out, 'none_killed.bag.tmp'))
+    with open(os.path.join(out, 'none_killed.bag'), 'wb') as f:
+        f.write(killed)
+    write_sidecar(os.path.join(out, 'none_killed.bag.expected'), msgs[:written], topics_of(msgs[:written]),
+                  open_chunk)
 
     # /odom on a second connection with another type: the writer keeps one connection per topic,
     # so forget it before writing the String.
