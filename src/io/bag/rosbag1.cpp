@@ -17,6 +17,7 @@
 // from the file; the last decompressed chunk is kept.
 #include <algorithm>
 #include <map>
+#include <set>
 #include <unordered_map>
 
 #include "core/error.h"
@@ -47,7 +48,7 @@ struct Chunk {
   uint64_t data_pos = 0;
   uint32_t data_size = 0;
   uint64_t end = 0;  // just after the data: the chunk's index data records follow
-  std::vector<std::pair<uint32_t, uint32_t>> counts;  // chunk info: (connection, messages); indexed bags
+  std::map<uint32_t, uint32_t> counts;  // chunk info: connection -> messages; indexed bags
 };
 
 // A message found by scanning.
@@ -239,9 +240,8 @@ class Rosbag1File final : public BagFile {
       if (!connections_.count(conn))
         place_.fail(r.pos, "a chunk info record names connection " + std::to_string(conn) +
                                ", which the index does not have");
-      if (std::any_of(c.counts.begin(), c.counts.end(), [&](const auto& cn) { return cn.first == conn; }))
+      if (!c.counts.emplace(conn, load_u32(data.data() + 8 * k + 4)).second)
         place_.fail(r.pos, "a chunk info record names connection " + std::to_string(conn) + " twice");
-      c.counts.emplace_back(conn, load_u32(data.data() + 8 * k + 4));
     }
     return c;
   }
@@ -313,10 +313,12 @@ class Rosbag1File final : public BagFile {
       for (const auto& [conn, n] : c.counts) counts[conn] += n;
     for (const ScannedMessage& m : scanned_) ++counts[m.conn];
     std::map<std::string, std::vector<uint32_t>> by_name;
+    std::map<std::pair<std::string, std::string>, uint32_t> by_name_and_type;
     for (const auto& [id, c] : connections_) {
-      uint32_t t = 0;
-      while (t < topics_.size() && !(topics_[t].info.name == c.topic && topics_[t].info.type == c.type)) ++t;
-      if (t == topics_.size()) {
+      const auto [it, added] =
+          by_name_and_type.emplace(std::make_pair(c.topic, c.type), static_cast<uint32_t>(topics_.size()));
+      const uint32_t t = it->second;
+      if (added) {
         topics_.push_back(Topic{TopicInfo{c.topic, c.type, 0, c.md5sum}, {}});
         by_name[c.topic].push_back(t);
       } else if (topics_[t].info.md5sum != c.md5sum && topics_[t].conflict.empty()) {
@@ -379,8 +381,8 @@ class Rosbag1File final : public BagFile {
   void index_chunk(uint32_t index, const std::unordered_map<uint32_t, uint32_t>& wanted,
                    std::vector<MessageRef>& refs) {
     uint64_t pos = chunks_[index].end;
-    std::vector<bool> seen(chunks_[index].counts.size(), false);  // each listed connection once
-    for (size_t k = 0; k < seen.size(); ++k) {
+    std::set<uint32_t> seen;  // each listed connection once
+    for (size_t k = 0; k < chunks_[index].counts.size(); ++k) {
       const FileRecord r = read_file_record(file_, pos, place_);
       const Chunk& c = chunks_[index];
       if (r.header.op() != kOpIndexData)
@@ -389,13 +391,10 @@ class Rosbag1File final : public BagFile {
         place_.fail(pos, "index data version " + std::to_string(r.header.u32("ver")) + "; planarvo reads version 1");
       const uint32_t conn = r.header.u32("conn");
       const uint32_t count = r.header.u32("count");
-      const auto listed =
-          std::find_if(c.counts.begin(), c.counts.end(), [&](const auto& cn) { return cn.first == conn; });
-      const size_t slot = static_cast<size_t>(listed - c.counts.begin());
-      if (listed == c.counts.end() || listed->second != count || seen[slot])
+      const auto listed = c.counts.find(conn);
+      if (listed == c.counts.end() || listed->second != count || !seen.insert(conn).second)
         place_.fail(pos, "index data for connection " + std::to_string(conn) + " with " + std::to_string(count) +
                              " messages, which the chunk info does not list (or lists once)");
-      seen[slot] = true;
       if (static_cast<uint64_t>(count) * 12 != r.data_size)
         place_.fail(pos, "index data of " + std::to_string(count) + " messages with " + std::to_string(r.data_size) +
                              " bytes of data, not 12 each");
