@@ -19,7 +19,7 @@
 set -euo pipefail
 
 root=$(cd "$(dirname "$0")/.." && pwd)
-all_targets=(camera_yaml extrinsics_yaml frames tum direction motion_pairs g2o capi mcap)
+all_targets=(camera_yaml extrinsics_yaml frames tum direction motion_pairs g2o capi mcap rosbag1)
 seconds=60
 jobs=1
 build="$root/build-fuzz"
@@ -64,6 +64,7 @@ dict_for() {
     camera_yaml|extrinsics_yaml) echo "$root/fuzz/dict/yaml.dict" ;;
     capi) echo "" ;;
     mcap) echo "$root/fuzz/dict/mcap.dict" ;;
+    rosbag1) echo "$root/fuzz/dict/rosbag1.dict" ;;
     *) echo "$root/fuzz/dict/text.dict" ;;
   esac
 }

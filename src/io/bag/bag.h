@@ -24,6 +24,8 @@ struct TopicInfo {
   std::string type;      // as recorded: "sensor_msgs/Image" (ROS 1), "sensor_msgs/msg/Image" (ROS 2)
   int64_t count = 0;     // messages on the topic; -1 when the file does not say (an MCAP file
                          // without a summary lists the topic with -1 until indexed)
+  std::string md5sum;    // ROS 1: the md5sum of the message definition the connection recorded
+                         // (a reader checks it for the types it decodes); empty for MCAP
 };
 
 // Where one message is, so that its bytes can be read back later.

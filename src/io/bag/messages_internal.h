@@ -12,6 +12,9 @@ ImageMessage decode_image(const uint8_t* data, size_t size);
 CompressedImageMessage decode_compressed_image(const uint8_t* data, size_t size);
 CameraInfoMessage decode_camera_info(const uint8_t* data, size_t size);
 OdometryMessage decode_odometry(const uint8_t* data, size_t size);
+// The md5sum of the ROS 1 message definition these decoders read ("" for Other): a connection
+// whose type has another md5sum was recorded with a different definition under the same name.
+const char* definition_md5(MessageKind kind);
 }  // namespace ros1
 namespace cdr {
 Header decode_header(const uint8_t* data, size_t size);
