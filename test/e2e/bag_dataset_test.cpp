@@ -266,21 +266,29 @@ TEST_F(BagDataset, BadBagsAreExit2NamingTheProblem) {
   EXPECT_EQ(truncated.exit_code, 2) << truncated.output;
   EXPECT_THAT(truncated.output, HasSubstr("byte"));
 
-  // A camera info 2 pixels wider than the images.
-  const fs::path wide = scratch() / "wide";
-  fs::remove_all(wide);
-  fs::copy(dataset_dir(), wide, fs::copy_options::recursive);
-  std::string yaml = test::read_file(wide / "camera.yaml");
+  // A camera info 2 pixels wider than the images: the bag rewritten by python3-rosbag with
+  // each CameraInfo's width changed.
+  const fs::path wide = scratch() / "wide.bag";
+  const auto w = run_command(
+      "/usr/bin/python3 -c \"import rosbag, sys\n"
+      "out = rosbag.Bag(sys.argv[2], 'w')\n"
+      "for topic, m, t in rosbag.Bag(sys.argv[1]).read_messages():\n"
+      "    if topic == '/camera/camera_info': m.width = 322\n"
+      "    out.write(topic, m, t)\n"
+      "out.close()\" " + bag.string() + " " + wide.string());
+  ASSERT_EQ(w.exit_code, 0) << w.output;
+  const auto size = run_cli("track --quiet " + wide.string() + extr);
+  EXPECT_EQ(size.exit_code, 2);
+  EXPECT_THAT(size.output, HasSubstr("322x240"));
+  // The same with the camera from a camera.yaml that disagrees.
+  std::string yaml = test::read_file(dataset_dir() / "camera.yaml");
   const size_t at = yaml.find("image_width: 320");
   ASSERT_NE(at, std::string::npos);
   yaml.replace(at, 16, "image_width: 322");
-  std::ofstream(wide / "camera.yaml") << yaml;
-  const fs::path wide_bag = scratch() / "wide.bag";
-  const auto w = run_command("/usr/bin/python3 " + rosbag_writer() + " " + wide.string() + " " + wide_bag.string());
-  ASSERT_EQ(w.exit_code, 0) << w.output;
-  const auto size = run_cli("track --quiet " + wide_bag.string() + extr);
-  EXPECT_EQ(size.exit_code, 2);
-  EXPECT_THAT(size.output, HasSubstr("322x240"));
+  std::ofstream(scratch() / "wide.yaml") << yaml;
+  const auto size_yaml = run_cli("track --quiet " + bag.string() + extr + " --camera " + (scratch() / "wide.yaml").string());
+  EXPECT_EQ(size_yaml.exit_code, 2);
+  EXPECT_THAT(size_yaml.output, HasSubstr("322x240"));
 
   // Bag options for a folder are a usage error, not silently ignored.
   EXPECT_EQ(run_cli("track --quiet " + dataset_dir().string() + " --image-topic /camera/image_raw").exit_code, 2);

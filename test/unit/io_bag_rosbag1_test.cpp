@@ -14,6 +14,7 @@
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include "core/error.h"
 #include "io/bag/bag.h"
@@ -192,7 +193,8 @@ std::string expect_error(F&& f, ErrorCode code, const std::vector<std::string>& 
 class Rosbag1Test : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
-    dir_ = PLANARVO_BINARY_DIR "/test-scratch/rosbag1";
+    // A folder per process (CTest runs the suite's tests in parallel processes), removed at the end.
+    dir_ = PLANARVO_BINARY_DIR "/test-scratch/rosbag1." + std::to_string(getpid());
     if (std::system("/usr/bin/python3 -c 'import rosbag, roslz4, sensor_msgs.msg, nav_msgs.msg' 2>/dev/null") != 0) {
       skip_ = "Debian's python3-rosbag (and its message packages) are missing: run scripts/install-deps.sh";
       return;
@@ -201,6 +203,10 @@ class Rosbag1Test : public ::testing::Test {
     const std::string cmd = "/usr/bin/python3 " PLANARVO_SOURCE_DIR "/test/tools/rosbag/write_test_bags.py '" + dir_ +
                             "' 2>/dev/null";
     generated_ = std::system(cmd.c_str()) == 0;
+  }
+  static void TearDownTestSuite() {
+    std::error_code ec;
+    if (!std::getenv("PLANARVO_KEEP_SCRATCH")) fs::remove_all(dir_, ec);
   }
 
   void SetUp() override {

@@ -206,7 +206,7 @@ void Reader::assign_topics() {
     uint32_t t = 0;
     while (t < topics_.size() && topics_[t].name != info.record.topic) ++t;
     if (t == topics_.size()) {
-      topics_.push_back(TopicInfo{info.record.topic, type, stat_counts_.empty() ? -1 : 0});
+      topics_.push_back(TopicInfo{info.record.topic, type, stat_counts_.empty() ? -1 : 0, std::string()});
       topic_problem_.emplace_back();
     } else if (topics_[t].type != type && topic_problem_[t].empty()) {
       topic_problem_[t] = path_ + ": topic " + topics_[t].name + " has channels of two types, " + topics_[t].type +
