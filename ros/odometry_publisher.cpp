@@ -70,8 +70,8 @@ void OdometryPublisher::publish(const ros::Time& stamp, const planarvo_track_res
   const bool first = r.status == PLANARVO_TRACK_FIRST;
   const bool covariance_ok = finite_covariance(r.covariance);
   // The pose's covariance: the last one moved along the step, plus the motion's rotated into the
-  // odom frame (first order; frames that share a keyframe have correlated errors, which this
-  // treats as independent: it grows faster than the truth, never slower).
+  // odom frame (first order; frames tracked against one keyframe have correlated errors, which
+  // this treats as independent, so it tends to overstate the uncertainty).
   if (!first) {
     double m[9];
     for (int i = 0; i < 9; ++i) m[i] = covariance_ok ? r.covariance[i] : (i % 4 == 0 ? kUnusedVariance : 0.0);

@@ -159,6 +159,7 @@ class Node {
       c = counts_;
     }
     publish_counts(c);
+    if (counts_topic_.getNumSubscribers() > 0) ros::WallDuration(0.2).sleep();  // let the last counts go out
     ROS_INFO("%s", c.summary().c_str());
     std::printf("%s\n", c.summary().c_str());
     std::fflush(stdout);
