@@ -14,7 +14,7 @@ if(PkgConfig_FOUND)
 endif()
 set(planarvo_ros_missing "")
 if(NOT PLANARVO_ROSCPP_FOUND)
-  list(APPEND planarvo_ros_missing "roscpp (pkg-config roscpp; libroscpp-dev)")
+  list(APPEND planarvo_ros_missing "roscpp (libroscpp-dev)")
 endif()
 set(PLANARVO_ROS_MESSAGE_INCLUDE_DIRS "")
 foreach(header sensor_msgs/Image.h sensor_msgs/CameraInfo.h nav_msgs/Odometry.h geometry_msgs/TransformStamped.h
