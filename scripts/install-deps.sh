@@ -19,6 +19,13 @@ packages=(
 )
 # Benchmark-only peer (issue 3): Ceres Solver. Installed when PLANARVO_BENCH_DEPS=1.
 if [ "${PLANARVO_BENCH_DEPS:-0}" = 1 ]; then packages+=(libceres-dev); fi
+# planarvo_node (ros/): roscpp and the messages it uses (ROS 1 as Debian packages it); and its
+# end-to-end test (test/ros): roscore (python3-roslaunch brings rosmaster and rosout), rosbag play
+# and the bag writer, rospy with the message modules the test reads.
+packages+=(
+  libroscpp-dev libstd-msgs-dev libsensor-msgs-dev libnav-msgs-dev libgeometry-msgs-dev libtf2-msgs-dev
+  python3-roslaunch python3-rosbag python3-rospy python3-yaml python3-sensor-msgs python3-nav-msgs python3-tf2-msgs
+)
 
 missing=()
 for p in "${packages[@]}"; do

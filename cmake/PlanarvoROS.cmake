@@ -1,0 +1,46 @@
+# ROS 1 (roscpp) for planarvo_node (ros/), found without catkin: roscpp through its pkg-config
+# file, the message packages (header-only generated code) by their headers. Debian 12's packages:
+# libroscpp-dev, libsensor-msgs-dev, libnav-msgs-dev, libgeometry-msgs-dev, libtf2-msgs-dev,
+# libstd-msgs-dev (scripts/install-deps.sh). Sets PLANARVO_ROS_FOUND and, when found, the imported
+# target PlanarvoROS::roscpp with the include directories of the messages.
+set(PLANARVO_ROS_FOUND OFF)
+if(NOT PLANARVO_ROS)
+  message(STATUS "planarvo: PLANARVO_ROS is OFF: planarvo_node is not built")
+  return()
+endif()
+find_package(PkgConfig QUIET)
+if(PkgConfig_FOUND)
+  pkg_check_modules(PLANARVO_ROSCPP QUIET IMPORTED_TARGET roscpp)
+endif()
+set(planarvo_ros_missing "")
+if(NOT PLANARVO_ROSCPP_FOUND)
+  list(APPEND planarvo_ros_missing "roscpp (libroscpp-dev)")
+endif()
+set(PLANARVO_ROS_MESSAGE_INCLUDE_DIRS "")
+foreach(header sensor_msgs/Image.h sensor_msgs/CameraInfo.h nav_msgs/Odometry.h geometry_msgs/TransformStamped.h
+               tf2_msgs/TFMessage.h std_msgs/String.h)
+  string(MAKE_C_IDENTIFIER "PLANARVO_ROS_${header}" var)
+  find_path(${var} ${header})
+  if(${var})
+    list(APPEND PLANARVO_ROS_MESSAGE_INCLUDE_DIRS ${${var}})
+  else()
+    string(REGEX REPLACE "/.*" "" package "${header}")
+    string(REPLACE "_" "-" deb "${package}")
+    list(APPEND planarvo_ros_missing "${header} (lib${deb}-dev)")
+  endif()
+endforeach()
+if(planarvo_ros_missing)
+  string(REPLACE ";" ", " planarvo_ros_missing "${planarvo_ros_missing}")
+  message(STATUS "planarvo: ROS 1 (roscpp) not found: planarvo_node is not built (missing ${planarvo_ros_missing}; "
+                 "scripts/install-deps.sh installs them, -DPLANARVO_ROS=OFF silences this)")
+  return()
+endif()
+list(REMOVE_DUPLICATES PLANARVO_ROS_MESSAGE_INCLUDE_DIRS)
+if(NOT TARGET PlanarvoROS::roscpp)
+  add_library(PlanarvoROS::roscpp INTERFACE IMPORTED)
+  target_link_libraries(PlanarvoROS::roscpp INTERFACE PkgConfig::PLANARVO_ROSCPP)
+  # SYSTEM (an imported target's directories are): ROS's headers do not meet planarvo's warnings.
+  target_include_directories(PlanarvoROS::roscpp SYSTEM INTERFACE ${PLANARVO_ROS_MESSAGE_INCLUDE_DIRS})
+endif()
+set(PLANARVO_ROS_FOUND ON)
+message(STATUS "planarvo: ROS 1 roscpp ${PLANARVO_ROSCPP_VERSION} found: planarvo_node is built")

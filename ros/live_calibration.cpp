@@ -1,0 +1,162 @@
+#include "live_calibration.h"
+
+#include <cmath>
+#include <cstring>
+
+#include <ros/ros.h>
+
+namespace planarvo_node {
+namespace {
+
+const char* const kNames[6] = {"x", "y", "z", "roll", "pitch", "yaw"};
+
+double yaw_of(const geometry_msgs::Quaternion& q) {
+  return std::atan2(2 * (q.w * q.z + q.x * q.y), 1 - 2 * (q.y * q.y + q.z * q.z));
+}
+
+}  // namespace
+
+LiveCalibration::LiveCalibration(planarvo_context* context, const planarvo_camera& camera, const NodeParams& params)
+    : params_(params) {
+  planarvo_camera_calibration_options o;
+  planarvo_camera_calibration_options_init(&o);
+  o.method = PLANARVO_CALIBRATE_ODOMETRY;
+  o.height = params.calibration_height;
+  // As `planarvo calibrate`: the camera's motions are far more precise than wheel odometry, so
+  // the odometry's noise model is fitted to the drive's residuals.
+  planarvo_calibration_options graph;
+  planarvo_calibration_options_init(&graph);
+  graph.method = PLANARVO_CALIBRATE_ODOMETRY;
+  graph.estimate_odometry_noise = 1;
+  o.graph = &graph;
+  o.tracker = &params.tracker;
+  if (planarvo_camera_calibrator_create(context, &camera, &o, &calibrator_) != PLANARVO_OK)
+    throw std::runtime_error(std::string("planarvo_camera_calibrator_create: ") + planarvo_last_error());
+  result_.struct_size = sizeof result_;
+}
+
+LiveCalibration::~LiveCalibration() { planarvo_camera_calibrator_destroy(calibrator_); }
+
+void LiveCalibration::add_odometry(const nav_msgs::Odometry& m) {
+  const Pose p{static_cast<int64_t>(m.header.stamp.toNSec()),
+               {m.pose.pose.position.x, m.pose.pose.position.y, yaw_of(m.pose.pose.orientation)}};
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (!odometry_.empty() && p.ns <= odometry_.back().ns) {
+    if (p.ns < odometry_.back().ns - 1000000000LL) odometry_.clear();  // time went back: a new run
+    else return;
+  }
+  odometry_.push_back(p);
+}
+
+void LiveCalibration::add_frame(const planarvo_image& image, int64_t stamp_ns, double t) {
+  if (finished_) return;
+  if (t <= last_t_) {
+    ROS_WARN_THROTTLE(5, "planarvo_node: calibration: a frame at t = %.6f s after one at %.6f s is left out", t, last_t_);
+    return;
+  }
+  last_t_ = t;
+  Frame f;
+  const size_t bpp = image.format == PLANARVO_GRAY8 ? 1 : 3;
+  const size_t row = static_cast<size_t>(image.width) * bpp;
+  f.pixels.resize(row * static_cast<size_t>(image.height));
+  for (int32_t y = 0; y < image.height; ++y)
+    std::memcpy(f.pixels.data() + row * static_cast<size_t>(y),
+                static_cast<const uint8_t*>(image.data) + image.stride * static_cast<size_t>(y), row);
+  f.image = image;
+  f.image.data = f.pixels.data();
+  f.image.stride = row;
+  f.ns = stamp_ns;
+  f.t = t;
+  waiting_.push_back(std::move(f));
+}
+
+// The odometry pose at the frame's stamp, interpolated between the messages around it; none when
+// the frame lies outside them (final: the odometry will not grow any more).
+void LiveCalibration::feed(Frame& f, bool final) {
+  planarvo_se2 pose{};
+  bool has = false;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    while (odometry_.size() > 2 && odometry_[1].ns <= f.ns) odometry_.pop_front();
+    for (size_t i = 0; i + 1 < odometry_.size() && !has; ++i) {
+      const Pose &a = odometry_[i], &b = odometry_[i + 1];
+      if (a.ns <= f.ns && f.ns <= b.ns) {
+        const double u = b.ns == a.ns ? 0.0 : static_cast<double>(f.ns - a.ns) / static_cast<double>(b.ns - a.ns);
+        pose.x = a.pose.x + u * (b.pose.x - a.pose.x);
+        pose.y = a.pose.y + u * (b.pose.y - a.pose.y);
+        pose.theta = a.pose.theta + u * std::remainder(b.pose.theta - a.pose.theta, 2 * M_PI);
+        has = true;
+      }
+    }
+    if (!has && odometry_.size() == 1 && odometry_[0].ns == f.ns) pose = odometry_[0].pose, has = true;
+  }
+  if (!has && !warned_no_odometry_) {
+    ROS_WARN("planarvo_node: calibration: no odometry around the frame at t = %.3f s%s; frames without it give "
+             "the calibration no interval",
+             f.t, final ? " (shutdown)" : " within ~calibration_odom_wait");
+    warned_no_odometry_ = true;
+  }
+  const planarvo_status st = planarvo_camera_calibrator_add_frame(calibrator_, &f.image, f.t, has ? &pose : nullptr,
+                                                                  nullptr);
+  if (st != PLANARVO_OK)
+    ROS_ERROR_THROTTLE(5, "planarvo_node: calibration: frame at t = %.3f s: %s", f.t, planarvo_last_error());
+  ++fed_;
+  with_odometry_ += has ? 1 : 0;
+}
+
+bool LiveCalibration::poll() {
+  while (!finished_ && !waiting_.empty()) {
+    Frame& f = waiting_.front();
+    int64_t newest = 0;
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      newest = odometry_.empty() ? 0 : odometry_.back().ns;
+    }
+    const bool covered = newest >= f.ns;
+    const bool waited_too_long =
+        static_cast<double>(waiting_.back().ns - f.ns) * 1e-9 > params_.calibration_odom_wait;
+    if (!covered && !waited_too_long) break;
+    feed(f, false);
+    waiting_.pop_front();
+    if (params_.calibration_frames > 0 && fed_ >= params_.calibration_frames) complete();
+  }
+  return finished_;
+}
+
+void LiveCalibration::finish() {
+  if (finished_) return;
+  while (!waiting_.empty()) {
+    feed(waiting_.front(), true);
+    waiting_.pop_front();
+  }
+  complete();
+}
+
+void LiveCalibration::complete() {
+  finished_ = true;
+  waiting_.clear();
+  ROS_INFO("planarvo_node: calibrating from %lld frames (%lld with odometry)...", static_cast<long long>(fed_),
+           static_cast<long long>(with_odometry_));
+  const planarvo_status st = planarvo_camera_calibrator_finish(calibrator_, &result_);
+  if (st != PLANARVO_OK) {
+    ROS_ERROR("planarvo_node: calibration failed (%s): %s; %s not written", planarvo_status_name(st),
+              st == PLANARVO_ERROR_FAILED ? result_.reason : planarvo_last_error(), params_.calibration_output.c_str());
+    return;
+  }
+  std::string estimated;
+  for (int i = 0; i < 6; ++i)
+    if (result_.estimated[i]) estimated += std::string(estimated.empty() ? "" : ",") + kNames[i];
+  const std::string method = "roll and pitch from images (sec. 5.1); x, y, z, yaw against wheel odometry (5.2.1)";
+  const std::string notes = "planarvo_node live calibration, " + std::to_string(fed_) + " frames";
+  if (planarvo_extrinsics_save(params_.calibration_output.c_str(), &result_.extrinsics, result_.covariance,
+                               estimated.c_str(), method.c_str(), notes.c_str()) != PLANARVO_OK) {
+    ROS_ERROR("planarvo_node: calibration: %s", planarvo_last_error());
+    return;
+  }
+  succeeded_ = true;
+  const planarvo_extrinsics& e = result_.extrinsics;
+  ROS_INFO("planarvo_node: calibrated: x %.4f y %.4f z %.4f m, roll %.3f pitch %.3f yaw %.3f deg; wrote %s", e.x, e.y,
+           e.z, e.roll * 180 / M_PI, e.pitch * 180 / M_PI, e.yaw * 180 / M_PI, params_.calibration_output.c_str());
+}
+
+}  // namespace planarvo_node

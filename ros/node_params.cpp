@@ -1,0 +1,119 @@
+#include "node_params.h"
+
+#include <cmath>
+#include <sstream>
+
+#include <ros/ros.h>
+
+namespace planarvo_node {
+namespace {
+
+// A parameter's value as a user wrote it ("12", "true", "abc"), for the error messages.
+std::string text(XmlRpc::XmlRpcValue& v) {
+  std::ostringstream os;
+  os << v;
+  return v.getType() == XmlRpc::XmlRpcValue::TypeString ? "\"" + os.str() + "\"" : os.str();
+}
+
+// A string parameter that a user may also give as a number (~device:=1 arrives as an int).
+bool get_text(const ros::NodeHandle& nh, const std::string& name, std::string* out) {
+  XmlRpc::XmlRpcValue v;
+  if (!nh.getParam(name, v)) return true;
+  switch (v.getType()) {
+    case XmlRpc::XmlRpcValue::TypeString: *out = static_cast<std::string>(v); return true;
+    case XmlRpc::XmlRpcValue::TypeInt: *out = std::to_string(static_cast<int>(v)); return true;
+    default:
+      ROS_FATAL("planarvo_node: parameter ~%s must be a string, not %s", name.c_str(), text(v).c_str());
+      return false;
+  }
+}
+
+bool get_int(const ros::NodeHandle& nh, const std::string& name, int lo, int hi, int* out) {
+  XmlRpc::XmlRpcValue v;
+  if (!nh.getParam(name, v)) return true;
+  if (v.getType() != XmlRpc::XmlRpcValue::TypeInt || static_cast<int>(v) < lo || static_cast<int>(v) > hi) {
+    ROS_FATAL("planarvo_node: parameter ~%s must be an integer within %d..%d, not %s", name.c_str(), lo, hi,
+              text(v).c_str());
+    return false;
+  }
+  *out = static_cast<int>(v);
+  return true;
+}
+
+bool get_double(const ros::NodeHandle& nh, const std::string& name, double lo, double hi, double* out) {
+  XmlRpc::XmlRpcValue v;
+  if (!nh.getParam(name, v)) return true;
+  double x = NAN;
+  if (v.getType() == XmlRpc::XmlRpcValue::TypeDouble) x = static_cast<double>(v);
+  if (v.getType() == XmlRpc::XmlRpcValue::TypeInt) x = static_cast<int>(v);
+  if (!(x >= lo && x <= hi)) {
+    ROS_FATAL("planarvo_node: parameter ~%s must be a number within %g..%g, not %s", name.c_str(), lo, hi,
+              text(v).c_str());
+    return false;
+  }
+  *out = x;
+  return true;
+}
+
+bool get_bool(const ros::NodeHandle& nh, const std::string& name, bool* out) {
+  XmlRpc::XmlRpcValue v;
+  if (!nh.getParam(name, v)) return true;
+  if (v.getType() != XmlRpc::XmlRpcValue::TypeBoolean) {
+    ROS_FATAL("planarvo_node: parameter ~%s must be true or false, not %s", name.c_str(), text(v).c_str());
+    return false;
+  }
+  *out = static_cast<bool>(v);
+  return true;
+}
+
+bool get_frame(const ros::NodeHandle& nh, const std::string& name, std::string* out) {
+  if (!get_text(nh, name, out)) return false;
+  if (out->empty() || out->find(' ') != std::string::npos) {
+    ROS_FATAL("planarvo_node: parameter ~%s must be a frame name without spaces, not \"%s\"", name.c_str(),
+              out->c_str());
+    return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+bool read_params(const ros::NodeHandle& nh, NodeParams* p) {
+  planarvo_tracker_options_init(&p->tracker);
+  planarvo_tracker_options& t = p->tracker;
+  int levels = t.levels, finest = t.finest_level, subsample = t.level0_subsample, iterations = t.max_iterations;
+  bool ok = get_text(nh, "camera", &p->camera) && get_text(nh, "extrinsics", &p->extrinsics) &&
+            get_text(nh, "device", &p->device) && get_text(nh, "cache_dir", &p->cache_dir) &&
+            get_text(nh, "kernel_binaries", &p->kernel_binaries) &&
+            get_bool(nh, "prepare_kernels", &p->prepare_kernels) && get_frame(nh, "odom_frame", &p->odom_frame) &&
+            get_frame(nh, "base_frame", &p->base_frame) && get_bool(nh, "publish_tf", &p->publish_tf) &&
+            get_int(nh, "levels", 1, 8, &levels) && get_int(nh, "finest_level", -1, levels - 1, &finest) &&
+            get_int(nh, "level0_subsample", 0, 8, &subsample) &&
+            get_int(nh, "max_iterations", 0, 1000, &iterations) &&
+            get_double(nh, "keyframe_overlap", 0.0, 1.0, &t.keyframe_overlap) &&
+            get_int(nh, "queue_size", 1, 100000, &p->queue_size) &&
+            get_int(nh, "max_pending", 1, 100000, &p->max_pending) &&
+            get_double(nh, "drain_seconds", 0.0, 3600.0, &p->drain_seconds) &&
+            get_bool(nh, "calibrate", &p->calibrate) &&
+            get_text(nh, "calibration_output", &p->calibration_output) &&
+            get_int(nh, "calibration_frames", 0, 10000000, &p->calibration_frames) &&
+            get_double(nh, "calibration_height", 0.0, 100.0, &p->calibration_height) &&
+            get_double(nh, "calibration_odom_wait", 0.0, 60.0, &p->calibration_odom_wait);
+  if (!ok) return false;
+  t.levels = levels;
+  t.finest_level = finest;
+  t.level0_subsample = subsample;
+  t.max_iterations = iterations;
+  if (p->calibrate && p->calibration_output.empty()) {
+    ROS_FATAL("planarvo_node: ~calibrate is true but ~calibration_output (the extrinsics file to write) is not set");
+    return false;
+  }
+  if (!p->calibrate && p->extrinsics.empty()) {
+    ROS_FATAL("planarvo_node: ~extrinsics (the camera's extrinsics.yaml) is required for tracking; or set "
+              "~calibrate true and ~calibration_output FILE to calibrate them from the images and /odom");
+    return false;
+  }
+  return true;
+}
+
+}  // namespace planarvo_node
