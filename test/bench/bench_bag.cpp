@@ -1,15 +1,17 @@
 // What reading a bag costs against reading the same frames from a data set folder, and against
 // tracking them: per source, the time to open (index, stamps, camera), the median time to read
 // and decode one frame, and the median time to track one (the tracker's own time, reading
-// excluded), through the C API as `planarvo track` uses it. Sources are read in turn, `rounds`
-// times, each round in a fresh process state for the file cache (the files are read once before
-// timing, so all rounds read from the page cache, as a second run of the tool does).
+// excluded), through the C API as `planarvo track` uses it; and the largest difference of any
+// frame's tracked motion (m, rad), time after the first frame, odometry and ground-truth pose
+// from the first source's (the folder). Sources are read in turn, `rounds` times; after the
+// first round the files are in the page cache, as for a second run of the tool.
 //
 //   bench_bag DATASET EXTRINSICS.yaml SOURCE... [rounds=3] [odom=/odom] [gt=/ground_truth]
 //     SOURCE: the DATASET folder itself, a .bag or an .mcap written from it
 //     (test/tools/rosbag/dataset_to_rosbag.py, test/tools/mcap/dataset_to_mcap.mjs)
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -44,7 +46,30 @@ struct Row {
   std::string source;
   int64_t frames = 0;
   std::vector<double> open_ms, read_ms, track_ms, total_ms;
+  std::vector<planarvo_frame_data> data;  // the first round's
+  std::vector<planarvo_se2> motion;
 };
+
+double angle_diff(double a, double b) { return std::abs(std::remainder(a - b, 2 * M_PI)); }
+double pose_diff(const planarvo_se2& a, const planarvo_se2& b) {
+  return std::max({std::abs(a.x - b.x), std::abs(a.y - b.y), angle_diff(a.theta, b.theta)});
+}
+
+// The largest difference of motions, times and poses from the reference's, or -1 when the frame
+// counts differ.
+double max_difference(const Row& r, const Row& ref) {
+  if (r.motion.size() != ref.motion.size()) return -1;
+  double worst = 0;
+  const double t0 = ref.data.empty() ? 0 : ref.data.front().timestamp;
+  for (size_t i = 0; i < r.motion.size(); ++i) {
+    const planarvo_frame_data &a = r.data[i], &b = ref.data[i];
+    worst = std::max({worst, pose_diff(r.motion[i], ref.motion[i]), std::abs(a.timestamp - (b.timestamp - t0))});
+    if (a.has_odometry != b.has_odometry || a.has_groundtruth != b.has_groundtruth) return -1;
+    if (a.has_odometry) worst = std::max(worst, pose_diff(a.odometry, b.odometry));
+    if (a.has_groundtruth) worst = std::max(worst, pose_diff(a.groundtruth, b.groundtruth));
+  }
+  return worst;
+}
 
 }  // namespace
 
@@ -105,6 +130,10 @@ int main(int argc, char** argv) {
         const auto t_track = Clock::now();
         check(planarvo_tracker_track(tracker, &img, fd.timestamp, &r), "track");
         row.track_ms.push_back(ms_since(t_track));
+        if (round == 0) {
+          row.data.push_back(fd);
+          row.motion.push_back(r.motion);
+        }
       }
       row.total_ms.push_back(ms_since(t_all) + row.open_ms.back());
       planarvo_tracker_destroy(tracker);
@@ -115,15 +144,17 @@ int main(int argc, char** argv) {
 
   const Row& base = rows.front();
   std::printf("%d rounds; medians over rounds (open, total) and over frames x rounds (read, track)\n\n", rounds);
-  std::printf("| source | frames | open ms | read ms/frame | track ms/frame | read / track | total s | vs %s |\n",
+  std::printf("| source | frames | open ms | read ms/frame | track ms/frame | (open + read) / track | total s | "
+              "vs %s | max difference |\n",
               std::filesystem::path(base.source).filename().c_str());
-  std::printf("|---|---|---|---|---|---|---|---|\n");
+  std::printf("|---|---|---|---|---|---|---|---|---|\n");
   for (const Row& r : rows) {
-    const double rd = median(r.read_ms), tr = median(r.track_ms);
-    std::printf("| %s | %lld | %.1f | %.3f | %.2f | %.1f%% | %.2f | %+.1f%% |\n",
-                std::filesystem::path(r.source).filename().c_str(), static_cast<long long>(r.frames),
-                median(r.open_ms), rd, tr, 100.0 * rd / tr, median(r.total_ms) / 1e3,
-                100.0 * (median(r.total_ms) / median(base.total_ms) - 1.0));
+    const double rd = median(r.read_ms), tr = median(r.track_ms), op = median(r.open_ms);
+    const double n = static_cast<double>(r.frames);
+    std::printf("| %s | %lld | %.1f | %.3f | %.2f | %.1f%% | %.2f | %+.1f%% | %.1e |\n",
+                std::filesystem::path(r.source).filename().c_str(), static_cast<long long>(r.frames), op, rd, tr,
+                100.0 * (op + rd * n) / (tr * n), median(r.total_ms) / 1e3,
+                100.0 * (median(r.total_ms) / median(base.total_ms) - 1.0), max_difference(r, base));
   }
   return 0;
 }
