@@ -1,6 +1,7 @@
 // What reading a bag costs against reading the same frames from a data set folder, and against
 // tracking them: per source, the time to open (index, stamps, camera), the median time to read
-// and decode one frame, and the median time to track one (the tracker's own time, reading
+// and decode one frame (the mean: a compressed chunk holds several frames, and the first one
+// read pays for its decompression), and the median time to track one (the tracker's own time, reading
 // excluded), through the C API as `planarvo track` uses it; and the largest difference of any
 // frame's tracked motion (m, rad), time after the first frame, odometry and ground-truth pose
 // from the first source's (the folder). Sources are read in turn, `rounds` times; after the
@@ -143,13 +144,17 @@ int main(int argc, char** argv) {
   planarvo_context_destroy(ctx);
 
   const Row& base = rows.front();
-  std::printf("%d rounds; medians over rounds (open, total) and over frames x rounds (read, track)\n\n", rounds);
+  std::printf("%d rounds; medians over rounds (open, total), mean over frames x rounds (read), median over frames "
+              "x rounds (track)\n\n",
+              rounds);
   std::printf("| source | frames | open ms | read ms/frame | track ms/frame | (open + read) / track | total s | "
               "vs %s | max difference |\n",
               std::filesystem::path(base.source).filename().c_str());
   std::printf("|---|---|---|---|---|---|---|---|---|\n");
   for (const Row& r : rows) {
-    const double rd = median(r.read_ms), tr = median(r.track_ms), op = median(r.open_ms);
+    double rd = 0;
+    for (double v : r.read_ms) rd += v / static_cast<double>(r.read_ms.size());
+    const double tr = median(r.track_ms), op = median(r.open_ms);
     const double n = static_cast<double>(r.frames);
     std::printf("| %s | %lld | %.1f | %.3f | %.2f | %.1f%% | %.2f | %+.1f%% | %.1e |\n",
                 std::filesystem::path(r.source).filename().c_str(), static_cast<long long>(r.frames), op, rd, tr,
