@@ -210,6 +210,23 @@ TEST_F(BagDataset, ReceiveTimesShiftTheOriginOnly) {
   expect_same_as_folder(write_rosbag("mono8_none.bag", "--compression none"), true);
 }
 
+// Recorded out of order: the bag rewritten by python3-rosbag with the receive times reversed (the
+// last frame received first). The frames are taken in header-stamp order, so nothing changes.
+TEST_F(BagDataset, MessagesRecordedOutOfOrderAreTakenInStampOrder) {
+  SKIP_WITHOUT(rosbag_missing());
+  const fs::path bag = write_rosbag("mono8_none.bag", "--compression none");
+  const fs::path reversed = scratch() / "reversed.bag";
+  const auto w = run_command(
+      "/usr/bin/python3 -c \"import rosbag, rospy, sys\n"
+      "out = rosbag.Bag(sys.argv[2], 'w')\n"
+      "end = rospy.Time(1800000000)\n"
+      "for topic, m, t in rosbag.Bag(sys.argv[1]).read_messages():\n"
+      "    out.write(topic, m, end - (t - rospy.Time(1700000000)))\n"
+      "out.close()\" " + bag.string() + " " + reversed.string());
+  ASSERT_EQ(w.exit_code, 0) << w.output;
+  expect_same_as_folder(reversed);
+}
+
 // The tool on a bag: the trajectory it writes carries the bag's stamps, and its poses are the
 // folder's.
 TEST_F(BagDataset, TrackWritesTheBagsStamps) {
