@@ -102,6 +102,12 @@ PLANARVO_API planarvo_status planarvo_dataset_frame_data(const planarvo_dataset*
 PLANARVO_API planarvo_status planarvo_dataset_frame(planarvo_dataset* dataset, int64_t index,
                                                     planarvo_image* image);
 
+/* The topics of a ROS 1 bag or MCAP file, one per line: "name<TAB>type<TAB>count\n" (count -1
+ * when the file does not say), in the file's order, as a NUL-terminated string in buffer (size
+ * bytes; NULL with size 0 to ask). *needed, when not NULL, receives the bytes the whole list takes
+ * with its NUL; PLANARVO_ERROR_INVALID_ARGUMENT, writing nothing, when size is less. */
+PLANARVO_API planarvo_status planarvo_bag_topics(const char* path, char* buffer, size_t size, size_t* needed);
+
 /* Writes a TUM trajectory (t x y z qx qy qz qw, z = 0, rotation about z). */
 PLANARVO_API planarvo_status planarvo_write_tum(const char* path, const double* timestamps,
                                                 const planarvo_se2* poses, size_t count);

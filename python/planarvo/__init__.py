@@ -18,7 +18,7 @@ from ._camera import EXTRINSICS_NAMES, Camera, Extrinsics
 from ._camera_calibration import (CalibrationStatus, CameraCalibrationOptions, CameraCalibrationResult,
                                   CameraCalibrator, RollPitch, RollPitchOptions, RollPitchResult, calibrate_dataset)
 from ._context import Context, DeviceInfo, list_devices, version
-from ._dataset import Dataset, DatasetInfo, FrameData
+from ._dataset import Dataset, DatasetInfo, FrameData, bag_topics
 from ._errors import Error, Status
 from ._evaluation import MotionAccuracy, evaluate_motions
 from ._motion_pairs import MotionPair, load_motion_pairs, save_motion_pairs, track_motions
@@ -36,6 +36,6 @@ __all__ = ["EXTRINSICS_NAMES", "CalibrationMethod", "CalibrationOptions", "Calib
     "Context", "Dataset", "DatasetInfo", "DeviceInfo", "Error", "Extrinsics", "FrameData", "MotionAccuracy",
     "MotionPair", "MotionProfile", "PosegraphInit", "RobustLoss", "RollPitch", "RollPitchOptions",
     "RollPitchResult", "SE2", "SimOptions", "SolverSummary", "StatsWriter", "Status", "Tracker",
-    "TrackerOptions", "TrackResult", "TrackStatus", "calibrate", "calibrate_dataset", "compose_extrinsics",
+    "TrackerOptions", "TrackResult", "TrackStatus", "bag_topics", "calibrate", "calibrate_dataset", "compose_extrinsics",
     "default_texture", "evaluate_motions", "list_devices", "load_motion_pairs", "posegraph_optimize",
     "save_motion_pairs", "simulate", "track_motions", "version", "write_tum"]

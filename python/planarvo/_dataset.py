@@ -4,7 +4,7 @@ from __future__ import annotations
 import ctypes
 import os
 from dataclasses import dataclass
-from typing import Iterator, Optional, Tuple
+from typing import Iterator, List, Optional, Tuple
 
 import numpy as np
 
@@ -42,6 +42,20 @@ class FrameData:
     odometry: Optional[SE2]
     groundtruth: Optional[SE2]
     direction: Optional[int]
+
+
+def bag_topics(path: PathLike) -> List[Tuple[str, str, int]]:
+    """The topics of a ROS 1 bag or MCAP file: (name, type, message count; -1 when the file does
+    not say), in the file's order."""
+    needed = ctypes.c_size_t(0)
+    _check(lib.planarvo_bag_topics(_path(path), None, 0, ctypes.byref(needed)))
+    buf = ctypes.create_string_buffer(needed.value)
+    _check(lib.planarvo_bag_topics(_path(path), buf, needed.value, None))
+    out = []
+    for line in buf.value.decode().splitlines():
+        name, type_, count = line.rsplit("\t", 2)
+        out.append((name, type_, int(count)))
+    return out
 
 
 class Dataset(_Handle):

@@ -215,6 +215,7 @@ _SIGNATURES = {
     "planarvo_dataset_options_init": (None, [P(DatasetOptions)]),
     "planarvo_dataset_open": (S, [c_char_p, P(DatasetOptions), P(c_void_p)]),
     "planarvo_dataset_destroy": (None, [c_void_p]),
+    "planarvo_bag_topics": (S, [c_char_p, c_char_p, c_size_t, P(c_size_t)]),
     "planarvo_dataset_info_get": (S, [c_void_p, P(DatasetInfo)]),
     "planarvo_dataset_set_roi": (S, [c_void_p, P(Region)]),
     "planarvo_dataset_frame_data": (S, [c_void_p, c_int64, P(FrameData)]),

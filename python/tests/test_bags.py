@@ -55,6 +55,12 @@ def test_a_bag_holds_the_folders_frames(drive, tmp_path, writer, name, options):
 def test_a_missing_topic_names_the_topics_there_are(drive, tmp_path):
     path = tmp_path / "drive.bag"
     subprocess.run(_rosbag_writer() + [str(drive), str(path)], check=True, capture_output=True)
+    with planarvo.Dataset(drive) as folder:
+        n = folder.info.frame_count
+    assert sorted(planarvo.bag_topics(path)) == [("/camera/camera_info", "sensor_msgs/CameraInfo", n),
+                                                 ("/camera/image_raw", "sensor_msgs/Image", n),
+                                                 ("/ground_truth", "nav_msgs/Odometry", n),
+                                                 ("/odom", "nav_msgs/Odometry", n)]
     with pytest.raises(planarvo.Error) as e:
         planarvo.Dataset(path, image_topic="/front/image_raw")
     assert e.value.status == planarvo.Status.INVALID_INPUT

@@ -8,6 +8,7 @@
 #include "capi/handles.h"
 #include "capi/status.h"
 #include "core/error.h"
+#include "io/bag/bag.h"
 #include "io/dataset.h"
 
 using planarvo::capi::guard;
@@ -55,6 +56,22 @@ PLANARVO_API planarvo_status planarvo_dataset_open(const char* directory, const 
     auto handle = std::make_unique<planarvo_dataset>();
     handle->dataset = std::make_unique<planarvo::io::Dataset>(directory, o);
     *dataset = handle.release();
+  });
+}
+
+PLANARVO_API planarvo_status planarvo_bag_topics(const char* path, char* buffer, size_t size, size_t* needed) {
+  return guard([&] {
+    require(path != nullptr && *path, "planarvo_bag_topics: path is NULL or empty");
+    require(buffer != nullptr || size == 0, "planarvo_bag_topics: buffer is NULL with a size");
+    const std::unique_ptr<planarvo::io::bag::BagFile> bag = planarvo::io::bag::open_bag(path);
+    std::string list;
+    for (const planarvo::io::bag::TopicInfo& t : bag->topics())
+      list += t.name + "\t" + t.type + "\t" + std::to_string(t.count) + "\n";
+    if (needed) *needed = list.size() + 1;
+    if (size != 0 && size < list.size() + 1)
+      planarvo::throw_invalid_argument("planarvo_bag_topics: the list takes " + std::to_string(list.size() + 1) +
+                                       " bytes, the buffer has " + std::to_string(size));
+    if (size) std::memcpy(buffer, list.c_str(), list.size() + 1);
   });
 }
 

@@ -156,6 +156,23 @@ DriveSummary summarise(planarvo_dataset* ds, int64_t n) {
   return s;
 }
 
+// A bag's topics, before it is opened as a data set (which needs the right topics).
+void print_bag_topics(const std::string& path) {
+  size_t needed = 0;
+  check(planarvo_bag_topics(path.c_str(), nullptr, 0, &needed));
+  std::string list(needed, '\0');
+  check(planarvo_bag_topics(path.c_str(), list.data(), list.size(), nullptr));
+  std::printf("topics of %s\n", path.c_str());
+  size_t at = 0;
+  for (size_t end = list.find('\n'); end != std::string::npos; at = end + 1, end = list.find('\n', at)) {
+    const std::string line = list.substr(at, end - at);
+    const size_t a = line.find('\t'), b = line.rfind('\t');
+    const std::string count = line.substr(b + 1);
+    std::printf("  %-32s %-32s %s\n", line.substr(0, a).c_str(), line.substr(a + 1, b - a - 1).c_str(),
+                count == "-1" ? "" : (count + " messages").c_str());
+  }
+}
+
 void print_dataset(planarvo_dataset* ds, const std::string& dir) {
   planarvo_dataset_info info{};
   info.struct_size = sizeof info;
@@ -245,6 +262,7 @@ int cmd_info(int argc, char** argv) {
     return kExitOk;
   }
   args.expect_positionals(1, "DATASET, the data set folder or a bag");
+  if (is_bag_path(args.positionals()[0])) print_bag_topics(args.positionals()[0]);
   Progress progress(!args.has("quiet"));
   DatasetPtr ds = open_dataset(args.positionals()[0], args, args.has("verify"), &progress);
   progress.finish();

@@ -4,6 +4,7 @@
 // to 1e-9 (the figure of issue 10), whatever the chunk compression or the image encoding. And
 // what bad bags get: exit 2 naming what is wrong. Skipped, saying why, when a writer is missing
 // (scripts/install-deps.sh installs both).
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -208,6 +209,24 @@ TEST_F(BagDataset, McapFilesGiveTheFoldersMotions) {
 TEST_F(BagDataset, ReceiveTimesShiftTheOriginOnly) {
   SKIP_WITHOUT(rosbag_missing());
   expect_same_as_folder(write_rosbag("mono8_none.bag", "--compression none"), true);
+}
+
+// The topics as the writer wrote them, through planarvo_bag_topics (what `planarvo info` prints).
+TEST_F(BagDataset, TopicsAreListedWithTheirTypesAndCounts) {
+  SKIP_WITHOUT(rosbag_missing());
+  const fs::path bag = write_rosbag("mono8_none.bag", "--compression none");
+  size_t needed = 0;
+  ASSERT_EQ(planarvo_bag_topics(bag.c_str(), nullptr, 0, &needed), PLANARVO_OK) << planarvo_last_error();
+  std::string list(needed, '\0');
+  EXPECT_EQ(planarvo_bag_topics(bag.c_str(), list.data(), needed - 1, nullptr), PLANARVO_ERROR_INVALID_ARGUMENT);
+  ASSERT_EQ(planarvo_bag_topics(bag.c_str(), list.data(), list.size(), nullptr), PLANARVO_OK);
+  const std::string n = std::to_string(folder_.size());
+  for (const std::string& line : std::vector<std::string>{"/camera/image_raw\tsensor_msgs/Image\t" + n,
+                                  "/camera/camera_info\tsensor_msgs/CameraInfo\t" + n,
+                                  "/odom\tnav_msgs/Odometry\t", "/ground_truth\tnav_msgs/Odometry\t"})
+    EXPECT_THAT(list, HasSubstr(line));
+  EXPECT_EQ(std::count(list.begin(), list.end(), '\n'), 4);
+  EXPECT_EQ(planarvo_bag_topics(dataset_dir().c_str(), nullptr, 0, &needed), PLANARVO_ERROR_INVALID_INPUT);
 }
 
 // Recorded out of order: the bag rewritten by python3-rosbag with the receive times reversed (the

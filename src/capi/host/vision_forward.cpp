@@ -100,6 +100,11 @@ PLANARVO_API planarvo_status planarvo_dataset_open(const char* directory, const 
   return fn ? fn(directory, options, dataset) : PLANARVO_ERROR_INTERNAL;
 }
 
+PLANARVO_API planarvo_status planarvo_bag_topics(const char* path, char* buffer, size_t size, size_t* needed) {
+  PLANARVO_FORWARD(planarvo_bag_topics);
+  return fn ? fn(path, buffer, size, needed) : PLANARVO_ERROR_INTERNAL;
+}
+
 PLANARVO_API void planarvo_dataset_destroy(planarvo_dataset* dataset) {
   PLANARVO_FORWARD(planarvo_dataset_destroy);
   if (fn) fn(dataset);
