@@ -152,6 +152,85 @@ cv::Mat wrap_image(const bag::ImageMessage& m, const std::string& where, int& cv
                  const_cast<uint8_t*>(m.data.data()), m.step);
 }
 
+// The topics a data set reads: what was asked for, or the only candidate.
+struct Topics {
+  uint32_t image = 0;
+  std::optional<uint32_t> info, odom, gt;
+  std::vector<uint32_t> all() const {
+    std::vector<uint32_t> v{image};
+    for (const auto& t : {info, odom, gt})
+      if (t && std::find(v.begin(), v.end(), *t) == v.end()) v.push_back(*t);
+    return v;
+  }
+};
+
+Topics select_topics(const bag::BagFile& file, const BagDatasetOptions& o) {
+  Topics t;
+  const auto image_kinds = {MessageKind::Image, MessageKind::CompressedImage};
+  t.image = o.image_topic.empty() ? *only_topic(file, image_kinds, "the images (--image-topic)", true)
+                                  : find_topic(file, o.image_topic, image_kinds, "--image-topic");
+  if (!o.camera_info_topic.empty() && !o.camera_yaml.empty())
+    throw_invalid_input(file.path() + ": both a camera info topic and a camera.yaml were given; give one");
+  if (!o.camera_info_topic.empty())
+    t.info = find_topic(file, o.camera_info_topic, {MessageKind::CameraInfo}, "--camera-info-topic");
+  else if (o.camera_yaml.empty())
+    t.info = only_topic(file, {MessageKind::CameraInfo}, "the camera (--camera-info-topic, or --camera FILE)", true);
+  if (!o.odometry_topic.empty()) t.odom = find_topic(file, o.odometry_topic, {MessageKind::Odometry}, "--odom-topic");
+  if (!o.groundtruth_topic.empty())
+    t.gt = find_topic(file, o.groundtruth_topic, {MessageKind::Odometry}, "--groundtruth-topic");
+  return t;
+}
+
+// What one pass over the indexed messages gives: each image's time (header stamp or receive
+// time; only the header is decoded) and its index in refs, the odometry and ground-truth poses
+// with their times, and the camera info.
+struct Stamped {
+  int64_t ns;
+  size_t ref;
+};
+struct Scanned {
+  std::vector<Stamped> images;
+  std::vector<std::pair<int64_t, SE2>> odom, gt;
+  std::optional<bag::CameraInfoMessage> info;
+};
+
+std::string message_place(const bag::BagFile& file, const bag::MessageRef& m) {
+  return file.path() + ": " + file.topics()[m.topic].name + " message at receive time " +
+         std::to_string(m.receive_time_ns) + " ns";
+}
+
+Scanned read_stamps(bag::BagFile& file, const std::vector<bag::MessageRef>& refs, const Topics& topics,
+                    bool receive_time, std::vector<uint8_t>& buf,
+                    const std::function<void(double, const char*)>& report) {
+  const bag::Serialization ser = file.serialization();
+  Scanned s;
+  for (size_t r = 0; r < refs.size(); ++r) {
+    if (r % 64 == 0) report(0.8 + 0.2 * static_cast<double>(r) / static_cast<double>(refs.size()), "reading stamps");
+    const bag::MessageRef& m = refs[r];
+    file.read(m, buf);
+    try {
+      if (m.topic == topics.image)
+        s.images.push_back({receive_time ? m.receive_time_ns : bag::decode_header(ser, buf.data(), buf.size()).stamp_ns, r});
+      if (topics.info && m.topic == *topics.info) {
+        bag::CameraInfoMessage ci = bag::decode_camera_info(ser, buf.data(), buf.size());
+        if (!s.info)
+          s.info = std::move(ci);
+        else if (!same_camera(*s.info, ci))
+          throw_invalid_input("the camera info differs from the first one; planarvo uses one camera for a run");
+      }
+      for (auto [topic, out] : {std::pair{topics.odom, &s.odom}, std::pair{topics.gt, &s.gt}}) {
+        if (!topic || m.topic != *topic) continue;
+        const bag::OdometryMessage od = bag::decode_odometry(ser, buf.data(), buf.size());
+        out->emplace_back(receive_time ? m.receive_time_ns : od.header.stamp_ns, planar_pose(od));
+      }
+    } catch (const Error& e) {
+      if (e.code() != ErrorCode::InvalidInput) throw;
+      throw_invalid_input(message_place(file, m) + ": " + e.what());
+    }
+  }
+  return s;
+}
+
 }  // namespace
 
 struct BagSource::Impl {
@@ -168,98 +247,40 @@ BagSource::BagSource(const std::string& path, const BagDatasetOptions& o, bool v
   Impl& d = *impl_;
   d.file = bag::open_bag(path);
   bag::BagFile& file = *d.file;
-  const bag::Serialization ser = file.serialization();
-
-  // Topics: what was asked for, or the only candidate.
-  const auto image_kinds = {MessageKind::Image, MessageKind::CompressedImage};
-  d.image_topic = o.image_topic.empty() ? *only_topic(file, image_kinds, "the images (--image-topic)", true)
-                                        : find_topic(file, o.image_topic, image_kinds, "--image-topic");
-  d.compressed = bag::message_kind(file.topics()[d.image_topic].type) == MessageKind::CompressedImage;
-  if (!o.camera_info_topic.empty() && !o.camera_yaml.empty())
-    throw_invalid_input(path + ": both a camera info topic and a camera.yaml were given; give one");
-  std::optional<uint32_t> info_topic;
-  if (!o.camera_info_topic.empty())
-    info_topic = find_topic(file, o.camera_info_topic, {MessageKind::CameraInfo}, "--camera-info-topic");
-  else if (o.camera_yaml.empty())
-    info_topic = only_topic(file, {MessageKind::CameraInfo}, "the camera (--camera-info-topic, or --camera FILE)", true);
-  std::optional<uint32_t> odom_topic, gt_topic;
-  if (!o.odometry_topic.empty()) odom_topic = find_topic(file, o.odometry_topic, {MessageKind::Odometry}, "--odom-topic");
-  if (!o.groundtruth_topic.empty())
-    gt_topic = find_topic(file, o.groundtruth_topic, {MessageKind::Odometry}, "--groundtruth-topic");
-
-  std::vector<uint32_t> wanted{d.image_topic};
-  for (const auto& t : {info_topic, odom_topic, gt_topic})
-    if (t && std::find(wanted.begin(), wanted.end(), *t) == wanted.end()) wanted.push_back(*t);
-  const std::vector<bag::MessageRef> refs = file.index(wanted, [&](double f) {
+  const Topics topics = select_topics(file, o);
+  d.image_topic = topics.image;
+  d.compressed = bag::message_kind(file.topics()[topics.image].type) == MessageKind::CompressedImage;
+  const std::vector<bag::MessageRef> refs = file.index(topics.all(), [&](double f) {
     report(0.8 * f, "indexing the bag");
     return true;
   });
-
-  // One pass in file order: each message's time (header stamp or receive time), decoded
-  // headers only for images.
-  struct Stamped {
-    int64_t ns;
-    size_t ref;
-  };
-  std::vector<Stamped> images;
-  std::vector<std::pair<int64_t, SE2>> odom_raw, gt_raw;
-  std::optional<bag::CameraInfoMessage> info;
-  std::vector<uint8_t>& buf = d.buffer;
-  auto where = [&](size_t r) {
-    return path + ": " + file.topics()[refs[r].topic].name + " message at receive time " +
-           std::to_string(refs[r].receive_time_ns) + " ns";
-  };
-  for (size_t r = 0; r < refs.size(); ++r) {
-    if (r % 64 == 0) report(0.8 + 0.2 * static_cast<double>(r) / static_cast<double>(refs.size()), "reading stamps");
-    const bag::MessageRef& m = refs[r];
-    file.read(m, buf);
-    try {
-      if (m.topic == d.image_topic) {
-        const int64_t ns = o.use_receive_time ? m.receive_time_ns : bag::decode_header(ser, buf.data(), buf.size()).stamp_ns;
-        images.push_back({ns, r});
-      }
-      if (info_topic && m.topic == *info_topic) {
-        bag::CameraInfoMessage ci = bag::decode_camera_info(ser, buf.data(), buf.size());
-        if (!info)
-          info = std::move(ci);
-        else if (!same_camera(*info, ci))
-          throw_invalid_input("the camera info differs from the first one; planarvo uses one camera for a run");
-      }
-      for (auto [topic, out] : {std::pair{odom_topic, &odom_raw}, std::pair{gt_topic, &gt_raw}}) {
-        if (!topic || m.topic != *topic) continue;
-        const bag::OdometryMessage od = bag::decode_odometry(ser, buf.data(), buf.size());
-        out->emplace_back(o.use_receive_time ? m.receive_time_ns : od.header.stamp_ns, planar_pose(od));
-      }
-    } catch (const Error& e) {
-      if (e.code() != ErrorCode::InvalidInput) throw;
-      throw_invalid_input(where(r) + ": " + e.what());
-    }
-  }
-  if (images.empty())
-    throw_invalid_input(path + ": the image topic " + file.topics()[d.image_topic].name + " has no messages");
+  Scanned s = read_stamps(file, refs, topics, o.use_receive_time, d.buffer, report);
+  if (s.images.empty())
+    throw_invalid_input(path + ": the image topic " + file.topics()[topics.image].name + " has no messages");
 
   // Frames in time order; the same time twice is two frames that cannot both be right.
-  std::stable_sort(images.begin(), images.end(), [](const Stamped& a, const Stamped& b) { return a.ns < b.ns; });
-  for (size_t i = 1; i < images.size(); ++i)
-    if (images[i].ns == images[i - 1].ns)
-      throw_invalid_input(where(images[i].ref) + ": has the same " +
-                          (o.use_receive_time ? "receive time" : "header stamp") + " as " + where(images[i - 1].ref) +
-                          " (" + std::to_string(images[i].ns) + " ns)");
-  origin_ns_ = images.front().ns;
-  for (const Stamped& s : images) {
-    frames_.push_back({seconds_after(s.ns, origin_ns_), std::string(), 0});
-    d.frame_refs.push_back(refs[s.ref]);
+  std::stable_sort(s.images.begin(), s.images.end(), [](const Stamped& a, const Stamped& b) { return a.ns < b.ns; });
+  for (size_t i = 1; i < s.images.size(); ++i)
+    if (s.images[i].ns == s.images[i - 1].ns)
+      throw_invalid_input(message_place(file, refs[s.images[i].ref]) + ": has the same " +
+                          (o.use_receive_time ? "receive time" : "header stamp") + " as " +
+                          message_place(file, refs[s.images[i - 1].ref]) + " (" + std::to_string(s.images[i].ns) +
+                          " ns)");
+  origin_ns_ = s.images.front().ns;
+  for (const Stamped& st : s.images) {
+    frames_.push_back({seconds_after(st.ns, origin_ns_), std::string(), 0});
+    d.frame_refs.push_back(refs[st.ref]);
   }
-  for (auto [raw, out] : {std::pair{&odom_raw, &odometry_}, std::pair{&gt_raw, &groundtruth_}}) {
+  for (auto [raw, out] : {std::pair{&s.odom, &odometry_}, std::pair{&s.gt, &groundtruth_}}) {
     std::stable_sort(raw->begin(), raw->end(), [](const auto& a, const auto& b) { return a.first < b.first; });
     for (const auto& [ns, pose] : *raw) out->push_back({seconds_after(ns, origin_ns_), pose});
   }
-  for (auto [topic, out] : {std::pair{odom_topic, &odometry_}, std::pair{gt_topic, &groundtruth_}})
+  for (auto [topic, out] : {std::pair{topics.odom, &odometry_}, std::pair{topics.gt, &groundtruth_}})
     if (topic && out->empty()) throw_invalid_input(path + ": the topic " + file.topics()[*topic].name + " has no messages");
 
-  if (info) {
-    camera_source_ = "the camera info on " + file.topics()[*info_topic].name;
-    camera_ = camera_from_info(*info, path + ": " + camera_source_);
+  if (s.info) {
+    camera_source_ = "the camera info on " + file.topics()[*topics.info].name;
+    camera_ = camera_from_info(*s.info, path + ": " + camera_source_);
   } else {
     camera_source_ = o.camera_yaml;
     camera_ = read_camera_yaml(o.camera_yaml);
