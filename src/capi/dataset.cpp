@@ -1,6 +1,7 @@
 // C API: data sets (src/io/dataset.h).
 #include <cstring>
 #include <memory>
+#include <optional>
 #include <string>
 #include <utility>
 
@@ -63,7 +64,8 @@ PLANARVO_API planarvo_status planarvo_bag_topics(const char* path, char* buffer,
   return guard([&] {
     require(path != nullptr && *path, "planarvo_bag_topics: path is NULL or empty");
     require(buffer != nullptr || size == 0, "planarvo_bag_topics: buffer is NULL with a size");
-    const std::unique_ptr<planarvo::io::bag::BagFile> bag = planarvo::io::bag::open_bag(path);
+    const std::optional<std::string> file = planarvo::io::bag_file_for(path);
+    const std::unique_ptr<planarvo::io::bag::BagFile> bag = planarvo::io::bag::open_bag(file ? *file : path);
     std::string list;
     for (const planarvo::io::bag::TopicInfo& t : bag->topics())
       list += t.name + "\t" + t.type + "\t" + std::to_string(t.count) + "\n";

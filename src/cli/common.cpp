@@ -98,7 +98,9 @@ std::vector<OptionSpec> bag_options() {
 
 bool is_bag_path(const std::string& path) {
   std::error_code ec;
-  return std::filesystem::is_regular_file(path, ec);
+  return std::filesystem::is_regular_file(path, ec) ||
+         (std::filesystem::is_directory(path, ec) && std::filesystem::exists(std::filesystem::path(path) / "metadata.yaml", ec) &&
+          !std::filesystem::exists(std::filesystem::path(path) / "frames.txt", ec));
 }
 
 DatasetPtr open_dataset(const std::string& path, const Args& args, bool verify, Progress* progress,

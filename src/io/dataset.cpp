@@ -261,8 +261,8 @@ Dataset::Dataset(const std::string& directory, DatasetOptions options) : impl_(s
   d.dir = fs::path(directory);
   std::error_code ec;
   if (!fs::exists(d.dir, ec)) throw_invalid_input(directory + ": the data set directory does not exist");
-  if (fs::is_regular_file(d.dir, ec) && bag::looks_like_bag(directory)) {
-    open_bag(options);
+  if (const std::optional<std::string> bag_file = bag_file_for(directory)) {
+    open_bag(*bag_file, options);
     return;
   }
   if (!fs::is_directory(d.dir, ec))
@@ -331,10 +331,10 @@ Dataset::Dataset(const std::string& directory, DatasetOptions options) : impl_(s
   progress.report(1.0, "done");
 }
 
-void Dataset::open_bag(const DatasetOptions& options) {
+void Dataset::open_bag(const std::string& file, const DatasetOptions& options) {
   Impl& d = *impl_;
   const Progress progress(options.progress);
-  d.bag = std::make_unique<BagSource>(d.directory, options.bag, options.verify_images,
+  d.bag = std::make_unique<BagSource>(file, options.bag, options.verify_images,
                                       [&](double f, const char* stage) { progress.report(f, stage); });
   d.camera = d.bag->camera();
   d.frames = d.bag->frames();

@@ -51,7 +51,8 @@ std::optional<int> direction_at(const std::vector<DirectionLabel>& labels, doubl
 class Dataset {
  public:
   // Opens and validates the data set in `directory`, or the ROS 1 bag or MCAP file at that path
-  // (recognised by its first bytes). Throws Error(InvalidInput) naming the file for anything
+  // (recognised by its first bytes), or the MCAP file of the ROS 2 bag directory at that path
+  // (bag_file_for). Throws Error(InvalidInput) naming the file for anything
   // missing or malformed, Error(Cancelled) when the progress callback says so.
   explicit Dataset(const std::string& directory, DatasetOptions options = {});
   ~Dataset();
@@ -108,7 +109,7 @@ class Dataset {
  private:
   struct Impl;
   void check_index(int64_t i, const char* what) const;
-  void open_bag(const DatasetOptions& options);
+  void open_bag(const std::string& file, const DatasetOptions& options);
   std::unique_ptr<Impl> impl_;
 };
 

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <optional>
 #include <utility>
 
@@ -232,6 +233,38 @@ Scanned read_stamps(bag::BagFile& file, const std::vector<bag::MessageRef>& refs
 }
 
 }  // namespace
+
+}  // namespace planarvo::io::detail
+
+namespace planarvo::io {
+
+std::optional<std::string> bag_file_for(const std::string& path) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (fs::is_regular_file(path, ec))
+    return bag::looks_like_bag(path) ? std::optional<std::string>(path) : std::nullopt;
+  if (!fs::is_directory(path, ec) || !fs::exists(fs::path(path) / "metadata.yaml", ec)) return std::nullopt;
+  std::vector<std::string> mcap, db3;
+  for (const auto& entry : fs::directory_iterator(path, ec)) {
+    const std::string ext = entry.path().extension().string();
+    if (ext == ".mcap") mcap.push_back(entry.path().string());
+    if (ext == ".db3") db3.push_back(entry.path().string());
+  }
+  std::sort(mcap.begin(), mcap.end());
+  if (mcap.size() == 1) return mcap.front();
+  if (mcap.size() > 1)
+    throw_invalid_input(path + ": a ROS 2 bag split into " + std::to_string(mcap.size()) + " MCAP files (" +
+                        mcap.front() + ", ...); planarvo reads one file: join them with `ros2 bag convert` "
+                        "(max_bagfile_size 0), or give one of the files");
+  if (!db3.empty())
+    throw_invalid_input(path + ": a ROS 2 bag stored in SQLite (" + db3.front() + "); planarvo reads MCAP: convert it "
+                        "with `ros2 bag convert` to the mcap storage");
+  throw_invalid_input(path + ": has a ROS 2 bag's metadata.yaml but no .mcap file");
+}
+
+}  // namespace planarvo::io
+
+namespace planarvo::io::detail {
 
 struct BagSource::Impl {
   std::unique_ptr<bag::BagFile> file;

@@ -11,6 +11,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -29,6 +30,12 @@ struct BagDatasetOptions {
   std::string groundtruth_topic;  // empty: none
   bool use_receive_time = false;  // time by the recorder's receive time, not header stamps
 };
+
+// The file to read for `path`: path itself when it is a ROS 1 bag or an MCAP file; the MCAP file
+// inside it when it is a ROS 2 bag directory (`ros2 bag record` writes metadata.yaml and
+// NAME_0.mcap); none otherwise. A ROS 2 bag directory split into several files, or stored in
+// SQLite (.db3), is InvalidInput saying how to convert it.
+std::optional<std::string> bag_file_for(const std::string& path);
 
 namespace detail {
 

@@ -206,6 +206,31 @@ TEST_F(BagDataset, McapFilesGiveTheFoldersMotions) {
   }
 }
 
+// What `ros2 bag record -s mcap` writes: a directory with metadata.yaml and NAME_0.mcap. The
+// directory opens as its MCAP file; split into two files, or in SQLite, it says how to convert.
+TEST_F(BagDataset, ARos2BagDirectoryIsReadThroughItsMcapFile) {
+  SKIP_WITHOUT(mcap_missing());
+  const fs::path dir = scratch() / "ros2_bag";
+  fs::create_directories(dir);
+  std::ofstream(dir / "metadata.yaml") << "rosbag2_bagfile_information:\n  version: 5\n  storage_identifier: mcap\n";
+  fs::copy_file(write_mcap("zstd.mcap", "--compression zstd"), dir / "ros2_bag_0.mcap",
+                fs::copy_options::overwrite_existing);
+  expect_same_as_folder(dir);
+  const std::string extr = " --extrinsics " + (dataset_dir() / "extrinsics_gt.yaml").string();
+  EXPECT_EQ(run_cli("track --quiet " + dir.string() + extr + " --odom-topic /odom").exit_code, 0);
+
+  fs::copy_file(dir / "ros2_bag_0.mcap", dir / "ros2_bag_1.mcap");
+  const auto split = run_cli("track --quiet " + dir.string() + extr);
+  EXPECT_EQ(split.exit_code, 2);
+  EXPECT_THAT(split.output, HasSubstr("ros2 bag convert"));
+  fs::remove(dir / "ros2_bag_0.mcap");
+  fs::remove(dir / "ros2_bag_1.mcap");
+  std::ofstream(dir / "ros2_bag_0.db3") << "SQLite format 3";
+  const auto sqlite = run_cli("track --quiet " + dir.string() + extr);
+  EXPECT_EQ(sqlite.exit_code, 2);
+  EXPECT_THAT(sqlite.output, HasSubstr("mcap"));
+}
+
 TEST_F(BagDataset, ReceiveTimesShiftTheOriginOnly) {
   SKIP_WITHOUT(rosbag_missing());
   expect_same_as_folder(write_rosbag("mono8_none.bag", "--compression none"), true);
