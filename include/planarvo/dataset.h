@@ -14,7 +14,8 @@
 
 /* A data set directory (camera.yaml, frames.txt + images/, or a video; optional odometry.txt,
  * direction.txt, groundtruth.txt, extrinsics.yaml, extrinsics_gt.yaml), or a recorded log: a ROS 1
- * bag (format 2.0) or a ROS 2 MCAP file, recognised by its first bytes, whatever its name. Read and
+ * bag (format 2.0) or a ROS 2 MCAP file, recognised by its first bytes, whatever its name, or the
+ * directory `ros2 bag record` writes (metadata.yaml and one .mcap file). Read and
  * validated on open; images are decoded on demand by planarvo_dataset_frame. A bag's frames are
  * the messages of one image topic; its camera comes from a CameraInfo topic or a camera.yaml; its
  * odometry and ground truth from nav_msgs/Odometry topics (docs/formats.md, "ROS bags"). Times
