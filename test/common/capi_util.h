@@ -51,14 +51,19 @@ struct TrackedFrame {
   planarvo_track_result result;
 };
 
-// Every frame of the data set in dir tracked with the tracker's default options and the given
-// extrinsics.
-inline std::vector<TrackedFrame> track_through_api(const std::string& dir, const planarvo_extrinsics& extrinsics) {
+// Every frame of the data set at path (a folder, or a bag with options) tracked with the
+// tracker's default options and the given extrinsics; the data set's info in *info when asked.
+inline std::vector<TrackedFrame> track_through_api(const std::string& path, const planarvo_extrinsics& extrinsics,
+                                                   const planarvo_dataset_options* options = nullptr,
+                                                   planarvo_dataset_info* info_out = nullptr) {
   ApiContext context = api_context();
-  ApiDataset dataset = api_dataset(dir);
+  planarvo_dataset* d = nullptr;
+  EXPECT_EQ(planarvo_dataset_open(path.c_str(), options, &d), PLANARVO_OK) << planarvo_last_error();
+  ApiDataset dataset(d);
   std::vector<TrackedFrame> frames;
   if (!context || !dataset) return frames;
   const planarvo_dataset_info info = api_info(dataset.get());
+  if (info_out) *info_out = info;
   planarvo_tracker* t = nullptr;
   EXPECT_EQ(planarvo_tracker_create(context.get(), &info.camera, &extrinsics, nullptr, &t), PLANARVO_OK)
       << planarvo_last_error();

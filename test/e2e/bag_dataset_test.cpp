@@ -101,29 +101,7 @@ class BagDataset : public ::testing::Test {
   // Every frame tracked through the C API with the true extrinsics; options NULL for a folder.
   static std::vector<TrackedFrame> track(const std::string& path, const planarvo_dataset_options* options,
                                          planarvo_dataset_info* info_out = nullptr) {
-    std::vector<TrackedFrame> frames;
-    test::ApiContext context = test::api_context();
-    planarvo_dataset* d = nullptr;
-    EXPECT_EQ(planarvo_dataset_open(path.c_str(), options, &d), PLANARVO_OK) << planarvo_last_error();
-    test::ApiDataset dataset(d);
-    if (!context || !dataset) return frames;
-    const planarvo_dataset_info info = test::api_info(dataset.get());
-    if (info_out) *info_out = info;
-    planarvo_tracker* t = nullptr;
-    EXPECT_EQ(planarvo_tracker_create(context.get(), &info.camera, &extrinsics_, nullptr, &t), PLANARVO_OK)
-        << planarvo_last_error();
-    test::ApiTracker tracker(t);
-    for (int64_t i = 0; tracker && i < info.frame_count; ++i) {
-      TrackedFrame f{};
-      EXPECT_EQ(planarvo_dataset_frame_data(dataset.get(), i, &f.data), PLANARVO_OK) << planarvo_last_error();
-      planarvo_image image{};
-      EXPECT_EQ(planarvo_dataset_frame(dataset.get(), i, &image), PLANARVO_OK) << planarvo_last_error();
-      f.result.struct_size = sizeof f.result;
-      EXPECT_EQ(planarvo_tracker_track(tracker.get(), &image, f.data.timestamp, &f.result), PLANARVO_OK)
-          << planarvo_last_error();
-      frames.push_back(f);
-    }
-    return frames;
+    return test::track_through_api(path, extrinsics_, options, info_out);
   }
 
   static planarvo_dataset_options bag_options(bool receive_time = false) {
