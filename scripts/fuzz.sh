@@ -11,7 +11,8 @@
 #   -b DIR       build directory (default build-fuzz)
 #   --no-build   use the targets already built
 #   --report     run nothing: print the table of the last runs in BUILD_DIR/fuzz-runs
-#   TARGET       camera_yaml extrinsics_yaml frames tum direction motion_pairs g2o capi (default all)
+#   TARGET       camera_yaml extrinsics_yaml frames tum direction motion_pairs g2o capi mcap rosbag1
+#                (default all)
 #
 # Each run's log, working corpus and artifacts are in BUILD_DIR/fuzz-runs/TARGET/. Needs only
 # Debian packages: clang, libclang-rt-dev (libFuzzer), cmake, ninja-build, and the library's own
