@@ -86,6 +86,22 @@ void apply_roi(const std::optional<planarvo_region>& roi, planarvo_dataset* data
   if (roi) check(planarvo_dataset_set_roi(dataset, &*roi));
 }
 
+namespace {
+
+// Opens path with the source options in o and the ones every data set takes.
+DatasetPtr open_with(const std::string& path, planarvo_dataset_options* o, bool verify, Progress* progress,
+                     bool allow_missing) {
+  o->verify_images = verify ? 1 : 0;
+  o->allow_missing_images = allow_missing ? 1 : 0;
+  o->progress = &Progress::callback;
+  o->progress_user_data = progress;
+  planarvo_dataset* d = nullptr;
+  check(planarvo_dataset_open(path.c_str(), o, &d));
+  return DatasetPtr(d);
+}
+
+}  // namespace
+
 std::vector<OptionSpec> bag_options() {
   return {{"image-topic", "TOPIC", "bag: the images (sensor_msgs/Image or CompressedImage)", "the bag's only image topic"},
           {"camera-info-topic", "TOPIC", "bag: the camera (sensor_msgs/CameraInfo, plumb_bob)",
@@ -96,11 +112,11 @@ std::vector<OptionSpec> bag_options() {
           {"receive-time", "", "bag: time messages by when they were recorded, not by their header stamps", ""}};
 }
 
+// The library's rule (io::bag_file_for): a file, or a directory with a ROS 2 bag's metadata.yaml.
 bool is_bag_path(const std::string& path) {
+  namespace fs = std::filesystem;
   std::error_code ec;
-  return std::filesystem::is_regular_file(path, ec) ||
-         (std::filesystem::is_directory(path, ec) && std::filesystem::exists(std::filesystem::path(path) / "metadata.yaml", ec) &&
-          !std::filesystem::exists(std::filesystem::path(path) / "frames.txt", ec));
+  return fs::is_regular_file(path, ec) || (fs::is_directory(path, ec) && fs::exists(fs::path(path) / "metadata.yaml", ec));
 }
 
 DatasetPtr open_dataset(const std::string& path, const Args& args, bool verify, Progress* progress,
@@ -123,12 +139,7 @@ DatasetPtr open_dataset(const std::string& path, const Args& args, bool verify, 
   o.odometry_topic = odom.empty() ? nullptr : odom.c_str();
   o.groundtruth_topic = gt.empty() ? nullptr : gt.c_str();
   o.use_receive_time = args.has("receive-time") ? 1 : 0;
-  o.verify_images = verify ? 1 : 0;
-  o.progress = &Progress::callback;
-  o.progress_user_data = progress;
-  planarvo_dataset* d = nullptr;
-  check(planarvo_dataset_open(path.c_str(), &o, &d));
-  return DatasetPtr(d);
+  return open_with(path, &o, verify, progress, allow_missing);
 }
 
 DatasetPtr open_dataset(const std::string& dir, const std::string& video, bool verify, Progress* progress,
@@ -136,13 +147,7 @@ DatasetPtr open_dataset(const std::string& dir, const std::string& video, bool v
   planarvo_dataset_options o;
   planarvo_dataset_options_init(&o);
   if (!video.empty()) o.video = video.c_str();
-  o.verify_images = verify ? 1 : 0;
-  o.allow_missing_images = allow_missing ? 1 : 0;
-  o.progress = &Progress::callback;
-  o.progress_user_data = progress;
-  planarvo_dataset* d = nullptr;
-  check(planarvo_dataset_open(dir.c_str(), &o, &d));
-  return DatasetPtr(d);
+  return open_with(dir, &o, verify, progress, allow_missing);
 }
 
 planarvo_se2 relative(const planarvo_se2& a, const planarvo_se2& b) {

@@ -14,6 +14,7 @@
 #include <cmath>
 #include <deque>
 #include <filesystem>
+#include <tuple>
 #include <utility>
 
 #include <opencv2/imgcodecs.hpp>
@@ -232,6 +233,17 @@ struct Dataset::Impl {
 
 namespace {
 
+// Samples (poses or labels, in time order) that apply to no frame are almost always a clock or
+// unit mismatch: InvalidInput "<what> [first, last] apply to no frame; <hint>".
+template <typename T, typename Applies>
+void require_some_frame(const std::vector<T>& samples, Applies applies, int64_t frame_count, const std::string& what,
+                        const char* hint) {
+  for (int64_t i = 0; i < frame_count; ++i)
+    if (applies(i)) return;
+  throw_invalid_input(what + " [" + detail::format_exact(samples.front().t) + ", " +
+                      detail::format_exact(samples.back().t) + "] apply to no frame; " + hint);
+}
+
 // Optional trajectory/label files: absent is fine; present must be valid, non-empty and must
 // apply to at least one frame (a file that applies to none is almost always a clock or unit
 // mismatch, e.g. milliseconds against seconds).
@@ -242,12 +254,8 @@ bool read_optional(const fs::path& file, std::vector<T>& out, Reader reader, App
   if (!fs::exists(file, ec)) return false;
   out = reader(file.string());
   if (out.empty()) throw_invalid_input(file.string() + ": has no " + what + " (only comments or blank lines)");
-  bool any = false;
-  for (int64_t i = 0; i < frame_count && !any; ++i) any = applies(i);
-  if (!any)
-    throw_invalid_input(file.string() + ": its times [" + detail::format_exact(out.front().t) +
-                        ", " + detail::format_exact(out.back().t) +
-                        "] apply to no frame; are they on the frames' clock, in seconds?");
+  require_some_frame(out, applies, frame_count, file.string() + ": its times",
+                     "are they on the frames' clock, in seconds?");
   return true;
 }
 
@@ -341,18 +349,14 @@ void Dataset::open_bag(const std::string& file, const DatasetOptions& options) {
   d.odometry = d.bag->odometry();
   d.groundtruth = d.bag->groundtruth();
   const int64_t n = static_cast<int64_t>(d.frames.size());
-  const char* topics[] = {"--odom-topic", "--groundtruth-topic"};
-  int which = 0;
-  for (auto [samples, has] : {std::pair{&d.odometry, &d.has_odometry}, std::pair{&d.groundtruth, &d.has_groundtruth}}) {
-    const char* option = topics[which++];
+  for (auto [samples, has, option] : {std::tuple{&d.odometry, &d.has_odometry, "--odom-topic"},
+                                      std::tuple{&d.groundtruth, &d.has_groundtruth, "--groundtruth-topic"}}) {
     *has = !samples->empty();
     if (!*has) continue;
-    bool any = false;
-    for (int64_t i = 0; i < n && !any; ++i) any = interpolate_pose(*samples, d.frames[static_cast<size_t>(i)].t).has_value();
-    if (!any)
-      throw_invalid_input(d.directory + ": the " + option + " messages' times [" +
-                          detail::format_exact(samples->front().t) + ", " + detail::format_exact(samples->back().t) +
-                          "] s after the first frame apply to no frame; are both stamped on the same clock?");
+    require_some_frame(
+        *samples, [&](int64_t i) { return interpolate_pose(*samples, d.frames[static_cast<size_t>(i)].t).has_value(); },
+        n, d.directory + ": the " + option + " messages' times (s after the first frame)",
+        "are both stamped on the same clock?");
   }
   progress.report(1.0, "done");
 }
