@@ -14,7 +14,7 @@ from ._errors import Error, Status, _check
 from ._handle import _Handle
 from ._native import lib
 from ._se2 import SE2
-from ._util import PathLike, ProgressFn, _Callback, _path
+from ._util import PathLike, ProgressFn, _Callback, _opt, _path
 
 
 @dataclass
@@ -80,7 +80,7 @@ class Dataset(_Handle):
                             ("odometry_topic", odometry_topic), ("groundtruth_topic", groundtruth_topic)):
             if value is not None and not isinstance(value, str):
                 raise ValueError(f"{name} must be a str, not {type(value).__name__}")
-            setattr(o, name, None if value is None else value.encode())
+            setattr(o, name, _opt(value))
         o.camera_yaml = None if camera_yaml is None else _path(camera_yaml)
         o.use_receive_time = int(bool(use_receive_time))
         cb = _Callback(progress, N.PROGRESS_FN)
