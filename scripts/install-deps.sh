@@ -13,6 +13,8 @@ packages=(
   libzstd-dev liblz4-dev libbz2-dev
   libgtest-dev libgmock-dev
   python3 python3-numpy python3-pytest
+  # planarvo plot (python/planarvo/plot): the figures and the calibration report.
+  python3-matplotlib
   # ROS 1 bag tests: the official writer (brings python3-roslz4) and the message modules
   # (python3-sensor-msgs brings python3-geometry-msgs and python3-std-msgs).
   python3-rosbag python3-sensor-msgs python3-nav-msgs
