@@ -109,6 +109,14 @@ PLANARVO_API planarvo_status planarvo_dataset_frame(planarvo_dataset* dataset, i
  * with its NUL; PLANARVO_ERROR_INVALID_ARGUMENT, writing nothing, when size is less. */
 PLANARVO_API planarvo_status planarvo_bag_topics(const char* path, char* buffer, size_t size, size_t* needed);
 
+/* Reads a TUM trajectory (t x y z qx qy qz qw per line, '#' comments; planar poses only: z, qx
+ * and qy zero to 1e-6, else PLANARVO_ERROR_INVALID_INPUT naming the line), times increasing.
+ * Writes at most capacity entries; *count receives the number in the file (call with capacity 0
+ * and NULL arrays to ask); PLANARVO_ERROR_INVALID_ARGUMENT, writing nothing, when capacity is
+ * less but not 0. */
+PLANARVO_API planarvo_status planarvo_read_tum(const char* path, double* timestamps, planarvo_se2* poses,
+                                               size_t capacity, size_t* count);
+
 /* Writes a TUM trajectory (t x y z qx qy qz qw, z = 0, rotation about z). */
 PLANARVO_API planarvo_status planarvo_write_tum(const char* path, const double* timestamps,
                                                 const planarvo_se2* poses, size_t count);

@@ -700,6 +700,11 @@ PLANARVO_API planarvo_status planarvo_compose_extrinsics(double roll, double pit
                                                          planarvo_extrinsics* extrinsics, double* covariance,
                                                          int32_t* estimated);
 
+/* The floor mosaic: planarvo/mosaic.h (part of this header). */
+#define PLANARVO_INSIDE_PLANARVO_H
+#include "mosaic.h" /* include/planarvo/mosaic.h */
+#undef PLANARVO_INSIDE_PLANARVO_H
+
 #ifdef __cplusplus
 }
 #endif

@@ -82,6 +82,24 @@ PLANARVO_API planarvo_status planarvo_extrinsics_matrix(const planarvo_extrinsic
   });
 }
 
+PLANARVO_API planarvo_status planarvo_read_tum(const char* path, double* timestamps, planarvo_se2* poses,
+                                               size_t capacity, size_t* count) {
+  return guard([&] {
+    require_path(path, "planarvo_read_tum");
+    require(capacity == 0 || (timestamps != nullptr && poses != nullptr), "planarvo_read_tum: NULL arrays");
+    const std::vector<planarvo::io::StampedPose> v = planarvo::io::read_tum(path);
+    if (count) *count = v.size();
+    if (capacity == 0) return;
+    if (capacity < v.size())
+      planarvo::throw_invalid_argument("planarvo_read_tum: " + std::string(path) + " has " + std::to_string(v.size()) +
+                                       " poses, the arrays hold " + std::to_string(capacity));
+    for (size_t i = 0; i < v.size(); ++i) {
+      timestamps[i] = v[i].t;
+      poses[i] = planarvo::capi::to_c(v[i].pose);
+    }
+  });
+}
+
 PLANARVO_API planarvo_status planarvo_write_tum(const char* path, const double* timestamps,
                                                 const planarvo_se2* poses, size_t count) {
   return guard([&] {

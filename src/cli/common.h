@@ -128,6 +128,7 @@ int cmd_simulate(int argc, char** argv);
 int cmd_info(int argc, char** argv);
 int cmd_demo(int argc, char** argv);
 int cmd_track(int argc, char** argv);
+int cmd_mosaic(int argc, char** argv);
 int cmd_posegraph(int argc, char** argv);
 int cmd_calibrate(int argc, char** argv);
 // calibrate DATASET (cmd_calibrate.cpp), with the graph options cmd_calibrate parsed.

@@ -77,6 +77,7 @@ inline constexpr const char* kPreludeName = "common";
 inline constexpr const char* kUseTrack = "track";          // the tracker: planarvo_tracker_*
 inline constexpr const char* kUseCalibrate = "calibrate";  // roll and pitch, then the tracker
 inline constexpr const char* kUseSimulate = "simulate";    // the simulator's renderer
+inline constexpr const char* kUseMosaic = "mosaic";        // the floor mosaic: planarvo_mosaic_*
 
 // Every platform's devices, in the order `planarvo devices` lists them. Never throws for a
 // machine without OpenCL: returns an empty list. A platform or device that cannot be queried

@@ -265,4 +265,40 @@ PLANARVO_API planarvo_status planarvo_compose_extrinsics(double roll, double pit
   return fn ? fn(roll, pitch, roll_pitch_covariance, graph, extrinsics, covariance, estimated) : PLANARVO_ERROR_INTERNAL;
 }
 
+PLANARVO_API planarvo_status planarvo_read_tum(const char* path, double* timestamps, planarvo_se2* poses, size_t capacity, size_t* count) {
+  PLANARVO_FORWARD(planarvo_read_tum);
+  return fn ? fn(path, timestamps, poses, capacity, count) : PLANARVO_ERROR_INTERNAL;
+}
+
+PLANARVO_API void planarvo_mosaic_options_init(planarvo_mosaic_options* options) {
+  PLANARVO_FORWARD(planarvo_mosaic_options_init);
+  if (fn) fn(options);
+}
+
+PLANARVO_API planarvo_status planarvo_mosaic_build(planarvo_context* context, planarvo_dataset* dataset, const planarvo_extrinsics* extrinsics, const double* timestamps, const planarvo_se2* poses, size_t count, const planarvo_mosaic_options* options, planarvo_mosaic** mosaic) {
+  PLANARVO_FORWARD(planarvo_mosaic_build);
+  return fn ? fn(context, dataset, extrinsics, timestamps, poses, count, options, mosaic) : PLANARVO_ERROR_INTERNAL;
+}
+
+PLANARVO_API void planarvo_mosaic_destroy(planarvo_mosaic* mosaic) {
+  if (!mosaic) return;
+  PLANARVO_FORWARD(planarvo_mosaic_destroy);
+  if (fn) fn(mosaic);
+}
+
+PLANARVO_API planarvo_status planarvo_mosaic_info_get(const planarvo_mosaic* mosaic, planarvo_mosaic_info* info) {
+  PLANARVO_FORWARD(planarvo_mosaic_info_get);
+  return fn ? fn(mosaic, info) : PLANARVO_ERROR_INTERNAL;
+}
+
+PLANARVO_API planarvo_status planarvo_mosaic_image(const planarvo_mosaic* mosaic, planarvo_image* image) {
+  PLANARVO_FORWARD(planarvo_mosaic_image);
+  return fn ? fn(mosaic, image) : PLANARVO_ERROR_INTERNAL;
+}
+
+PLANARVO_API planarvo_status planarvo_mosaic_save(const planarvo_mosaic* mosaic, const char* image_path) {
+  PLANARVO_FORWARD(planarvo_mosaic_save);
+  return fn ? fn(mosaic, image_path) : PLANARVO_ERROR_INTERNAL;
+}
+
 }  // extern "C"

@@ -1,0 +1,424 @@
+// The floor mosaic's builder: frame selection, the grid, tiles, gains, blending (mosaic.h).
+#include "mosaic/mosaic.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <locale>
+#include <sstream>
+#include <limits>
+#include <memory>
+
+#include <Eigen/Dense>
+#include <opencv2/imgcodecs.hpp>
+
+#include "core/error.h"
+
+namespace planarvo::mosaic {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+constexpr double kTurnForNewFrame = 5.0 * M_PI / 180.0;
+
+// v with `decimals` digits after the point (decimals < 0: the shortest general form, 3 digits).
+std::string num(double v, int decimals) {
+  std::ostringstream s;
+  s.imbue(std::locale::classic());
+  if (decimals >= 0) s << std::fixed << std::setprecision(decimals) << v;
+  else s << std::setprecision(3) << v;
+  return s.str();
+}
+
+// The ground the camera sees, in the robot frame: points on the boundary of the region of
+// interest's ground footprint, clipped to the range limit, and the points of the range circle
+// that the camera sees. Their bounding box bounds every pixel the warp can give weight to.
+std::vector<Eigen::Vector2d> footprint(const WarpSetup& s) {
+  const CameraModel& cam = s.camera;
+  const Eigen::Matrix3d R = s.extrinsics.R_vc();
+  const Eigen::Vector3d t = s.extrinsics.t_vc();
+  const Eigen::Vector2d foot = t.head<2>();
+  std::vector<Eigen::Vector2d> pts;
+  const PixelRegion r = cam.region();
+  const auto add_pixel = [&](double u, double v) {
+    const Eigen::Vector2d n = cam.unproject({u, v});
+    const Eigen::Vector3d d = R * Eigen::Vector3d(n.x(), n.y(), 1.0);
+    Eigen::Vector2d dir = d.head<2>();
+    if (dir.norm() < 1e-12) dir = Eigen::Vector2d(1, 0);
+    if (d.z() < 0) {
+      const Eigen::Vector2d p = (t + (-t.z() / d.z()) * d).head<2>();
+      if ((p - foot).norm() <= s.max_range) {
+        pts.push_back(p);
+        return;
+      }
+    }
+    pts.push_back(foot + s.max_range * dir.normalized());
+  };
+  const int step = 4;
+  for (int x = r.x; x < r.x + r.width; x += step) {
+    add_pixel(x, r.y);
+    add_pixel(x, r.y + r.height - 1);
+  }
+  for (int y = r.y; y < r.y + r.height; y += step) {
+    add_pixel(r.x, y);
+    add_pixel(r.x + r.width - 1, y);
+  }
+  add_pixel(r.x + r.width - 1, r.y + r.height - 1);
+  // The range circle where the camera sees it.
+  const Eigen::Matrix3d R_cv = R.transpose();
+  for (int k = 0; k < 360; ++k) {
+    const double a = 2.0 * M_PI * k / 360.0;
+    const Eigen::Vector2d g = foot + s.max_range * Eigen::Vector2d(std::cos(a), std::sin(a));
+    const Eigen::Vector3d pc = R_cv * (Eigen::Vector3d(g.x(), g.y(), 0.0) - t);
+    if (pc.z() <= 0) continue;
+    const Eigen::Vector2d n(pc.x() / pc.z(), pc.y() / pc.z());
+    if (n.squaredNorm() > s.max_radius2) continue;
+    const Eigen::Vector2d px = cam.project(pc);
+    if (px.x() >= r.x && px.y() >= r.y && px.x() <= r.x + r.width - 1 && px.y() <= r.y + r.height - 1) pts.push_back(g);
+  }
+  return pts;
+}
+
+struct Box {
+  double x0 = std::numeric_limits<double>::infinity(), y0 = x0;
+  double x1 = -std::numeric_limits<double>::infinity(), y1 = x1;
+  void add(const Eigen::Vector2d& p) {
+    x0 = std::min(x0, p.x());
+    y0 = std::min(y0, p.y());
+    x1 = std::max(x1, p.x());
+    y1 = std::max(y1, p.y());
+  }
+  void add(const Box& b) {
+    x0 = std::min(x0, b.x0);
+    y0 = std::min(y0, b.y0);
+    x1 = std::max(x1, b.x1);
+    y1 = std::max(y1, b.y1);
+  }
+};
+
+Box frame_box(const std::vector<Eigen::Vector2d>& fp, const SE2& pose) {
+  Box b;
+  for (const Eigen::Vector2d& p : fp) b.add(pose * p);
+  return b;
+}
+
+// The frames to use: the first, then each whose camera foot point has moved `spacing` or whose
+// heading has turned kTurnForNewFrame since the last one used, and the last.
+std::vector<size_t> select_frames(const std::vector<PosedFrame>& frames, const Eigen::Vector2d& foot, double spacing) {
+  std::vector<size_t> used;
+  for (size_t i = 0; i < frames.size(); ++i) {
+    if (used.empty() || spacing < 0 || i + 1 == frames.size()) {
+      used.push_back(i);
+      continue;
+    }
+    const SE2& a = frames[used.back()].pose;
+    const SE2& b = frames[i].pose;
+    const double moved = ((b * foot) - (a * foot)).norm();
+    const double turned = std::abs(std::remainder(b.theta - a.theta, 2.0 * M_PI));
+    if (moved >= spacing || turned >= kTurnForNewFrame) used.push_back(i);
+  }
+  return used;
+}
+
+// Float accumulators of one tile: the gain-corrected weighted sum and the weight.
+struct Tile {
+  std::vector<float> sum, weight;
+};
+
+class Blender {
+ public:
+  Blender(const MosaicGrid& grid, int tile, const std::vector<Window>& windows)
+      : grid_(grid), tile_(tile), nx_((grid.width + tile - 1) / tile), ny_((grid.height + tile - 1) / tile) {
+    tiles_.resize(static_cast<size_t>(nx_) * static_cast<size_t>(ny_));
+    last_use_.assign(tiles_.size(), -1);
+    for (size_t k = 0; k < windows.size(); ++k)
+      for_tiles(windows[k], [&](size_t t) { last_use_[t] = static_cast<int64_t>(k); });
+    image_ = cv::Mat::zeros(grid.height, grid.width, CV_8UC1);
+  }
+
+  // The gain that brings this frame's samples to the mosaic's values where the mosaic is already
+  // well covered (total weight at least 1): the ratio of the weighted means. NaN when too few
+  // pixels overlap (under 5% of the frame's).
+  double gain(const cv::Mat& samples, const Window& w) const {
+    double sm = 0, sf = 0;
+    int64_t seen = 0, overlap = 0;
+    for (int r = 0; r < w.height; ++r) {
+      const cv::Vec2f* s = samples.ptr<cv::Vec2f>(r);
+      const int gy = w.y + r;
+      for (int c = 0; c < w.width; ++c) {
+        const float wt = s[c][1];
+        if (wt <= 0.0f) continue;
+        ++seen;
+        const Tile* t = tile_at(w.x + c, gy);
+        if (!t || t->sum.empty()) continue;
+        const size_t i = index_in_tile(w.x + c, gy);
+        if (t->weight[i] < 1.0f) continue;
+        ++overlap;
+        sm += wt * (t->sum[i] / t->weight[i]);
+        sf += wt * s[c][0];
+      }
+    }
+    if (overlap < seen / 20 || overlap == 0 || !(sf > 0)) return std::nan("");
+    return sm / sf;
+  }
+
+  void add(const cv::Mat& samples, const Window& w, float gain) {
+    for (int r = 0; r < w.height; ++r) {
+      const cv::Vec2f* s = samples.ptr<cv::Vec2f>(r);
+      const int gy = w.y + r;
+      for (int c = 0; c < w.width; ++c) {
+        const float wt = s[c][1];
+        if (wt <= 0.0f) continue;
+        Tile& t = *tile_at(w.x + c, gy);
+        if (t.sum.empty()) allocate(t);
+        const size_t i = index_in_tile(w.x + c, gy);
+        t.sum[i] += wt * gain * s[c][0];
+        t.weight[i] += wt;
+      }
+    }
+  }
+
+  // Finishes (to 8 bits) and frees the tiles no later frame touches.
+  void finish_after(int64_t k, int64_t* covered) {
+    for (size_t ti = 0; ti < tiles_.size(); ++ti) {
+      if (last_use_[ti] != k) continue;
+      Tile& t = tiles_[ti];
+      if (t.sum.empty()) continue;
+      const int tx = static_cast<int>(ti % static_cast<size_t>(nx_)), ty = static_cast<int>(ti / static_cast<size_t>(nx_));
+      const int x0 = tx * tile_, y0 = ty * tile_;
+      const int x1 = std::min(x0 + tile_, grid_.width), y1 = std::min(y0 + tile_, grid_.height);
+      for (int y = y0; y < y1; ++y) {
+        uint8_t* out = image_.ptr<uint8_t>(y);
+        for (int x = x0; x < x1; ++x) {
+          const size_t i = index_in_tile(x, y);
+          if (!(t.weight[i] > 0.0f)) continue;
+          const float v = std::round(t.sum[i] / t.weight[i]);
+          out[x] = static_cast<uint8_t>(std::clamp(v, 1.0f, 255.0f));
+          ++*covered;
+        }
+      }
+      held_ -= 2 * static_cast<int64_t>(t.sum.size() * sizeof(float));
+      std::vector<float>().swap(t.sum);
+      std::vector<float>().swap(t.weight);
+    }
+  }
+
+  cv::Mat& image() { return image_; }
+  int64_t peak_bytes() const { return peak_; }
+
+ private:
+  template <class F>
+  void for_tiles(const Window& w, F f) const {
+    if (w.empty()) return;
+    for (int ty = w.y / tile_; ty <= (w.y + w.height - 1) / tile_; ++ty)
+      for (int tx = w.x / tile_; tx <= (w.x + w.width - 1) / tile_; ++tx)
+        f(static_cast<size_t>(ty) * static_cast<size_t>(nx_) + static_cast<size_t>(tx));
+  }
+  Tile* tile_at(int x, int y) { return &tiles_[static_cast<size_t>(y / tile_) * static_cast<size_t>(nx_) + static_cast<size_t>(x / tile_)]; }
+  const Tile* tile_at(int x, int y) const {
+    return &tiles_[static_cast<size_t>(y / tile_) * static_cast<size_t>(nx_) + static_cast<size_t>(x / tile_)];
+  }
+  size_t index_in_tile(int x, int y) const {
+    return static_cast<size_t>(y % tile_) * static_cast<size_t>(tile_) + static_cast<size_t>(x % tile_);
+  }
+  void allocate(Tile& t) {
+    const size_t n = static_cast<size_t>(tile_) * static_cast<size_t>(tile_);
+    t.sum.assign(n, 0.0f);
+    t.weight.assign(n, 0.0f);
+    held_ += 2 * static_cast<int64_t>(n * sizeof(float));
+    peak_ = std::max(peak_, held_);
+  }
+
+  MosaicGrid grid_;
+  int tile_, nx_, ny_;
+  std::vector<Tile> tiles_;
+  std::vector<int64_t> last_use_;
+  cv::Mat image_;
+  int64_t held_ = 0, peak_ = 0;
+};
+
+void check_options(const MosaicOptions& o) {
+  if (!(o.resolution > 0) || !std::isfinite(o.resolution))
+    throw_invalid_argument("mosaic: the resolution must be a positive number of metres per pixel");
+  if (!(o.max_range >= 0) || !std::isfinite(o.max_range)) throw_invalid_argument("mosaic: max_range must be >= 0");
+  if (!std::isfinite(o.frame_spacing)) throw_invalid_argument("mosaic: frame_spacing must be finite");
+  if (!(o.feather > 0 && o.feather <= 0.5)) throw_invalid_argument("mosaic: feather must lie in (0, 0.5]");
+  if (o.max_side < 1) throw_invalid_argument("mosaic: max_side must be positive");
+  if (o.tile_size < 16 || o.tile_size > 4096) throw_invalid_argument("mosaic: tile_size must lie in 16..4096");
+}
+
+// The grid over the union of the boxes, snapped to whole pixels of the resolution.
+MosaicGrid make_grid(const Box& all, const MosaicOptions& o) {
+  const double r = o.resolution;
+  MosaicGrid g;
+  g.resolution = r;
+  const double cx0 = std::floor(all.x0 / r), cy0 = std::floor(all.y0 / r);
+  const double cx1 = std::ceil(all.x1 / r), cy1 = std::ceil(all.y1 / r);
+  const double w = std::max(1.0, cx1 - cx0), h = std::max(1.0, cy1 - cy0);
+  if (w > o.max_side || h > o.max_side)
+    throw_invalid_input("the mosaic would be " + num(w, 0) + " x " + num(h, 0) + " pixels (" +
+                        num(all.x1 - all.x0, 2) + " m x " + num(all.y1 - all.y0, 2) + " m at " +
+                        num(r, -1) + " m/px), more than " + std::to_string(o.max_side) +
+                        " on a side; give a coarser resolution (" +
+                        num(r * std::max(w, h) / o.max_side * 1.001, -1) + " m/px or more)");
+  g.origin = Eigen::Vector2d(cx0 * r, cy0 * r);
+  g.width = static_cast<int>(w);
+  g.height = static_cast<int>(h);
+  return g;
+}
+
+Window window_of(const Box& b, const MosaicGrid& g) {
+  const double r = g.resolution;
+  const int c0 = std::max(0, static_cast<int>(std::floor((b.x0 - g.origin.x()) / r)) - 1);
+  const int c1 = std::min(g.width, static_cast<int>(std::ceil((b.x1 - g.origin.x()) / r)) + 1);
+  const int r0 = std::max(0, static_cast<int>(std::floor(g.height - (b.y1 - g.origin.y()) / r)) - 1);
+  const int r1 = std::min(g.height, static_cast<int>(std::ceil(g.height - (b.y0 - g.origin.y()) / r)) + 1);
+  return {c0, r0, std::max(0, c1 - c0), std::max(0, r1 - r0)};
+}
+
+}  // namespace
+
+std::vector<int64_t> match_frames(const std::vector<double>& frame_times, const std::vector<double>& times) {
+  if (times.empty()) throw_invalid_input("the trajectory is empty: it has no pose to place a frame with");
+  double shortest = std::numeric_limits<double>::infinity();
+  for (size_t i = 1; i < frame_times.size(); ++i) shortest = std::min(shortest, frame_times[i] - frame_times[i - 1]);
+  const double tol = std::min(1e-3, 0.25 * shortest);
+  std::vector<int64_t> out;
+  out.reserve(times.size());
+  for (size_t k = 0; k < times.size(); ++k) {
+    const double t = times[k];
+    const auto it = std::lower_bound(frame_times.begin(), frame_times.end(), t);
+    int64_t best = -1;
+    double d = std::numeric_limits<double>::infinity();
+    for (auto c : {it, it == frame_times.begin() ? it : it - 1}) {
+      if (c == frame_times.end()) continue;
+      if (std::abs(*c - t) < d) {
+        d = std::abs(*c - t);
+        best = c - frame_times.begin();
+      }
+    }
+    if (!(d <= tol))
+      throw_invalid_input("trajectory pose " + std::to_string(k + 1) + " (t = " + num(t, 6) +
+                          " s) has no frame within " + num(tol * 1e3, -1) + " ms" +
+                          (best >= 0 ? "; the nearest is frame " + std::to_string(best) + " at t = " +
+                                           num(frame_times[static_cast<size_t>(best)], 6) + " s"
+                                     : std::string()) +
+                          " (is the trajectory from this data set?)");
+    out.push_back(best);
+  }
+  return out;
+}
+
+Mosaic build_mosaic(ocl::Runtime& runtime, io::Dataset& dataset, const Extrinsics& extrinsics,
+                    const std::vector<PosedFrame>& frames, const MosaicOptions& options) {
+  const Clock::time_point t0 = Clock::now();
+  check_options(options);
+  if (frames.empty()) throw_invalid_input("mosaic: no poses: the trajectory is empty");
+  for (const PosedFrame& f : frames) {
+    if (f.frame < 0 || f.frame >= dataset.frame_count())
+      throw_invalid_argument("mosaic: frame " + std::to_string(f.frame) + " is not in the data set (it has " +
+                             std::to_string(dataset.frame_count()) + ")");
+    if (!std::isfinite(f.pose.x) || !std::isfinite(f.pose.y) || !std::isfinite(f.pose.theta))
+      throw_invalid_input("mosaic: the pose of frame " + std::to_string(f.frame) + " is not finite");
+  }
+  const CameraModel& cam = dataset.camera();
+  const PixelRegion region = cam.region();
+  const double max_range = options.max_range > 0 ? options.max_range : 4.0 * extrinsics.z;
+  const WarpSetup setup =
+      make_warp_setup(cam, extrinsics, max_range, options.feather * std::min(region.width, region.height));
+  const std::vector<Eigen::Vector2d> fp = footprint(setup);
+  if (fp.empty()) throw_invalid_input("mosaic: the camera sees no ground within the range limit");
+  Box robot_box;
+  for (const Eigen::Vector2d& p : fp) robot_box.add(p);
+  const double spacing = options.frame_spacing != 0
+                             ? options.frame_spacing
+                             : std::min(robot_box.x1 - robot_box.x0, robot_box.y1 - robot_box.y0) / 8.0;
+  const std::vector<size_t> used = select_frames(frames, extrinsics.t_vc().head<2>(), spacing);
+
+  std::vector<Box> boxes;
+  Box all;
+  for (size_t k : used) {
+    boxes.push_back(frame_box(fp, frames[k].pose));
+    all.add(boxes.back());
+  }
+  Mosaic m;
+  m.grid = make_grid(all, options);
+  std::vector<Window> windows;
+  for (const Box& b : boxes) windows.push_back(window_of(b, m.grid));
+
+  MosaicWarp warp(runtime, cam.width, cam.height);
+  Blender blender(m.grid, options.tile_size, windows);
+  cv::Mat samples;
+  double last_gain = 1.0;
+  m.stats.frames_given = static_cast<int64_t>(frames.size());
+  m.stats.frames_used = static_cast<int64_t>(used.size());
+  m.stats.gain_min = m.stats.gain_max = 1.0;
+  for (size_t k = 0; k < used.size(); ++k) {
+    if (options.progress && !options.progress(static_cast<double>(k) / static_cast<double>(used.size()), "mosaic"))
+      throw Error(ErrorCode::Cancelled, "mosaic: cancelled");
+    const Window& w = windows[k];
+    if (!w.empty()) {
+      const PosedFrame& f = frames[used[k]];
+      Clock::time_point t = Clock::now();
+      const cv::Mat frame = dataset.frame(f.frame);
+      m.stats.seconds_decode += seconds_since(t);
+      t = Clock::now();
+      warp.run(frame, warp_params(setup, f.pose, m.grid, w), w.width, w.height, &samples);
+      m.stats.seconds_warp += seconds_since(t);
+      t = Clock::now();
+      double g = 1.0;
+      if (options.estimate_gain && k > 0) {
+        g = blender.gain(samples, w);
+        g = std::isfinite(g) ? std::clamp(g, 0.25, 4.0) : last_gain;
+      }
+      last_gain = g;
+      m.stats.gain_min = std::min(m.stats.gain_min, g);
+      m.stats.gain_max = std::max(m.stats.gain_max, g);
+      blender.add(samples, w, static_cast<float>(g));
+      blender.finish_after(static_cast<int64_t>(k), &m.stats.covered_pixels);
+      m.stats.seconds_blend += seconds_since(t);
+    }
+  }
+  if (options.progress) options.progress(1.0, "mosaic");
+  m.image = blender.image();
+  m.stats.peak_tile_bytes = blender.peak_bytes();
+  m.stats.seconds_total = seconds_since(t0);
+  return m;
+}
+
+void save_mosaic(const Mosaic& mosaic, const std::string& image_path) {
+  namespace fs = std::filesystem;
+  const fs::path img(image_path);
+  if (img.extension().empty())
+    throw_invalid_argument("mosaic: the image path " + image_path + " has no extension (.png, say)");
+  const fs::path yaml = fs::path(img).replace_extension(".yaml");
+  if (yaml == img) throw_invalid_argument("mosaic: the image cannot be a .yaml file");
+  bool ok = false;
+  try {
+    ok = cv::imwrite(image_path, mosaic.image);
+  } catch (const cv::Exception& e) {
+    throw Error(ErrorCode::Io, "cannot write " + image_path + ": " + e.what());
+  }
+  if (!ok) throw Error(ErrorCode::Io, "cannot write " + image_path);
+  std::ofstream out(yaml);
+  char line[160];
+  out << "# planarvo mosaic: the ground under the trajectory, placed as ROS map_server reads a map.\n"
+      << "# origin: the lower-left corner of the lower-left pixel [x, y, yaw] in the trajectory's frame;\n"
+      << "# row 0 of the image is its top (+y), columns run along +x. 0: unseen; 1..255: the ground.\n";
+  out << "image: " << img.filename().string() << "\n";
+  std::snprintf(line, sizeof line, "resolution: %.17g\n", mosaic.grid.resolution);
+  out << line;
+  std::snprintf(line, sizeof line, "origin: [%.17g, %.17g, 0.0]\n", mosaic.grid.origin.x(), mosaic.grid.origin.y());
+  out << line;
+  out << "negate: 0\noccupied_thresh: 0.65\nfree_thresh: 0.196\n";
+  out.flush();
+  if (!out) throw Error(ErrorCode::Io, "cannot write " + yaml.string());
+}
+
+}  // namespace planarvo::mosaic
