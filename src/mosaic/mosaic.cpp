@@ -282,6 +282,17 @@ Window window_of(const Box& b, const MosaicGrid& g) {
   return {c0, r0, std::max(0, c1 - c0), std::max(0, r1 - r0)};
 }
 
+// The shortest decimal form that reads back to the same double.
+std::string shortest(double v) {
+  for (int precision = 1; precision <= 17; ++precision) {
+    std::ostringstream s;
+    s.imbue(std::locale::classic());
+    s << std::setprecision(precision) << v;
+    if (std::stod(s.str()) == v) return s.str();
+  }
+  return std::to_string(v);
+}
+
 }  // namespace
 
 std::vector<int64_t> match_frames(const std::vector<double>& frame_times, const std::vector<double>& times) {
@@ -407,15 +418,12 @@ void save_mosaic(const Mosaic& mosaic, const std::string& image_path) {
   }
   if (!ok) throw Error(ErrorCode::Io, "cannot write " + image_path);
   std::ofstream out(yaml);
-  char line[160];
   out << "# planarvo mosaic: the ground under the trajectory, placed as ROS map_server reads a map.\n"
       << "# origin: the lower-left corner of the lower-left pixel [x, y, yaw] in the trajectory's frame;\n"
       << "# row 0 of the image is its top (+y), columns run along +x. 0: unseen; 1..255: the ground.\n";
   out << "image: " << img.filename().string() << "\n";
-  std::snprintf(line, sizeof line, "resolution: %.17g\n", mosaic.grid.resolution);
-  out << line;
-  std::snprintf(line, sizeof line, "origin: [%.17g, %.17g, 0.0]\n", mosaic.grid.origin.x(), mosaic.grid.origin.y());
-  out << line;
+  out << "resolution: " << shortest(mosaic.grid.resolution) << "\n";
+  out << "origin: [" << shortest(mosaic.grid.origin.x()) << ", " << shortest(mosaic.grid.origin.y()) << ", 0.0]\n";
   out << "negate: 0\noccupied_thresh: 0.65\nfree_thresh: 0.196\n";
   out.flush();
   if (!out) throw Error(ErrorCode::Io, "cannot write " + yaml.string());

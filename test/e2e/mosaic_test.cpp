@@ -1,0 +1,275 @@
+// The floor mosaic end to end: a simulated drive tracked through the C API, its mosaic built at
+// 1 mm/px, written with its map_server YAML, read back and compared, pixel by pixel at the place
+// the YAML gives, with the simulator's own ground texture (normalised cross-correlation); a
+// wrong calibration must show. `planarvo mosaic` as a user runs it gives the same image; bad
+// input is exit code 2.
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <regex>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "common/capi_util.h"
+#include "common/test_util.h"
+#include "io/formats.h"
+
+namespace planarvo {
+namespace {
+
+namespace fs = std::filesystem;
+using test::run_cli;
+using test::ScratchDir;
+
+struct MosaicDeleter {
+  void operator()(planarvo_mosaic* m) const { planarvo_mosaic_destroy(m); }
+};
+using ApiMosaic = std::unique_ptr<planarvo_mosaic, MosaicDeleter>;
+
+struct MapYaml {
+  std::string image;
+  double resolution = 0, x = 0, y = 0, yaw = 0;
+};
+
+// The keys map_server reads, parsed on their own (not with the writer's code).
+MapYaml read_map_yaml(const fs::path& p) {
+  const std::string s = test::read_file(p);
+  MapYaml m;
+  std::smatch r;
+  if (std::regex_search(s, r, std::regex(R"(\nimage: (\S+))"))) m.image = r[1];
+  if (std::regex_search(s, r, std::regex(R"(\nresolution: (\S+))"))) m.resolution = std::stod(r[1]);
+  if (std::regex_search(s, r, std::regex(R"(\norigin: \[([^,]+), ([^,]+), ([^\]]+)\])"))) {
+    m.x = std::stod(r[1]);
+    m.y = std::stod(r[2]);
+    m.yaw = std::stod(r[3]);
+  }
+  return m;
+}
+
+// The simulator's ground: the texture mirror-tiled over the plane, world (X, Y) at texel
+// (X, Y) / texel (SIMULATOR.md), smoothed by a Gaussian of 0.3 mosaic pixels (the mosaic's pixels
+// are point samples of frames that already carry the camera's blur).
+class Ground {
+ public:
+  Ground(const std::string& texture, double texel, double resolution) : texel_(texel) {
+    cv::Mat t = cv::imread(texture, cv::IMREAD_GRAYSCALE);
+    EXPECT_FALSE(t.empty()) << texture;
+    t.convertTo(t, CV_32F);
+    cv::Mat flipped_x, flipped_y, flipped_xy, top, bottom;
+    cv::flip(t, flipped_x, 1);
+    cv::flip(t, flipped_y, 0);
+    cv::flip(t, flipped_xy, -1);
+    cv::hconcat(t, flipped_x, top);
+    cv::hconcat(flipped_y, flipped_xy, bottom);
+    cv::vconcat(top, bottom, period_);  // one whole mirror period: the plane tiles it by wrapping
+    const double sigma = 0.3 * resolution / texel;
+    const int pad = static_cast<int>(std::ceil(4 * sigma)) + 1;
+    cv::Mat padded, blurred;
+    cv::copyMakeBorder(period_, padded, pad, pad, pad, pad, cv::BORDER_WRAP);
+    cv::GaussianBlur(padded, blurred, cv::Size(0, 0), sigma);
+    period_ = blurred(cv::Rect(pad, pad, period_.cols, period_.rows)).clone();
+  }
+  double at(double X, double Y) const {
+    const double u = X / texel_, v = Y / texel_;
+    const double u0 = std::floor(u), v0 = std::floor(v);
+    const double fu = u - u0, fv = v - v0;
+    const auto px = [&](double a, double b) {
+      const int c = static_cast<int>(std::fmod(std::fmod(a, period_.cols) + period_.cols, period_.cols));
+      const int r = static_cast<int>(std::fmod(std::fmod(b, period_.rows) + period_.rows, period_.rows));
+      return static_cast<double>(period_.at<float>(r, c));
+    };
+    const double top = px(u0, v0) + fu * (px(u0 + 1, v0) - px(u0, v0));
+    const double bottom = px(u0, v0 + 1) + fu * (px(u0 + 1, v0 + 1) - px(u0, v0 + 1));
+    return top + fv * (bottom - top);
+  }
+
+ private:
+  double texel_;
+  cv::Mat period_;
+};
+
+// NCC of the mosaic's seen pixels against the ground at the place the YAML gives, the
+// trajectory's frame mapped to the world by the true first pose.
+double ncc_against_ground(const fs::path& image_path, const Ground& ground, const planarvo_se2& first_true_pose,
+                          int64_t* seen = nullptr) {
+  const MapYaml y = read_map_yaml(fs::path(image_path).replace_extension(".yaml"));
+  EXPECT_EQ(y.image, image_path.filename().string());
+  EXPECT_EQ(y.yaw, 0.0);
+  const cv::Mat m = cv::imread(image_path.string(), cv::IMREAD_UNCHANGED);
+  EXPECT_EQ(m.type(), CV_8UC1);
+  const double c = std::cos(first_true_pose.theta), s = std::sin(first_true_pose.theta);
+  double sa = 0, sb = 0, saa = 0, sbb = 0, sab = 0;
+  int64_t n = 0;
+  for (int row = 0; row < m.rows; ++row)
+    for (int col = 0; col < m.cols; ++col) {
+      const uint8_t v = m.at<uint8_t>(row, col);
+      if (v == 0) continue;
+      // map_server: the lower-left corner of the lower-left pixel at the origin, row 0 at the top.
+      const double x = y.x + (col + 0.5) * y.resolution;
+      const double yy = y.y + (m.rows - row - 0.5) * y.resolution;
+      const double a = v, b = ground.at(first_true_pose.x + c * x - s * yy, first_true_pose.y + s * x + c * yy);
+      sa += a;
+      sb += b;
+      saa += a * a;
+      sbb += b * b;
+      sab += a * b;
+      ++n;
+    }
+  if (seen) *seen = n;
+  if (n == 0) return 0;
+  const double cov = sab - sa * sb / n, va = saa - sa * sa / n, vb = sbb - sb * sb / n;
+  return cov / std::sqrt(va * vb);
+}
+
+ApiMosaic build(planarvo_context* ctx, planarvo_dataset* ds, const planarvo_extrinsics& e,
+                const std::vector<test::TrackedFrame>& frames, double resolution) {
+  std::vector<double> t;
+  std::vector<planarvo_se2> poses;
+  for (const auto& f : frames) {
+    t.push_back(f.data.timestamp);
+    poses.push_back(f.result.pose);
+  }
+  planarvo_mosaic_options o;
+  planarvo_mosaic_options_init(&o);
+  o.resolution = resolution;
+  planarvo_mosaic* m = nullptr;
+  EXPECT_EQ(planarvo_mosaic_build(ctx, ds, &e, t.data(), poses.data(), t.size(), &o, &m), PLANARVO_OK)
+      << planarvo_last_error();
+  return ApiMosaic(m);
+}
+
+TEST(Mosaic, MatchesTheGroundTextureWhereItsYamlPlacesIt) {
+  ScratchDir dir;
+  const std::string seq = (dir / "drive").string();
+  ASSERT_EQ(run_cli("simulate --quiet --out " + seq + " --seconds 3 --seed 11").exit_code, 0);
+  planarvo_dataset_info info{};
+  planarvo_extrinsics e{};
+  ASSERT_EQ(planarvo_extrinsics_load((seq + "/extrinsics_gt.yaml").c_str(), &e), PLANARVO_OK);
+  const std::vector<test::TrackedFrame> frames = test::track_through_api(seq, e, nullptr, &info);
+  ASSERT_EQ(frames.size(), 90u);
+  test::ApiContext ctx = test::api_context();
+  test::ApiDataset ds = test::api_dataset(seq);
+  const double texel = 0.0004;  // simulate's default (simulation.yaml)
+  const Ground ground(test::source_dir() / "data" / "textures" / "asphalt_01.png", texel, 0.001);
+
+  ApiMosaic mosaic = build(ctx.get(), ds.get(), e, frames, 0.001);
+  ASSERT_TRUE(mosaic);
+  const fs::path png = dir / "floor.png";
+  ASSERT_EQ(planarvo_mosaic_save(mosaic.get(), png.c_str()), PLANARVO_OK) << planarvo_last_error();
+  planarvo_mosaic_info mi{};
+  mi.struct_size = sizeof mi;
+  ASSERT_EQ(planarvo_mosaic_info_get(mosaic.get(), &mi), PLANARVO_OK);
+  int64_t seen = 0;
+  const double ncc = ncc_against_ground(png, ground, frames[0].data.groundtruth, &seen);
+  EXPECT_GT(ncc, 0.9);
+  EXPECT_EQ(seen, mi.covered_pixels);
+  EXPECT_GT(seen, 200000);  // over 0.2 m^2 of ground seen
+  // The image in memory is the file's.
+  planarvo_image im{};
+  ASSERT_EQ(planarvo_mosaic_image(mosaic.get(), &im), PLANARVO_OK);
+  const cv::Mat file = cv::imread(png.string(), cv::IMREAD_UNCHANGED);
+  ASSERT_EQ(file.cols, im.width);
+  ASSERT_EQ(file.rows, im.height);
+  EXPECT_EQ(cv::norm(file, cv::Mat(im.height, im.width, CV_8UC1, const_cast<void*>(im.data), im.stride), cv::NORM_INF),
+            0.0);
+
+  // Displaced by a whole number of pixels, the same image no longer matches: the placement is
+  // what the NCC measures, not the texture's statistics.
+  {
+    const MapYaml y = read_map_yaml(dir / "floor.yaml");
+    std::ofstream(dir / "shifted.yaml") << "# shifted\nimage: shifted.png\nresolution: " << y.resolution << "\norigin: ["
+                                        << y.x + 3 * y.resolution << ", " << y.y << ", 0.0]\n";
+    fs::copy_file(png, dir / "shifted.png");
+    EXPECT_LT(ncc_against_ground(dir / "shifted.png", ground, frames[0].data.groundtruth), 0.6);
+  }
+
+  // A wrong calibration (yaw 3 degrees and x 15 mm off) blurs and doubles the texture.
+  planarvo_extrinsics wrong = e;
+  wrong.yaw += 3 * M_PI / 180;
+  wrong.x += 0.015;
+  ApiMosaic bad = build(ctx.get(), ds.get(), wrong, frames, 0.001);
+  ASSERT_TRUE(bad);
+  ASSERT_EQ(planarvo_mosaic_save(bad.get(), (dir / "wrong.png").c_str()), PLANARVO_OK);
+  const double ncc_wrong = ncc_against_ground(dir / "wrong.png", ground, frames[0].data.groundtruth);
+  EXPECT_LT(ncc_wrong, ncc - 0.3) << "true " << ncc << ", wrong " << ncc_wrong;
+
+  // The tool, from the trajectory `track` wrote, makes the same image and YAML.
+  ASSERT_EQ(run_cli("track --quiet " + seq + " --extrinsics " + seq + "/extrinsics_gt.yaml -o " + (dir / "traj.txt").string())
+                .exit_code,
+            0);
+  const auto r = run_cli("mosaic --quiet " + seq + " --trajectory " + (dir / "traj.txt").string() + " --extrinsics " +
+                         seq + "/extrinsics_gt.yaml -o " + (dir / "cli.png").string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const cv::Mat cli = cv::imread((dir / "cli.png").string(), cv::IMREAD_UNCHANGED);
+  ASSERT_EQ(cli.size(), file.size());
+  // The trajectory file holds the poses to 17 significant digits, so the same warps; at most a
+  // rounding of the 8-bit value apart.
+  EXPECT_LE(cv::norm(cli, file, cv::NORM_INF), 1.0);
+  const MapYaml a = read_map_yaml(dir / "cli.yaml"), b = read_map_yaml(dir / "floor.yaml");
+  EXPECT_EQ(a.x, b.x);
+  EXPECT_EQ(a.y, b.y);
+  EXPECT_EQ(a.resolution, b.resolution);
+}
+
+TEST(Mosaic, BadInputIsExitCode2) {
+  ScratchDir dir;
+  const std::string seq = (dir / "tiny").string();
+  ASSERT_EQ(run_cli("simulate --quiet --out " + seq + " --seconds 0.5 --width 96 --height 64 --seed 3").exit_code, 0);
+  const std::string traj = (dir / "traj.txt").string();
+  ASSERT_EQ(run_cli("track --quiet " + seq + " --extrinsics " + seq + "/extrinsics_gt.yaml -o " + traj).exit_code, 0);
+  const std::string common = "mosaic --quiet " + seq + " --extrinsics " + seq + "/extrinsics_gt.yaml ";
+  const std::string out = " -o " + (dir / "m.png").string();
+  EXPECT_EQ(run_cli(common + "--trajectory " + traj + out).exit_code, 0);
+
+  // A pose at a time that is no frame's (the 5th line moved by 10 ms).
+  std::vector<io::StampedPose> poses = io::read_tum(traj);
+  std::vector<io::StampedPose> moved = poses;
+  moved[4].t += 0.010;
+  io::write_tum((dir / "moved.txt").string(), moved);
+  EXPECT_EQ(run_cli(common + "--trajectory " + (dir / "moved.txt").string() + out).exit_code, 2);
+  // An empty trajectory (the header only).
+  std::ofstream(dir / "empty.txt") << "# timestamp x y z qx qy qz qw\n";
+  EXPECT_EQ(run_cli(common + "--trajectory " + (dir / "empty.txt").string() + out).exit_code, 2);
+  // A resolution that would make the image over 20000 pixels on a side; the size it would be is
+  // printed: the drive's extent over the resolution.
+  const auto big = run_cli(common + "--trajectory " + traj + " --resolution 0.00001" + out);
+  EXPECT_EQ(big.exit_code, 2);
+  EXPECT_FALSE(fs::exists(dir / "big.png"));
+  // Bad options.
+  EXPECT_EQ(run_cli(common + "--trajectory " + traj + " --resolution -1" + out).exit_code, 2);
+  EXPECT_EQ(run_cli(common + out).exit_code, 2);  // no trajectory
+  EXPECT_EQ(run_cli(common + "--trajectory " + traj).exit_code, 2);  // no output
+  EXPECT_EQ(run_cli(common + "--trajectory " + (dir / "missing.txt").string() + out).exit_code, 2);
+
+  // Through the C API: the first mismatch is INVALID_INPUT; so is an empty trajectory.
+  test::ApiContext ctx = test::api_context();
+  test::ApiDataset ds = test::api_dataset(seq);
+  planarvo_extrinsics e{};
+  ASSERT_EQ(planarvo_extrinsics_load((seq + "/extrinsics_gt.yaml").c_str(), &e), PLANARVO_OK);
+  std::vector<double> t;
+  std::vector<planarvo_se2> p;
+  for (const auto& s : moved) {
+    t.push_back(s.t);
+    p.push_back({s.pose.x, s.pose.y, s.pose.theta});
+  }
+  planarvo_mosaic* m = nullptr;
+  EXPECT_EQ(planarvo_mosaic_build(ctx.get(), ds.get(), &e, t.data(), p.data(), t.size(), nullptr, &m),
+            PLANARVO_ERROR_INVALID_INPUT);
+  EXPECT_EQ(m, nullptr);
+  EXPECT_EQ(planarvo_mosaic_build(ctx.get(), ds.get(), &e, t.data(), p.data(), 0, nullptr, &m),
+            PLANARVO_ERROR_INVALID_INPUT);
+  // A trajectory may leave frames out.
+  t.erase(t.begin() + 4);
+  p.erase(p.begin() + 4);
+  EXPECT_EQ(planarvo_mosaic_build(ctx.get(), ds.get(), &e, t.data(), p.data(), t.size(), nullptr, &m), PLANARVO_OK)
+      << planarvo_last_error();
+  planarvo_mosaic_destroy(m);
+  planarvo_mosaic_destroy(nullptr);
+}
+
+}  // namespace
+}  // namespace planarvo
