@@ -9,7 +9,6 @@ import numpy as np
 import pytest
 
 pytest.importorskip("matplotlib")
-pytest.importorskip("scipy")
 
 import planarvo  # noqa: E402
 from planarvo.plot import _io, _motion, _residuals  # noqa: E402

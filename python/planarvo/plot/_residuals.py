@@ -56,11 +56,25 @@ def _noise_design(odometry: np.ndarray) -> np.ndarray:
     return np.column_stack([np.ones(len(odometry)), odometry[:, 0] ** 2 + odometry[:, 1] ** 2, odometry[:, 2] ** 2])
 
 
+def _nonnegative_lstsq(M: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """min |M x - b| over x >= 0 for a few columns, as the library solves it: a column whose
+    coefficient comes out negative is dropped and the rest solved again."""
+    active = np.ones(M.shape[1], bool)
+    for _ in range(M.shape[1]):
+        x = np.zeros(M.shape[1])
+        if not active.any():
+            break
+        x[active] = np.linalg.lstsq(M[:, active], b, rcond=None)[0]
+        if not (x < 0).any():
+            return x
+        active &= x >= 0
+    return np.zeros(M.shape[1])
+
+
 def fit_odometry_noise(odometry: np.ndarray, residual: np.ndarray) -> np.ndarray:
     """Per component c of the residual: variance = a_c + b_c |t|^2 + g_c theta^2 fitted to the
     squared residuals by non-negative least squares, reweighted by 1/variance (the model of the
     library's estimate_odometry_noise). Returns the (3, 3) coefficients, row c = (a_c, b_c, g_c)."""
-    from scipy.optimize import nnls
     A = _noise_design(odometry)
     scale = np.maximum(np.linalg.norm(A, axis=0), 1e-300)
     As = A / scale
@@ -70,7 +84,7 @@ def fit_odometry_noise(odometry: np.ndarray, residual: np.ndarray) -> np.ndarray
         w = np.ones(len(b))
         tiny = 1e-30 + 1e-6 * b.mean()
         for _ in range(6):
-            coef, _ = nnls(w[:, None] * As, w * b)
+            coef = _nonnegative_lstsq(w[:, None] * As, w * b)
             w = 1.0 / np.maximum(As @ coef, tiny)
             w /= w.max()
         coefs[c] = coef / scale
