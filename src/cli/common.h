@@ -131,6 +131,7 @@ int cmd_track(int argc, char** argv);
 int cmd_mosaic(int argc, char** argv);
 int cmd_posegraph(int argc, char** argv);
 int cmd_calibrate(int argc, char** argv);
+int cmd_plot(int argc, char** argv);
 // calibrate DATASET (cmd_calibrate.cpp), with the graph options cmd_calibrate parsed.
 int cmd_calibrate_dataset(const Args& args, const planarvo_calibration_options& graph);
 

@@ -18,6 +18,7 @@ const std::vector<Command>& commands() {
       {"posegraph", "optimise a 2-D pose graph (g2o format)", cmd_posegraph},
       {"simulate", "render a synthetic data set with exact ground truth", cmd_simulate},
       {"mosaic", "the floor under a trajectory as one image, with a ROS map_server YAML", cmd_mosaic},
+      {"plot", "figures and a calibration report (PNG/PDF/SVG, HTML) from a run's files; needs python3-matplotlib", cmd_plot},
       {"info", "read and check a data set, print what it holds", cmd_info},
       {"devices", "list OpenCL platforms and devices", cmd_devices},
       {"kernels", "export prebuilt kernel binaries for a device (FPGA flows)", cmd_kernels},

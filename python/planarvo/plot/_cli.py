@@ -1,0 +1,106 @@
+"""The command line: python3 -m planarvo.plot {track,calibration,report} ... (docs/outputs.md).
+
+Exit status 0 when the figures were written, 2 for bad input or usage (with the reason on
+stderr), 1 when something else failed."""
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+import time
+from typing import List, Optional
+
+from ._errors import InputError
+
+PROG = "planarvo plot"
+
+
+def _formats(text: str) -> List[str]:
+    from ._style import parse_formats  # imports matplotlib
+    try:
+        return parse_formats(text)
+    except ValueError as e:
+        raise InputError(str(e)) from None
+
+
+def _common(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--out-dir", default=".", help="where the figures go (default: the current directory; created)")
+    p.add_argument("--format", default="png", help="png, pdf, svg, or several comma-separated (default png)")
+
+
+def _parser() -> argparse.ArgumentParser:
+    ap = argparse.ArgumentParser(prog=PROG, description="Figures (PNG, PDF, SVG) and a calibration report "
+                                 "(self-contained HTML) from planarvo's output files.")
+    sub = ap.add_subparsers(dest="command", metavar="{track,calibration,report}")
+    t = sub.add_parser("track", help="trajectory, velocity, velocity histogram and tracking figures",
+                       description="trajectory.FMT, velocity.FMT, velocity_hist.FMT (needs ground truth) and "
+                       "tracking.FMT (needs --stats) from a data set and the trajectory that track wrote.")
+    t.add_argument("dataset", metavar="DATASET", help="the data set folder, bag or MCAP file that was tracked")
+    t.add_argument("--trajectory", required=True, help="the TUM trajectory from planarvo track -o")
+    t.add_argument("--stats", help="the per-frame statistics CSV from planarvo track --stats")
+    _common(t)
+    c = sub.add_parser("calibration", help="calibration estimates and residual figures, and an HTML report",
+                       description="calibration_estimates.FMT and calibration_residuals.FMT, and with --report "
+                       "one self-contained HTML file, from calibrated extrinsics and the motion pairs (given, or "
+                       "tracked from the data set as planarvo calibrate does).")
+    c.add_argument("dataset", metavar="DATASET", nargs="?", help="the data set that was calibrated")
+    c.add_argument("--extrinsics", required=True, help="the extrinsics YAML that planarvo calibrate wrote")
+    c.add_argument("--motions", help="a motion-pair CSV instead of DATASET (planarvo calibrate --motions)")
+    c.add_argument("--truth", help="true extrinsics YAML (default: DATASET/extrinsics_gt.yaml when present)")
+    c.add_argument("--windows", type=int, default=4, help="consecutive sub-trajectories calibrated on their own "
+                   "(default 4; 0: none)")
+    c.add_argument("--fix-scale", type=float, metavar="SCALE", help="motion pairs of a metric sensor: hold the "
+                   "scale at SCALE (1 for a laser) as calibrate --motions --fix-scale does")
+    c.add_argument("--report", metavar="HTML", help="also write a self-contained HTML report here")
+    _common(c)
+    r = sub.add_parser("report", help="track and calibration figures in one HTML file",
+                       description="Everything above for one data set: the track figures (with --trajectory) "
+                       "and the calibration figures (with --extrinsics), in one self-contained HTML file.")
+    r.add_argument("dataset", metavar="DATASET")
+    r.add_argument("--trajectory", help="the TUM trajectory from planarvo track -o")
+    r.add_argument("--stats", help="the per-frame statistics CSV")
+    r.add_argument("--extrinsics", help="the extrinsics YAML from planarvo calibrate")
+    r.add_argument("--truth", help="true extrinsics YAML (default: DATASET/extrinsics_gt.yaml when present)")
+    r.add_argument("--windows", type=int, default=4)
+    r.add_argument("-o", "--output", required=True, metavar="HTML", help="the HTML file to write")
+    return ap
+
+
+def _run(args: argparse.Namespace) -> List[str]:
+    if args.command == "track":
+        formats = _formats(args.format)
+        os.makedirs(args.out_dir, exist_ok=True)
+        from ._track import plot_track
+        return plot_track(args.dataset, args.trajectory, args.stats, args.out_dir, formats)
+    if args.command == "calibration":
+        formats = _formats(args.format)
+        if (args.dataset is None) == (args.motions is None):
+            raise InputError("give either DATASET or --motions FILE (one of them)")
+        if args.windows < 0:
+            raise InputError("--windows must be 0 or more")
+        os.makedirs(args.out_dir, exist_ok=True)
+        from ._calibration_command import plot_calibration
+        return plot_calibration(args)
+    from ._report import full_report
+    return full_report(args)
+
+
+def main(argv: Optional[List[str]] = None) -> int:
+    ap = _parser()
+    args = ap.parse_args(argv)
+    if args.command is None:
+        ap.print_help(sys.stderr)
+        return 2
+    t0 = time.perf_counter()
+    try:
+        written = _run(args)
+    except InputError as e:
+        print("%s %s: %s" % (PROG, args.command, e), file=sys.stderr)
+        return 2
+    except OSError as e:
+        print("%s %s: %s" % (PROG, args.command, e), file=sys.stderr)
+        return 2
+    for path in written:
+        print("wrote " + path)
+    print("%d files in %.2f s" % (len(written), time.perf_counter() - t0), file=sys.stderr)
+    return 0

@@ -1,0 +1,195 @@
+"""planarvo.plot: the numbers behind the figures against independent computations, the figures
+written as PNGs of the expected size that are not blank, and the bad-input exits."""
+import os
+import shutil
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+pytest.importorskip("matplotlib")
+
+import planarvo  # noqa: E402
+from planarvo.plot import _io, _motion, _residuals  # noqa: E402
+
+from conftest import true_motions  # noqa: E402
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+PYTHON_DIR = os.path.dirname(HERE)
+
+
+def run_plot(*args):
+    env = dict(os.environ)
+    env["PYTHONPATH"] = PYTHON_DIR + os.pathsep + env.get("PYTHONPATH", "")
+    return subprocess.run([sys.executable, "-m", "planarvo.plot", *map(str, args)], env=env,
+                          capture_output=True, text=True, timeout=120)
+
+
+def write_tum(path, t, poses):
+    with open(path, "w") as f:
+        f.write("# timestamp x y z qx qy qz qw\n")
+        for ti, (x, y, th) in zip(t, poses):
+            f.write("%.9f %.17g %.17g 0 0 0 %.17g %.17g\n" % (ti, x, y, np.sin(th / 2), np.cos(th / 2)))
+
+
+def groundtruth(drive):
+    a = np.loadtxt(os.path.join(drive, "groundtruth.txt"))
+    return a[:, 0], np.column_stack([a[:, 1], a[:, 2], 2 * np.arctan2(a[:, 6], a[:, 7])])
+
+
+def test_velocities_of_a_circle_are_its_speed_and_turn_rate():
+    v, w, dt = 0.4, 0.7, 0.05                # m/s, rad/s, s
+    t = np.arange(40) * dt
+    th = w * t
+    poses = np.column_stack([v / w * np.sin(th), v / w * (1 - np.cos(th)), th])   # starts at 0 heading +x
+    vel = _motion.velocities(t, poses)
+    # the chord over one interval: (v/w) sin(w dt) forward, (v/w)(1 - cos(w dt)) left
+    np.testing.assert_allclose(vel.vx, v / w * np.sin(w * dt) / dt, rtol=1e-9)
+    np.testing.assert_allclose(vel.vy, v / w * (1 - np.cos(w * dt)) / dt, rtol=1e-9)
+    np.testing.assert_allclose(vel.omega, w, rtol=1e-9)
+
+
+def test_velocities_from_the_data_set_equal_finite_differences_of_its_ground_truth(drive):
+    series = _io.read_dataset(str(drive))
+    t, gt = groundtruth(drive)
+    vel = _motion.velocities(series.times, series.groundtruth)
+    expected = true_motions(gt) / np.diff(t)[:, None]
+    np.testing.assert_allclose(np.column_stack([vel.vx, vel.vy, vel.omega]), expected, atol=1e-6)
+
+
+def test_trajectory_lines_are_matched_to_frames_and_may_skip_some(drive, tmp_path):
+    series = _io.read_dataset(str(drive))
+    keep = np.arange(0, len(series.times), 3)
+    t, gt = groundtruth(drive)
+    write_tum(tmp_path / "t.txt", t[keep] + 2e-5, gt[keep])
+    frames = _motion.match_frames(_io.read_tum(str(tmp_path / "t.txt")), series)
+    np.testing.assert_array_equal(frames, keep)
+
+
+def test_fitted_slope_equals_polyfit():
+    rng = np.random.default_rng(3)
+    x = rng.uniform(-1, 1, 500)
+    y = 0.93 * x + 0.02 + rng.normal(0, 0.05, 500)
+    fit = _motion.fit_line(x, y)
+    slope, intercept = np.polyfit(x, y, 1)
+    assert fit.slope == pytest.approx(slope, rel=1e-10)
+    assert fit.intercept == pytest.approx(intercept, abs=1e-12)
+
+
+def test_lost_and_degraded_spans_from_a_handwritten_csv(tmp_path):
+    status = ["first", "ok", "lost", "lost", "ok", "degraded", "ok", "skipped", "degraded", "degraded"]
+    path = tmp_path / "stats.csv"
+    with open(path, "w") as f:
+        f.write("timestamp,vx,vy,omega,iterations,final_cost,inlier_fraction,ms,status\n")
+        for k, s in enumerate(status):
+            f.write("%.9f,0,0,0,3,0.5,0.9,7.5,%s\n" % (0.1 * k, s))
+    st = _io.read_stats(str(path))
+    assert _motion.status_runs(st["status"], "lost") == [(2, 3)]
+    assert _motion.status_runs(st["status"], "degraded") == [(5, 5), (8, 9)]
+    spans = _motion.status_spans(st["timestamp"], st["status"], "lost")
+    np.testing.assert_allclose(spans, [(0.15, 0.35)])
+
+
+def png_ok(path, width_px, height_px):
+    import matplotlib.image as mpimg
+    with open(path, "rb") as f:
+        assert f.read(8) == b"\x89PNG\r\n\x1a\n"
+    img = mpimg.imread(path)
+    assert img.shape[1] == width_px and img.shape[0] == height_px
+    assert img[..., :3].var() > 1e-3           # not blank
+
+
+def test_track_figures_are_written(drive, tmp_path):
+    t, gt = groundtruth(drive)
+    write_tum(tmp_path / "traj.txt", t, gt + np.array([0.001, 0, 0]))
+    with open(tmp_path / "stats.csv", "w") as f:
+        f.write("timestamp,vx,vy,omega,iterations,final_cost,inlier_fraction,ms,status\n")
+        for k, ti in enumerate(t):
+            f.write("%.9f,0,0,0,%d,0.5,0.9,7.5,%s\n" % (ti, 3 + k % 4, "lost" if k in (5, 6) else "ok"))
+    r = run_plot("track", drive, "--trajectory", tmp_path / "traj.txt", "--stats", tmp_path / "stats.csv",
+                 "--out-dir", tmp_path / "out", "--format", "png,svg")
+    assert r.returncode == 0, r.stderr
+    from planarvo.plot import _style
+    for name in ("trajectory", "velocity", "velocity_hist", "tracking"):
+        fig_h = {"trajectory": 5.6, "velocity": 5.0, "velocity_hist": 3.4, "tracking": 6.4}[name]
+        png_ok(tmp_path / "out" / (name + ".png"), round(_style.WIDTH_IN * _style.DPI), round(fig_h * _style.DPI))
+        assert os.path.getsize(tmp_path / "out" / (name + ".svg")) > 1000
+
+
+def test_without_ground_truth_the_histogram_is_left_out(drive, tmp_path):
+    d = tmp_path / "nogt"
+    shutil.copytree(drive, d)
+    t, gt = groundtruth(drive)
+    os.remove(d / "groundtruth.txt")
+    write_tum(tmp_path / "traj.txt", t, gt)
+    r = run_plot("track", d, "--trajectory", tmp_path / "traj.txt", "--out-dir", tmp_path / "out")
+    assert r.returncode == 0, r.stderr
+    assert (tmp_path / "out" / "trajectory.png").exists()
+    assert not (tmp_path / "out" / "velocity_hist.png").exists()
+
+
+def test_a_time_that_matches_no_frame_and_an_empty_trajectory_exit_2(drive, tmp_path):
+    t, gt = groundtruth(drive)
+    t_bad = t.copy()
+    t_bad[4] += 0.01
+    write_tum(tmp_path / "bad.txt", t_bad, gt)
+    r = run_plot("track", drive, "--trajectory", tmp_path / "bad.txt", "--out-dir", tmp_path / "o1")
+    assert r.returncode == 2
+    assert not (tmp_path / "o1" / "trajectory.png").exists()
+    (tmp_path / "empty.txt").write_text("# timestamp x y z qx qy qz qw\n")
+    r = run_plot("track", drive, "--trajectory", tmp_path / "empty.txt", "--out-dir", tmp_path / "o2")
+    assert r.returncode == 2
+
+
+def se2_matrix(p):
+    c, s = np.cos(p[2]), np.sin(p[2])
+    return np.array([[c, -s, p[0]], [s, c, p[1]], [0, 0, 1]])
+
+
+def synthetic_pairs(z, n, rng, noise):
+    """Odometry motions and the sensor's, m_s = S_1/h(T^-1 W T) by 3x3 matrices (independent of
+    the code under test), odometry perturbed by noise (m, m, rad)."""
+    T = se2_matrix([z[0], z[1], z[3]])
+    pairs = []
+    for _ in range(n):
+        w = np.array([rng.uniform(-0.02, 0.03), rng.uniform(-0.002, 0.002), rng.uniform(-0.08, 0.08)])
+        m = np.linalg.inv(T) @ se2_matrix(w) @ T
+        s = np.array([m[0, 2] / z[2], m[1, 2] / z[2], np.arctan2(m[1, 0], m[0, 0])])
+        wn = w + rng.normal(0, 1, 3) * noise
+        pairs.append(planarvo.MotionPair(1 / 30, planarvo.SE2(*s), planarvo.SE2(*wn)))
+    return pairs
+
+
+def arrays(pairs):
+    odo = np.array([[p.odometry.x, p.odometry.y, p.odometry.theta] for p in pairs])
+    sen = np.array([[p.sensor.x, p.sensor.y, p.sensor.theta] for p in pairs])
+    return odo, sen
+
+
+def test_residuals_vanish_on_noise_free_pairs_at_the_true_values():
+    z = (0.25, -0.02, 0.18, -0.16)
+    odo, sen = arrays(synthetic_pairs(z, 50, np.random.default_rng(1), 0.0))
+    eye = np.tile(np.eye(3) * 1e-6, (50, 1, 1))
+    res = _residuals.pair_residuals(odo, sen, z, eye, eye)
+    assert np.abs(res.d).max() < 1e-12
+    res = _residuals.pair_residuals(odo, sen, (0.26, -0.02, 0.18, -0.16), eye, eye)
+    assert np.abs(res.d).max() > 1e-4             # and do not vanish elsewhere
+
+
+def test_residual_chi2_is_the_solvers_at_its_least_squares_optimum():
+    from planarvo.plot import _calibration_data as C
+    z = (0.25, -0.02, 0.18, -0.16)
+    pairs = synthetic_pairs(z, 300, np.random.default_rng(2), np.array([3e-4, 1e-4, 1e-3]))
+    options = planarvo.CalibrationOptions(loss=planarvo.RobustLoss.NONE, gate_sigma=0.0)
+    result = planarvo.calibrate(pairs, options)
+    odo, sen = arrays(pairs)
+    s_cov, o_cov, fit = C.covariances(pairs, options, odo, sen)
+    assert not fit
+    res = _residuals.pair_residuals(odo, sen, result.value, o_cov, s_cov)
+    # The C API reports final_chi2 as 2 x the solver's final cost (capi/graph.cpp), and the
+    # solver's cost is already the sum of e' Omega e over the factors (normal_equations_assembly.cpp).
+    assert res.chi2.sum() == pytest.approx(result.summary.final_chi2 / 2, rel=1e-6)
+    # Moving off the optimum raises it.
+    off = np.array(result.value) + np.array([1e-3, 0, 0, 0])
+    assert _residuals.pair_residuals(odo, sen, off, o_cov, s_cov).chi2.sum() > res.chi2.sum() + 1.0
