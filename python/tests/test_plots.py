@@ -187,9 +187,8 @@ def test_residual_chi2_is_the_solvers_at_its_least_squares_optimum():
     s_cov, o_cov, fit = C.covariances(pairs, options, odo, sen)
     assert not fit
     res = _residuals.pair_residuals(odo, sen, result.value, o_cov, s_cov)
-    # The C API reports final_chi2 as 2 x the solver's final cost (capi/graph.cpp), and the
-    # solver's cost is already the sum of e' Omega e over the factors (normal_equations_assembly.cpp).
-    assert res.chi2.sum() == pytest.approx(result.summary.final_chi2 / 2, rel=1e-6)
+    # final_chi2 is the sum of e' Omega e over the factors at the optimum (planarvo.h).
+    assert res.chi2.sum() == pytest.approx(result.summary.final_chi2, rel=1e-6)
     # Moving off the optimum raises it.
     off = np.array(result.value) + np.array([1e-3, 0, 0, 0])
     assert _residuals.pair_residuals(odo, sen, off, o_cov, s_cov).chi2.sum() > res.chi2.sum() + 1.0

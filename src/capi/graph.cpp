@@ -210,7 +210,8 @@ planarvo_calibration_result calibration_result_to_c(const planarvo::graph::Calib
   out.ok = r.ok();
   planarvo::capi::copy_string(out.unobservable_reason, sizeof out.unobservable_reason, r.unobservable_reason);
   out.summary.struct_size = sizeof out.summary;
-  fill_summary(r.summary, 2.0 * r.summary.initial_cost, 2.0 * r.summary.final_cost, &out.summary);
+  // The solver's cost is already the sum of e' Omega e (graph/normal_equations_assembly.cpp).
+  fill_summary(r.summary, r.summary.initial_cost, r.summary.final_cost, &out.summary);
   out.total_iterations = r.total_iterations;
   out.total_seconds = r.total_time_s;
   out.variance_factor = r.variance_factor;
