@@ -21,6 +21,7 @@ from ._context import Context, DeviceInfo, list_devices, version
 from ._dataset import Dataset, DatasetInfo, FrameData, bag_topics
 from ._errors import Error, Status
 from ._evaluation import MotionAccuracy, evaluate_motions
+from ._mosaic import Mosaic, MosaicInfo, build_mosaic, read_tum
 from ._motion_pairs import MotionPair, load_motion_pairs, save_motion_pairs, track_motions
 from ._output import StatsWriter, write_tum
 from ._posegraph import PosegraphInit, SolverSummary, posegraph_optimize
@@ -34,8 +35,8 @@ __version__ = _lib.planarvo_version_string().decode()
 __all__ = ["EXTRINSICS_NAMES", "CalibrationMethod", "CalibrationOptions", "CalibrationResult",
     "CalibrationStatus", "Camera", "CameraCalibrationOptions", "CameraCalibrationResult", "CameraCalibrator",
     "Context", "Dataset", "DatasetInfo", "DeviceInfo", "Error", "Extrinsics", "FrameData", "MotionAccuracy",
-    "MotionPair", "MotionProfile", "PosegraphInit", "RobustLoss", "RollPitch", "RollPitchOptions",
+    "Mosaic", "MosaicInfo", "MotionPair", "MotionProfile", "PosegraphInit", "RobustLoss", "RollPitch", "RollPitchOptions",
     "RollPitchResult", "SE2", "SimOptions", "SolverSummary", "StatsWriter", "Status", "Tracker",
     "TrackerOptions", "TrackResult", "TrackStatus", "bag_topics", "calibrate", "calibrate_dataset", "compose_extrinsics",
-    "default_texture", "evaluate_motions", "list_devices", "load_motion_pairs", "posegraph_optimize",
+    "build_mosaic", "default_texture", "evaluate_motions", "list_devices", "load_motion_pairs", "posegraph_optimize", "read_tum",
     "save_motion_pairs", "simulate", "track_motions", "version", "write_tum"]

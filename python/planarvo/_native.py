@@ -186,6 +186,20 @@ class CameraCalibrationResult(ctypes.Structure):
                 ("seconds_graph", c_double), ("seconds_total", c_double)]
 
 
+class MosaicOptions(ctypes.Structure):
+    _fields_ = [("struct_size", c_size_t), ("resolution", c_double), ("max_range", c_double),
+                ("frame_spacing", c_double), ("estimate_gain", c_int32), ("max_side", c_int32),
+                ("progress", PROGRESS_FN), ("progress_user_data", c_void_p)]
+
+
+class MosaicInfo(ctypes.Structure):
+    _fields_ = [("struct_size", c_size_t), ("width", c_int32), ("height", c_int32), ("resolution", c_double),
+                ("origin_x", c_double), ("origin_y", c_double), ("frames_given", c_int64), ("frames_used", c_int64),
+                ("covered_pixels", c_int64), ("gain_min", c_double), ("gain_max", c_double),
+                ("peak_tile_bytes", c_int64), ("seconds_decode", c_double), ("seconds_warp", c_double),
+                ("seconds_blend", c_double), ("seconds_total", c_double)]
+
+
 def sized(struct_type):
     """A zeroed instance of a versioned struct with its struct_size set."""
     s = struct_type()
@@ -221,6 +235,14 @@ _SIGNATURES = {
     "planarvo_dataset_frame_data": (S, [c_void_p, c_int64, P(FrameData)]),
     "planarvo_dataset_frame": (S, [c_void_p, c_int64, P(Image)]),
     "planarvo_write_tum": (S, [c_char_p, P(c_double), P(SE2), c_size_t]),
+    "planarvo_read_tum": (S, [c_char_p, P(c_double), P(SE2), c_size_t, P(c_size_t)]),
+    "planarvo_mosaic_options_init": (None, [P(MosaicOptions)]),
+    "planarvo_mosaic_build": (S, [c_void_p, c_void_p, P(Extrinsics), P(c_double), P(SE2), c_size_t,
+                                  P(MosaicOptions), P(c_void_p)]),
+    "planarvo_mosaic_destroy": (None, [c_void_p]),
+    "planarvo_mosaic_info_get": (S, [c_void_p, P(MosaicInfo)]),
+    "planarvo_mosaic_image": (S, [c_void_p, P(Image)]),
+    "planarvo_mosaic_save": (S, [c_void_p, c_char_p]),
     "planarvo_stats_writer_open": (S, [c_char_p, P(c_void_p)]),
     "planarvo_stats_writer_add": (S, [c_void_p, P(FrameStats)]),
     "planarvo_stats_writer_close": (S, [c_void_p]),
