@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <future>
 #include <iomanip>
 #include <locale>
 #include <sstream>
@@ -145,24 +146,24 @@ class Blender {
   // The gain that brings this frame's samples to the mosaic's values where the mosaic is already
   // well covered (total weight at least 1): the ratio of the weighted means. NaN when too few
   // pixels overlap (under 5% of the frame's).
-  double gain(const cv::Mat& samples, const Window& w) const {
+  double gain(const cv::Mat& samples, const Window& w) {
     double sm = 0, sf = 0;
     int64_t seen = 0, overlap = 0;
     for (int r = 0; r < w.height; ++r) {
       const cv::Vec2f* s = samples.ptr<cv::Vec2f>(r);
-      const int gy = w.y + r;
-      for (int c = 0; c < w.width; ++c) {
-        const float wt = s[c][1];
-        if (wt <= 0.0f) continue;
-        ++seen;
-        const Tile* t = tile_at(w.x + c, gy);
-        if (!t || t->sum.empty()) continue;
-        const size_t i = index_in_tile(w.x + c, gy);
-        if (t->weight[i] < 1.0f) continue;
-        ++overlap;
-        sm += wt * (t->sum[i] / t->weight[i]);
-        sf += wt * s[c][0];
-      }
+      for_row_runs(w.y + r, w.x, w.width, [&](Tile& t, size_t i0, int c0, int n) {
+        for (int c = c0; c < c0 + n; ++c) {
+          const float wt = s[c][1];
+          if (wt <= 0.0f) continue;
+          ++seen;
+          if (t.sum.empty()) continue;
+          const size_t i = i0 + static_cast<size_t>(c - c0);
+          if (t.weight[i] < 1.0f) continue;
+          ++overlap;
+          sm += wt * (t.sum[i] / t.weight[i]);
+          sf += wt * s[c][0];
+        }
+      });
     }
     if (overlap < seen / 20 || overlap == 0 || !(sf > 0)) return std::nan("");
     return sm / sf;
@@ -171,16 +172,21 @@ class Blender {
   void add(const cv::Mat& samples, const Window& w, float gain) {
     for (int r = 0; r < w.height; ++r) {
       const cv::Vec2f* s = samples.ptr<cv::Vec2f>(r);
-      const int gy = w.y + r;
-      for (int c = 0; c < w.width; ++c) {
-        const float wt = s[c][1];
-        if (wt <= 0.0f) continue;
-        Tile& t = *tile_at(w.x + c, gy);
-        if (t.sum.empty()) allocate(t);
-        const size_t i = index_in_tile(w.x + c, gy);
-        t.sum[i] += wt * gain * s[c][0];
-        t.weight[i] += wt;
-      }
+      for_row_runs(w.y + r, w.x, w.width, [&](Tile& t, size_t i0, int c0, int n) {
+        float* sum = nullptr;
+        float* weight = nullptr;
+        for (int c = c0; c < c0 + n; ++c) {
+          const float wt = s[c][1];
+          if (wt <= 0.0f) continue;
+          if (!sum) {
+            if (t.sum.empty()) allocate(t);
+            sum = t.sum.data() + i0 - static_cast<size_t>(c0);
+            weight = t.weight.data() + i0 - static_cast<size_t>(c0);
+          }
+          sum[c] += wt * gain * s[c][0];
+          weight[c] += wt;
+        }
+      });
     }
   }
 
@@ -213,6 +219,20 @@ class Blender {
   int64_t peak_bytes() const { return peak_; }
 
  private:
+  // f(tile, index of the run's first pixel in the tile, first window column, length) for each
+  // run of window row gy (mosaic row) from mosaic column x0, width columns, within one tile.
+  template <class F>
+  void for_row_runs(int gy, int x0, int width, F f) {
+    const size_t row = static_cast<size_t>(gy / tile_) * static_cast<size_t>(nx_);
+    const size_t in_row = static_cast<size_t>(gy % tile_) * static_cast<size_t>(tile_);
+    for (int c = 0; c < width;) {
+      const int gx = x0 + c;
+      const int tx = gx / tile_;
+      const int n = std::min(width - c, (tx + 1) * tile_ - gx);
+      f(tiles_[row + static_cast<size_t>(tx)], in_row + static_cast<size_t>(gx % tile_), c, n);
+      c += n;
+    }
+  }
   template <class F>
   void for_tiles(const Window& w, F f) const {
     if (w.empty()) return;
@@ -370,32 +390,43 @@ Mosaic build_mosaic(ocl::Runtime& runtime, io::Dataset& dataset, const Extrinsic
   m.stats.frames_given = static_cast<int64_t>(frames.size());
   m.stats.frames_used = static_cast<int64_t>(used.size());
   m.stats.gain_min = m.stats.gain_max = 1.0;
+  // Frames are decoded one ahead on a second thread (the only user of the data set meanwhile),
+  // so decoding overlaps the warp and the blending.
+  double decode_seconds = 0;  // the decoding thread's, read after each get()
+  const auto decode = [&](size_t k) {
+    const Clock::time_point t = Clock::now();
+    cv::Mat f = windows[k].empty() ? cv::Mat() : dataset.frame(frames[used[k]].frame).clone();
+    decode_seconds += seconds_since(t);
+    return f;
+  };
+  std::future<cv::Mat> next = std::async(std::launch::async, decode, size_t{0});
   for (size_t k = 0; k < used.size(); ++k) {
     if (options.progress && !options.progress(static_cast<double>(k) / static_cast<double>(used.size()), "mosaic"))
       throw Error(ErrorCode::Cancelled, "mosaic: cancelled");
+    Clock::time_point t = Clock::now();
+    const cv::Mat frame = next.get();
+    m.stats.seconds_decode_wait += seconds_since(t);
+    if (k + 1 < used.size()) next = std::async(std::launch::async, decode, k + 1);
     const Window& w = windows[k];
-    if (!w.empty()) {
-      const PosedFrame& f = frames[used[k]];
-      Clock::time_point t = Clock::now();
-      const cv::Mat frame = dataset.frame(f.frame);
-      m.stats.seconds_decode += seconds_since(t);
-      t = Clock::now();
-      warp.run(frame, warp_params(setup, f.pose, m.grid, w), w.width, w.height, &samples);
-      m.stats.seconds_warp += seconds_since(t);
-      t = Clock::now();
-      double g = 1.0;
-      if (options.estimate_gain && k > 0) {
-        g = blender.gain(samples, w);
-        g = std::isfinite(g) ? std::clamp(g, 0.25, 4.0) : last_gain;
-      }
-      last_gain = g;
-      m.stats.gain_min = std::min(m.stats.gain_min, g);
-      m.stats.gain_max = std::max(m.stats.gain_max, g);
-      blender.add(samples, w, static_cast<float>(g));
-      blender.finish_after(static_cast<int64_t>(k), &m.stats.covered_pixels);
-      m.stats.seconds_blend += seconds_since(t);
+    if (w.empty()) continue;
+    const PosedFrame& f = frames[used[k]];
+    t = Clock::now();
+    warp.run(frame, warp_params(setup, f.pose, m.grid, w), w.width, w.height, &samples);
+    m.stats.seconds_warp += seconds_since(t);
+    t = Clock::now();
+    double g = 1.0;
+    if (options.estimate_gain && k > 0) {
+      g = blender.gain(samples, w);
+      g = std::isfinite(g) ? std::clamp(g, 0.25, 4.0) : last_gain;
     }
+    last_gain = g;
+    m.stats.gain_min = std::min(m.stats.gain_min, g);
+    m.stats.gain_max = std::max(m.stats.gain_max, g);
+    blender.add(samples, w, static_cast<float>(g));
+    blender.finish_after(static_cast<int64_t>(k), &m.stats.covered_pixels);
+    m.stats.seconds_blend += seconds_since(t);
   }
+  m.stats.seconds_decode = decode_seconds;
   if (options.progress) options.progress(1.0, "mosaic");
   m.image = blender.image();
   m.stats.peak_tile_bytes = blender.peak_bytes();

@@ -6,7 +6,6 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
-#include <regex>
 #include <string>
 #include <vector>
 
@@ -15,6 +14,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "common/capi_util.h"
+#include "common/mosaic_check.h"
 #include "common/test_util.h"
 #include "io/formats.h"
 
@@ -30,99 +30,17 @@ struct MosaicDeleter {
 };
 using ApiMosaic = std::unique_ptr<planarvo_mosaic, MosaicDeleter>;
 
-struct MapYaml {
-  std::string image;
-  double resolution = 0, x = 0, y = 0, yaw = 0;
-};
+using test::Ground;
+using test::MapYaml;
+using test::read_map_yaml;
 
-// The keys map_server reads, parsed on their own (not with the writer's code).
-MapYaml read_map_yaml(const fs::path& p) {
-  const std::string s = test::read_file(p);
-  MapYaml m;
-  std::smatch r;
-  if (std::regex_search(s, r, std::regex(R"(\nimage: (\S+))"))) m.image = r[1];
-  if (std::regex_search(s, r, std::regex(R"(\nresolution: (\S+))"))) m.resolution = std::stod(r[1]);
-  if (std::regex_search(s, r, std::regex(R"(\norigin: \[([^,]+), ([^,]+), ([^\]]+)\])"))) {
-    m.x = std::stod(r[1]);
-    m.y = std::stod(r[2]);
-    m.yaw = std::stod(r[3]);
-  }
-  return m;
-}
-
-// The simulator's ground: the texture mirror-tiled over the plane, world (X, Y) at texel
-// (X, Y) / texel (SIMULATOR.md), smoothed by a Gaussian of 0.3 mosaic pixels (the mosaic's pixels
-// are point samples of frames that already carry the camera's blur).
-class Ground {
- public:
-  Ground(const std::string& texture, double texel, double resolution) : texel_(texel) {
-    cv::Mat t = cv::imread(texture, cv::IMREAD_GRAYSCALE);
-    EXPECT_FALSE(t.empty()) << texture;
-    t.convertTo(t, CV_32F);
-    cv::Mat flipped_x, flipped_y, flipped_xy, top, bottom;
-    cv::flip(t, flipped_x, 1);
-    cv::flip(t, flipped_y, 0);
-    cv::flip(t, flipped_xy, -1);
-    cv::hconcat(t, flipped_x, top);
-    cv::hconcat(flipped_y, flipped_xy, bottom);
-    cv::vconcat(top, bottom, period_);  // one whole mirror period: the plane tiles it by wrapping
-    const double sigma = 0.3 * resolution / texel;
-    const int pad = static_cast<int>(std::ceil(4 * sigma)) + 1;
-    cv::Mat padded, blurred;
-    cv::copyMakeBorder(period_, padded, pad, pad, pad, pad, cv::BORDER_WRAP);
-    cv::GaussianBlur(padded, blurred, cv::Size(0, 0), sigma);
-    period_ = blurred(cv::Rect(pad, pad, period_.cols, period_.rows)).clone();
-  }
-  double at(double X, double Y) const {
-    const double u = X / texel_, v = Y / texel_;
-    const double u0 = std::floor(u), v0 = std::floor(v);
-    const double fu = u - u0, fv = v - v0;
-    const auto px = [&](double a, double b) {
-      const int c = static_cast<int>(std::fmod(std::fmod(a, period_.cols) + period_.cols, period_.cols));
-      const int r = static_cast<int>(std::fmod(std::fmod(b, period_.rows) + period_.rows, period_.rows));
-      return static_cast<double>(period_.at<float>(r, c));
-    };
-    const double top = px(u0, v0) + fu * (px(u0 + 1, v0) - px(u0, v0));
-    const double bottom = px(u0, v0 + 1) + fu * (px(u0 + 1, v0 + 1) - px(u0, v0 + 1));
-    return top + fv * (bottom - top);
-  }
-
- private:
-  double texel_;
-  cv::Mat period_;
-};
-
-// NCC of the mosaic's seen pixels against the ground at the place the YAML gives, the
-// trajectory's frame mapped to the world by the true first pose.
 double ncc_against_ground(const fs::path& image_path, const Ground& ground, const planarvo_se2& first_true_pose,
                           int64_t* seen = nullptr) {
   const MapYaml y = read_map_yaml(fs::path(image_path).replace_extension(".yaml"));
+  EXPECT_TRUE(y.ok);
   EXPECT_EQ(y.image, image_path.filename().string());
   EXPECT_EQ(y.yaw, 0.0);
-  const cv::Mat m = cv::imread(image_path.string(), cv::IMREAD_UNCHANGED);
-  EXPECT_EQ(m.type(), CV_8UC1);
-  const double c = std::cos(first_true_pose.theta), s = std::sin(first_true_pose.theta);
-  double sa = 0, sb = 0, saa = 0, sbb = 0, sab = 0;
-  int64_t n = 0;
-  for (int row = 0; row < m.rows; ++row)
-    for (int col = 0; col < m.cols; ++col) {
-      const uint8_t v = m.at<uint8_t>(row, col);
-      if (v == 0) continue;
-      // map_server: the lower-left corner of the lower-left pixel at the origin, row 0 at the top.
-      const double x = y.x + (col + 0.5) * y.resolution;
-      const double yy = y.y + (m.rows - row - 0.5) * y.resolution;
-      const double a = v, b = ground.at(first_true_pose.x + c * x - s * yy, first_true_pose.y + s * x + c * yy);
-      sa += a;
-      sb += b;
-      saa += a * a;
-      sbb += b * b;
-      sab += a * b;
-      ++n;
-    }
-  if (seen) *seen = n;
-  if (n == 0) return 0;
-  const double cov = sab - sa * sb / n, va = saa - sa * sa / n, vb = sbb - sb * sb / n;
-  return cov / std::sqrt(va * vb);
+  return test::ncc_against_ground(image_path, ground, first_true_pose.x, first_true_pose.y, first_true_pose.theta, seen);
 }
 
 ApiMosaic build(planarvo_context* ctx, planarvo_dataset* ds, const planarvo_extrinsics& e,
