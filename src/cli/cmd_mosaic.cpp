@@ -1,4 +1,5 @@
 // planarvo mosaic: the floor under a trajectory as one image, with its map_server YAML.
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -61,8 +62,12 @@ int cmd_mosaic(int argc, char** argv) {
   if (!args.has("output")) throw UsageError("-o FILE is required: where to write the mosaic image (floor.png)");
   args.expect_output_files({"output"});
   const std::string out = args.get("output");
-  if (std::filesystem::path(out).extension().empty())
-    throw UsageError("-o " + out + ": give the image's extension (.png)");
+  {
+    std::string ext = std::filesystem::path(out).extension().string();
+    for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    if (ext != ".png" && ext != ".pgm" && ext != ".tif" && ext != ".tiff" && ext != ".bmp")
+      throw UsageError("-o " + out + ": the mosaic is written as .png (or .pgm, .tif, .bmp: lossless formats)");
+  }
   planarvo_mosaic_options o;
   planarvo_mosaic_options_init(&o);
   o.resolution = args.get_double("resolution", o.resolution);

@@ -18,6 +18,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "core/error.h"
+#include "core/output_file.h"
 
 namespace planarvo::mosaic {
 
@@ -441,14 +442,23 @@ void save_mosaic(const Mosaic& mosaic, const std::string& image_path) {
     throw_invalid_argument("mosaic: the image path " + image_path + " has no extension (.png, say)");
   const fs::path yaml = fs::path(img).replace_extension(".yaml");
   if (yaml == img) throw_invalid_argument("mosaic: the image cannot be a .yaml file");
-  bool ok = false;
+  // Both files through OutputFile: each appears complete or not at all, the image first, so a
+  // YAML never names a missing or partial image. PNG at zlib level 1 (OpenCV's default is 3):
+  // the mosaic of the 20-s simulated drive is 17% larger, and written faster.
+  std::vector<uint8_t> bytes;
   try {
-    ok = cv::imwrite(image_path, mosaic.image);
+    if (!cv::imencode(img.extension().string(), mosaic.image, bytes, {cv::IMWRITE_PNG_COMPRESSION, 1}))
+      throw Error(ErrorCode::Io, "cannot encode " + image_path);
   } catch (const cv::Exception& e) {
-    throw Error(ErrorCode::Io, "cannot write " + image_path + ": " + e.what());
+    throw_invalid_argument("mosaic: cannot write an image as " + img.extension().string() + " (" + image_path +
+                           "): " + e.what());
   }
-  if (!ok) throw Error(ErrorCode::Io, "cannot write " + image_path);
-  std::ofstream out(yaml);
+  OutputFile image(image_path);
+  if (std::fwrite(bytes.data(), 1, bytes.size(), image.stream()) != bytes.size())
+    throw Error(ErrorCode::Io, "cannot write " + image_path);
+  image.commit();
+  std::ostringstream out;
+  out.imbue(std::locale::classic());
   out << "# planarvo mosaic: the ground under the trajectory, placed as ROS map_server reads a map.\n"
       << "# origin: the lower-left corner of the lower-left pixel [x, y, yaw] in the trajectory's frame;\n"
       << "# row 0 of the image is its top (+y), columns run along +x. 0: unseen; 1..255: the ground.\n";
@@ -456,8 +466,11 @@ void save_mosaic(const Mosaic& mosaic, const std::string& image_path) {
   out << "resolution: " << shortest(mosaic.grid.resolution) << "\n";
   out << "origin: [" << shortest(mosaic.grid.origin.x()) << ", " << shortest(mosaic.grid.origin.y()) << ", 0.0]\n";
   out << "negate: 0\noccupied_thresh: 0.65\nfree_thresh: 0.196\n";
-  out.flush();
-  if (!out) throw Error(ErrorCode::Io, "cannot write " + yaml.string());
+  const std::string text = out.str();
+  OutputFile yaml_file(yaml.string());
+  if (std::fwrite(text.data(), 1, text.size(), yaml_file.stream()) != text.size())
+    throw Error(ErrorCode::Io, "cannot write " + yaml.string());
+  yaml_file.commit();
 }
 
 }  // namespace planarvo::mosaic

@@ -1,4 +1,4 @@
-"""The command line: python3 -m planarvo.plot {track,calibration,report} ... (docs/outputs.md).
+"""The command line: python3 -m planarvo.plot {track,calibration,report,mosaic} ... (docs/outputs.md).
 
 Exit status 0 when the figures were written, 2 for bad input or usage (with the reason on
 stderr), 1 when something else failed."""
@@ -31,7 +31,7 @@ def _common(p: argparse.ArgumentParser) -> None:
 def _parser() -> argparse.ArgumentParser:
     ap = argparse.ArgumentParser(prog=PROG, description="Figures (PNG, PDF, SVG) and a calibration report "
                                  "(self-contained HTML) from planarvo's output files.")
-    sub = ap.add_subparsers(dest="command", metavar="{track,calibration,report}")
+    sub = ap.add_subparsers(dest="command", metavar="{track,calibration,report,mosaic}")
     t = sub.add_parser("track", help="trajectory, velocity, velocity histogram and tracking figures",
                        description="trajectory.FMT, velocity.FMT, velocity_hist.FMT (needs ground truth) and "
                        "tracking.FMT (needs --stats) from a data set and the trajectory that track wrote.")
@@ -63,6 +63,17 @@ def _parser() -> argparse.ArgumentParser:
     r.add_argument("--truth", help="true extrinsics YAML (default: DATASET/extrinsics_gt.yaml when present)")
     r.add_argument("--windows", type=int, default=4)
     r.add_argument("-o", "--output", required=True, metavar="HTML", help="the HTML file to write")
+    m = sub.add_parser("mosaic", help="floor mosaics in metres, side by side, with the trajectory over them",
+                       description="mosaic.FMT (or --name): each mosaic that planarvo mosaic wrote (its image and "
+                       "map_server YAML) in metric axes, side by side, optionally with a trajectory over it and "
+                       "a zoom, to compare two calibrations or trajectories.")
+    m.add_argument("images", metavar="MOSAIC", nargs="+", help="mosaic images (each with its .yaml beside it)")
+    m.add_argument("--title", action="append", default=[], help="a panel's title, once per mosaic in order "
+                   "(default: the file names)")
+    m.add_argument("--trajectory", help="a TUM trajectory in the mosaics' frame to draw over them")
+    m.add_argument("--zoom", metavar="X0,Y0,X1,Y1", help="show only this box, metres")
+    m.add_argument("--name", default="mosaic", help="the figure's file stem (default mosaic)")
+    _common(m)
     return ap
 
 
@@ -81,6 +92,11 @@ def _run(args: argparse.Namespace) -> List[str]:
         os.makedirs(args.out_dir, exist_ok=True)
         from ._calibration_command import plot_calibration
         return plot_calibration(args)
+    if args.command == "mosaic":
+        formats = _formats(args.format)
+        os.makedirs(args.out_dir, exist_ok=True)
+        from ._mosaic_figure import mosaic_figure
+        return mosaic_figure(args.images, args.title, args.trajectory, args.zoom, args.out_dir, args.name, formats)
     from ._report import full_report
     return full_report(args)
 
