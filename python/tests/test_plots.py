@@ -192,3 +192,31 @@ def test_residual_chi2_is_the_solvers_at_its_least_squares_optimum():
     # Moving off the optimum raises it.
     off = np.array(result.value) + np.array([1e-3, 0, 0, 0])
     assert _residuals.pair_residuals(odo, sen, off, o_cov, s_cov).chi2.sum() > res.chi2.sum() + 1.0
+
+
+def test_mosaic_figure_reads_the_map_yaml_and_draws_each_mosaic(tmp_path):
+    from PIL import Image
+    from planarvo.plot import _mosaic_figure
+    rng = np.random.default_rng(3)
+    image = rng.integers(1, 256, size=(120, 200), dtype=np.uint8)
+    image[:, :40] = 0  # unseen
+    Image.fromarray(image).save(tmp_path / "a.png")
+    (tmp_path / "a.yaml").write_text("image: a.png\nresolution: 0.002\norigin: [-0.1, 0.25, 0.0]\n"
+                                     "negate: 0\noccupied_thresh: 0.65\nfree_thresh: 0.196\n")
+    shutil.copy(tmp_path / "a.png", tmp_path / "b.png")
+    (tmp_path / "b.yaml").write_text("image: b.png\nresolution: 0.002\norigin: [0.0, 0.25, 0.0]\n")
+    read, res, ox, oy = _mosaic_figure.read_map(str(tmp_path / "a.png"))
+    assert np.array_equal(read, image) and (res, ox, oy) == (0.002, -0.1, 0.25)
+    write_tum(tmp_path / "traj.txt", [0.0, 1.0], np.array([[0.0, 0.3, 0.0], [0.2, 0.4, 0.5]]))
+    r = run_plot("mosaic", tmp_path / "a.png", tmp_path / "b.png", "--title", "one", "--title", "two",
+                 "--trajectory", tmp_path / "traj.txt", "--zoom", "0,0.26,0.2,0.45", "--out-dir", tmp_path / "out")
+    assert r.returncode == 0, r.stderr
+    from PIL import Image as I
+    with I.open(tmp_path / "out" / "mosaic.png") as im:
+        assert im.size[0] == 1125 and np.asarray(im.convert("L")).std() > 10
+    # Bad input: a YAML without an origin, a title count that does not match, a bad zoom box.
+    (tmp_path / "b.yaml").write_text("image: b.png\nresolution: 0.002\n")
+    assert run_plot("mosaic", tmp_path / "b.png", "--out-dir", tmp_path / "out").returncode == 2
+    assert run_plot("mosaic", tmp_path / "a.png", "--title", "x", "--title", "y",
+                    "--out-dir", tmp_path / "out").returncode == 2
+    assert run_plot("mosaic", tmp_path / "a.png", "--zoom", "1,1,0,0", "--out-dir", tmp_path / "out").returncode == 2

@@ -4,6 +4,7 @@
 // wrong calibration must show. `planarvo mosaic` as a user runs it gives the same image; bad
 // input is exit code 2.
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -102,7 +103,9 @@ TEST(Mosaic, MatchesTheGroundTextureWhereItsYamlPlacesIt) {
     std::ofstream(dir / "shifted.yaml") << "# shifted\nimage: shifted.png\nresolution: " << y.resolution << "\norigin: ["
                                         << y.x + 3 * y.resolution << ", " << y.y << ", 0.0]\n";
     fs::copy_file(png, dir / "shifted.png");
-    EXPECT_LT(ncc_against_ground(dir / "shifted.png", ground, frames[0].data.groundtruth), 0.6);
+    const double ncc_shifted = ncc_against_ground(dir / "shifted.png", ground, frames[0].data.groundtruth);
+    std::printf("NCC against the ground: %.3f; moved by 3 pixels: %.3f\n", ncc, ncc_shifted);
+    EXPECT_LT(ncc_shifted, 0.6);
   }
 
   // A wrong calibration (yaw 3 degrees and x 15 mm off) blurs and doubles the texture.
@@ -113,6 +116,7 @@ TEST(Mosaic, MatchesTheGroundTextureWhereItsYamlPlacesIt) {
   ASSERT_TRUE(bad);
   ASSERT_EQ(planarvo_mosaic_save(bad.get(), (dir / "wrong.png").c_str()), PLANARVO_OK);
   const double ncc_wrong = ncc_against_ground(dir / "wrong.png", ground, frames[0].data.groundtruth);
+  std::printf("NCC with a wrong calibration: %.3f\n", ncc_wrong);
   EXPECT_LT(ncc_wrong, ncc - 0.3) << "true " << ncc << ", wrong " << ncc_wrong;
 
   // The tool, from the trajectory `track` wrote, makes the same image and YAML.
