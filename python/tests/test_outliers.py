@@ -15,7 +15,7 @@ from planarvo.plot import _cli
 from planarvo.plot._outliers import track_frame
 
 FRAME = 12
-RECT = (185, 70, 60, 50)  # x, y, width, height in the live frame's (distorted) pixels
+RECT = (140, 150, 30, 25)  # x, y, width, height in the live frame's (distorted) pixels, where the keyframe saw the ground
 
 
 def _matrix(text, key):
@@ -67,19 +67,17 @@ def occluded(drive, tmp_path_factory):
     path = out / rows[FRAME][1]
     img = np.array(Image.open(path))
     x, y, w, h = RECT
-    img[y:y + h, x:x + w] = 250
+    img[y:y + h, x:x + w] = np.clip(img[y:y + h, x:x + w].astype(int) + 60, 0, 255)
     Image.fromarray(img).save(path)
     return out
 
 
-@pytest.mark.skip(reason="fails as of this commit: the rectangle is not found where the true poses put it "
-                  "(the frame is lost and its alignment or this test's geometry is off); to investigate")
 def test_the_pasted_rectangle_is_what_the_robust_norm_down_weights(occluded):
     fr = track_frame(str(occluded), str(occluded / "extrinsics_gt.yaml"), FRAME, 0)
     res = fr.residuals
-    # The tracker's non-robust match check (mean square residual against the keyframe's variance)
-    # calls a frame with a bright occluder this large lost ("images do not match"); its alignment ran,
-    # and the residuals are at it. Whether the alignment is right is the "clear" check below.
+    # The tracker's match check (the mean square residual against the keyframe's variance, not a
+    # robust measure) calls this frame lost, "images do not match", although its alignment holds
+    # (the "clear" check below): the residuals are at that alignment.
     assert fr.status != "lost" or fr.reason == "images do not match"
     u, v = live_pixels(str(occluded), fr.keyframe_frame, FRAME, res.weight.shape)
     x, y, w, h = RECT
@@ -89,7 +87,7 @@ def test_the_pasted_rectangle_is_what_the_robust_norm_down_weights(occluded):
     valid = res.weight > 0
     down = valid & (res.weight < 1)
     blob, clear = inside & valid, ~near & valid
-    assert blob.sum() > 1500 and clear.sum() > 40000
+    assert blob.sum() > 400 and clear.sum() > 40000
     # Nearly all of the rectangle is down-weighted, and far beyond the threshold (weight k / |r|).
     assert down[blob].mean() > 0.95
     assert np.median(res.weight[blob]) < 0.3
