@@ -372,6 +372,33 @@ PLANARVO_API planarvo_status planarvo_tracker_track(planarvo_tracker* tracker,
                                                     planarvo_track_result* result);
 /* Forgets the keyframe and the pose: the next frame is FIRST again. */
 PLANARVO_API planarvo_status planarvo_tracker_reset(planarvo_tracker* tracker);
+/* The last tracked frame's residuals against the keyframe it was aligned with, for an outlier
+ * overlay (the paper's Figure 20; planarvo plot outliers draws one). Per keyframe pixel of pyramid
+ * `level` (0 = full resolution; every pixel of the level, whatever subsampling tracking used),
+ * row-major, width x height of that level, in the keyframe's undistorted image:
+ *   residual   r = gain * I_live(w(p)) + bias - I_keyframe(p), grey levels, at the final
+ *              alignment (its warp w for that level, its gain and bias); 0 where invalid;
+ *   weight     the Huber weight: 1 for |r| <= k, k / |r| (below 1) for the pixels the robust norm
+ *              down-weighted, 0 where invalid (the keyframe pixel has no valid image, or its warp
+ *              leaves the live frame's valid pixels);
+ *   intensity  the keyframe's undistorted intensity (0..255), NaN where it has none.
+ * k (*threshold, grey levels) is the Huber threshold the tracker used at the finest level it
+ * tracked, at every level asked: 2 x the robust scale in use there (1.4826 x the median |r| of the
+ * frame's first pass at that level, or the previous frame's scale when within 25 % of it).
+ * Any of the arrays and of width, height, threshold may be NULL; with an array, capacity must be
+ * at least width x height (else PLANARVO_ERROR_BUFFER_TOO_SMALL, with *width and *height set):
+ * call with NULL arrays to ask the size. One extra pass on the device when asked (the first call
+ * also builds its kernel); asking again for the same level before the next frame reads it again.
+ * A frame that became the keyframe is still compared with the keyframe it was aligned with. A LOST
+ * frame whose alignment ran (reason "images do not match" or a brightness change) gives its
+ * residuals at that alignment; one that was not aligned (wrong size, too few valid pixels, no
+ * texture, diverged) gives PLANARVO_ERROR_FAILED. PLANARVO_ERROR_INVALID_ARGUMENT before any frame
+ * was tracked after the first (or after a reset), or for a level outside 0..levels-1. */
+PLANARVO_API planarvo_status planarvo_tracker_residuals(planarvo_tracker* tracker, int32_t level,
+                                                        float* residual, float* weight,
+                                                        float* intensity, size_t capacity,
+                                                        int32_t* width, int32_t* height,
+                                                        double* threshold);
 
 /* Accuracy of estimated frame-to-frame motions against true ones (see planarvo track). */
 typedef struct planarvo_motion_accuracy {

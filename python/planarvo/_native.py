@@ -255,6 +255,8 @@ _SIGNATURES = {
     "planarvo_tracker_destroy": (None, [c_void_p]),
     "planarvo_tracker_track": (S, [c_void_p, P(Image), c_double, P(TrackResult)]),
     "planarvo_tracker_reset": (S, [c_void_p]),
+    "planarvo_tracker_residuals": (S, [c_void_p, c_int32, P(ctypes.c_float), P(ctypes.c_float), P(ctypes.c_float),
+                                       c_size_t, P(c_int32), P(c_int32), P(c_double)]),
     "planarvo_evaluate_motions": (S, [P(SE2), P(SE2), P(c_double), P(c_int32), c_size_t, c_double,
                                       P(MotionAccuracy)]),
     "planarvo_posegraph_options_init": (None, [P(PosegraphOptions)]),

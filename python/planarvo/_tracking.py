@@ -61,6 +61,30 @@ class TrackResult:
     ms: float
 
 
+@dataclass
+class Residuals:
+    """The last tracked frame's residuals against its keyframe at one pyramid level (see
+    Tracker.residuals): float32 (height, width) arrays per keyframe pixel. residual: grey levels
+    (0 where invalid); weight: the Huber weight, 1 for inliers, below 1 for the pixels the robust
+    norm down-weighted, 0 where invalid; intensity: the keyframe's undistorted image, NaN where it
+    has none; threshold: the Huber threshold k in grey levels."""
+    level: int
+    residual: np.ndarray
+    weight: np.ndarray
+    intensity: np.ndarray
+    threshold: float
+
+    @property
+    def valid(self) -> np.ndarray:
+        """Pixels compared: a valid keyframe pixel whose warp lands on valid live pixels."""
+        return self.weight > 0
+
+    @property
+    def outliers(self) -> np.ndarray:
+        """Pixels the robust norm down-weighted (|r| > threshold)."""
+        return (self.weight > 0) & (self.weight < 1)
+
+
 class Tracker(_Handle):
     """Dense planar visual odometry (planarvo_tracker): tracks each frame against a keyframe.
 
@@ -93,6 +117,22 @@ class Tracker(_Handle):
                            np.frombuffer(r.covariance, dtype=np.float64).reshape(3, 3).copy(),
                            SE2(r.pose.x, r.pose.y, r.pose.theta), tuple(r.iterations), r.levels_used,
                            r.final_cost, r.inlier_fraction, r.overlap, bool(r.keyframe), r.ms)
+
+    def residuals(self, level: int = 0) -> Residuals:
+        """The last tracked frame's residuals against the keyframe it was aligned with, at pyramid
+        `level` (0: full resolution, every pixel), at the final alignment, with the Huber threshold
+        of the finest level tracked (planarvo_tracker_residuals). Raises Error with status
+        INVALID_ARGUMENT before any frame was tracked after the first or for a level out of
+        range, FAILED when the last frame was LOST without an alignment."""
+        w, h, k = N.c_int32(), N.c_int32(), N.c_double()
+        null = ctypes.POINTER(ctypes.c_float)()
+        _check(lib.planarvo_tracker_residuals(self._h(), int(level), null, null, null, 0, ctypes.byref(w),
+                                              ctypes.byref(h), ctypes.byref(k)))
+        arrays = [np.empty((h.value, w.value), dtype=np.float32) for _ in range(3)]
+        ptr = [a.ctypes.data_as(ctypes.POINTER(ctypes.c_float)) for a in arrays]
+        _check(lib.planarvo_tracker_residuals(self._h(), int(level), ptr[0], ptr[1], ptr[2], arrays[0].size,
+                                              ctypes.byref(w), ctypes.byref(h), ctypes.byref(k)))
+        return Residuals(int(level), arrays[0], arrays[1], arrays[2], k.value)
 
     def reset(self) -> None:
         """Forgets the keyframe and the pose: the next frame is FIRST again."""

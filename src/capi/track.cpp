@@ -188,6 +188,26 @@ PLANARVO_API planarvo_status planarvo_tracker_reset(planarvo_tracker* tracker) {
   });
 }
 
+PLANARVO_API planarvo_status planarvo_tracker_residuals(planarvo_tracker* tracker, int32_t level, float* residual,
+                                                        float* weight, float* intensity, size_t capacity,
+                                                        int32_t* width, int32_t* height, double* threshold) {
+  return guard([&] {
+    require(tracker != nullptr, "planarvo_tracker_residuals: tracker is NULL");
+    require(level >= 0 && level < planarvo::track::kMaxLevels, "planarvo_tracker_residuals: level must be 0..7");
+    const planarvo::track::ResidualImage r = tracker->tracker->residuals(level);
+    const size_t n = static_cast<size_t>(r.width) * static_cast<size_t>(r.height);
+    if (width) *width = r.width;
+    if (height) *height = r.height;
+    if (threshold) *threshold = r.huber_k;
+    if ((residual || weight || intensity) && capacity < n)
+      throw planarvo::capi::BufferTooSmall("planarvo_tracker_residuals: capacity " + std::to_string(capacity) +
+                                           " is less than width x height = " + std::to_string(n));
+    if (residual) std::copy(r.residual.begin(), r.residual.end(), residual);
+    if (weight) std::copy(r.weight.begin(), r.weight.end(), weight);
+    if (intensity) std::copy(r.intensity.begin(), r.intensity.end(), intensity);
+  });
+}
+
 PLANARVO_API planarvo_status planarvo_evaluate_motions(const planarvo_se2* estimated, const planarvo_se2* truth,
                                                        const double* dt, const int32_t* valid, size_t count,
                                                        double gross_threshold, planarvo_motion_accuracy* accuracy) {

@@ -447,6 +447,10 @@ AlignmentReport Aligner::align(std::vector<AlignmentPair>& pairs, Extrinsics* ex
         lambda = lambda == 0.0 ? options_.lambda_min : lambda * options_.lambda_up;
       }
     }
+    if (level == levels.finest) {
+      report.finest_huber_k.resize(P);
+      for (size_t p = 0; p < P; ++p) report.finest_huber_k[p] = options_.huber_factor * pairs[p].sigma[L];
+    }
     for (size_t p = 0; p < P; ++p) pairs[p].sigma[L] = measured[p];
     prev_sums_ = cur_;
     prev_state_ = pairs;

@@ -127,6 +127,10 @@ struct AlignmentReport {
   // does not yet mask the texture, so a residual measured there says whether the images match.
   std::vector<ReduceSums> match_stats;
   std::vector<double> finest_sigma;
+  // Per pair, the Huber threshold k the finest level's passes were weighted with (huber_factor
+  // times the scale in use there: finest_sigma, or the one the pair brought when within
+  // rescale_ratio of it), grey levels.
+  std::vector<double> finest_huber_k;
   // With the orientation: its information (Schur complement of the whole system at the finest
   // level, undamped, unscaled: J^T W J in grey levels^-2 units) and sum of w r^2 and valid pixels
   // over all pairs, for the covariance sigma^2 S^-1.

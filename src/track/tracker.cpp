@@ -25,6 +25,8 @@ constexpr int kMinLevelSide = 8;
 struct Estimate {
   SE2 T;
   double a = 0.0, b = 0.0;
+  double huber_k = 0.0;  // of the alignment that made it: the finest level's threshold, and that level
+  int finest = 0;
 };
 
 Eigen::Matrix3d lost_covariance() { return Eigen::Matrix3d::Identity(); }
@@ -45,6 +47,7 @@ constexpr const char* kWrongSize = "frame size differs from the camera's";
 constexpr const char* kTimeGap = "time gap";
 constexpr const char* kWeak = "motion poorly constrained";
 constexpr const char* kBadTime = "timestamp not increasing";
+constexpr const char* kNotAligned = "not aligned";
 
 // Mean squared gradient (grey levels^2 per pixel^2) a frame needs at the coarsest level to
 // become a keyframe. A flat or black frame has 0, the pixel noise of a flat frame at level 3
@@ -118,6 +121,16 @@ struct Tracker::Impl {
   std::array<double, kMaxLevels> sigma{};  // the robust scale per level, from frame to frame
   std::vector<AlignmentPair> pairs = std::vector<AlignmentPair>(1);
   AlignmentReport report;
+  // The last frame's final alignment for residuals() (has_last), or why there is none (missing;
+  // nullptr: no frame aligned since the first), and the residual image made from it (cached,
+  // level -1: none yet). The copy path's spare keyframe pyramid keeps the keyframe a frame that
+  // became the keyframe was aligned with.
+  AlignmentRecord last;
+  bool has_last = false;
+  const char* missing = nullptr;
+  std::unique_ptr<ResidualImager> imager;
+  ResidualImage cached;
+  Pyramid spare;
 
   Impl(ocl::Runtime& r, const CameraModel& c, const Extrinsics& e, const TrackerOptions& o)
       : rt(r), camera(validated(c, e, o)), ext(e), opt(o), aligner(r, c.K(), o, false), selector(r) {
@@ -125,6 +138,7 @@ struct Tracker::Impl {
   }
 
   void reset() {
+    forget_alignment(nullptr);
     has_keyframe = false;
     pose = SE2();
     prev = Estimate();
@@ -175,6 +189,8 @@ struct Tracker::Impl {
     out->T = pair.motion;
     out->a = pair.log_gain;
     out->b = pair.bias;
+    out->huber_k = report.finest_huber_k.empty() ? 0.0 : report.finest_huber_k[0];
+    out->finest = levels.finest;
     return true;
   }
 
@@ -303,12 +319,13 @@ struct Tracker::Impl {
       keyframe_is_slot = true;
       live_slot ^= 1;
     } else {
-      if (keyframe_is_slot || keyframe.levels.size() != live.levels.size()) keyframe.levels.clear();
-      keyframe_is_slot = false;
+      // Copied into the spare pyramid, which then swaps with the keyframe's: the old keyframe's
+      // contents stay for residuals() until the next frame (no more copying than in place).
+      if (spare.levels.size() != live.levels.size()) spare.levels.clear();
       for (size_t l = 0; l < live.levels.size(); ++l) {
         const PyramidLevel& src = live.levels[l];
-        if (keyframe.levels.size() <= l) keyframe.levels.push_back(PyramidLevel());
-        PyramidLevel& dst = keyframe.levels[l];
+        if (spare.levels.size() <= l) spare.levels.push_back(PyramidLevel());
+        PyramidLevel& dst = spare.levels[l];
         const size_t bytes = static_cast<size_t>(src.width) * src.height * 16;
         if (dst.width != src.width || dst.height != src.height || !dst.data()) {
           dst.width = src.width;
@@ -317,6 +334,9 @@ struct Tracker::Impl {
         }
         rt.queue().enqueueCopyBuffer(src.data, dst.data, 0, 0, bytes);
       }
+      std::swap(keyframe, spare);
+      if (keyframe_is_slot) spare = Pyramid();  // a slot's buffers are the pipeline's, not spare
+      keyframe_is_slot = false;
     }
     const AlignmentLevels levels = aligner.levels(keyframe, keyframe);
     for (int l = 0; l < keyframe.num_levels() && l < kMaxLevels; ++l) {
@@ -331,8 +351,39 @@ struct Tracker::Impl {
     prev_covariance.setZero();
   }
 
+  void forget_alignment(const char* why) {
+    has_last = false;
+    missing = why;
+    cached.level = -1;
+  }
+
+  void remember(const Pyramid& live, const Estimate& est) {
+    last.reference = keyframe;
+    last.live = live;
+    last.motion = est.T;
+    last.log_gain = est.a;
+    last.bias = est.b;
+    last.huber_k = est.huber_k;
+    last.finest_level = est.finest;
+    has_last = true;
+  }
+
+  ResidualImage residuals(int level) {
+    if (!has_last && !missing)
+      throw_invalid_argument("Tracker::residuals: no frame has been aligned with a keyframe yet");
+    if (!has_last)
+      throw Error(ErrorCode::Failed, std::string("Tracker::residuals: the last frame was not aligned (") + missing + ")");
+    if (cached.level != level) {
+      if (!imager) imager = std::make_unique<ResidualImager>(rt, camera.K(), opt.kernel);
+      cached.level = -1;
+      imager->compute(last, ext, level, &cached);
+    }
+    return cached;
+  }
+
   FrameResult track_gray(const uint8_t* gray, int width, int height, size_t stride, double t) {
     if (!gray) throw_invalid_argument("Tracker::track: the image is null");
+    forget_alignment(kNotAligned);  // the pipeline is about to overwrite the live slot
     if (width > 0 && stride < static_cast<size_t>(width))
       throw_invalid_argument("Tracker::track: stride " + std::to_string(stride) + " < width " +
                              std::to_string(width));
@@ -366,6 +417,7 @@ struct Tracker::Impl {
 
   FrameResult track(const Pyramid& live, double t) {
     const auto t0 = std::chrono::steady_clock::now();
+    forget_alignment(kNotAligned);
     FrameResult res;
     res.motion.covariance = lost_covariance();
 
@@ -414,9 +466,13 @@ struct Tracker::Impl {
       return done(res);
     };
 
-    if (!right_size(live)) return lost(kWrongSize, false);
+    if (!right_size(live)) {
+      missing = kWrongSize;
+      return lost(kWrongSize, false);
+    }
 
     if (!has_keyframe) {
+      missing = nullptr;  // nothing to align with: not a failure of this frame's alignment
       // The frame's own texture decides whether it can be the keyframe.
       int coarse = std::min(opt.levels, live.num_levels()) - 1;
       while (coarse > 0 && (live.levels[static_cast<size_t>(coarse)].width < kMinLevelSide ||
@@ -461,6 +517,8 @@ struct Tracker::Impl {
         }
       }
     }
+    if (ok) remember(live, est);  // before a new keyframe replaces the one aligned with
+    else missing = reason;
     if (!ok) return lost(reason, reason != kAlignNoLiveTexture);
     if (res.status == Status::Lost) return lost(res.reason, true);
     if (time_problem && res.status == Status::Ok) {
@@ -500,6 +558,7 @@ FrameResult Tracker::track(const uint8_t* gray, int width, int height, size_t st
   return impl_->track_gray(gray, width, height, stride, timestamp);
 }
 void Tracker::reset() { impl_->reset(); }
+ResidualImage Tracker::residuals(int level) { return impl_->residuals(level); }
 const SE2& Tracker::pose() const { return impl_->pose; }
 const TrackerOptions& Tracker::options() const { return impl_->opt; }
 

@@ -16,6 +16,7 @@
 #include "image/camera.h"
 #include "image/pyramid.h"
 #include "track/aligner.h"
+#include "track/residual_image.h"
 #include "track/warp_reduce.h"
 
 namespace planarvo::ocl {
@@ -150,6 +151,20 @@ class Tracker {
   // frame becomes the keyframe its levels are copied on the device. A pyramid of another
   // size is Lost.
   FrameResult track(const Pyramid& live, double timestamp);
+
+  // The last frame's residual image against the keyframe it was aligned with (residual_image.h),
+  // at pyramid `level` (0: full resolution), every pixel of the level whatever subsampling
+  // tracking used: the final alignment's warp for that level, its brightness, and the Huber
+  // threshold k of the finest level tracked (huber_factor times the robust scale in use there,
+  // AlignmentReport::finest_huber_k). One extra pass of the fused kernel's DEBUG_OUTPUT variant,
+  // made on request only (built on the first); asking again for the same level before the next
+  // frame costs nothing. A frame that became the keyframe is still compared with the keyframe
+  // it was aligned with. A Lost frame whose alignment ran (its images judged not to match, or
+  // its brightness) has its residuals at that alignment; for one without an alignment (wrong
+  // size, too few valid pixels, no live texture, diverged) this is Error(Failed) with the
+  // reason. InvalidArgument before any frame was aligned after the first (or after reset()),
+  // or for a level out of range. With track(Pyramid), the live pyramid must still hold the frame.
+  ResidualImage residuals(int level = 0);
 
   // Forgets the keyframe, the pose, the velocity and the residual scales.
   void reset();

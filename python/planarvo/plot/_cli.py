@@ -1,4 +1,4 @@
-"""The command line: python3 -m planarvo.plot {track,calibration,report,mosaic} ... (docs/outputs.md).
+"""The command line: python3 -m planarvo.plot {track,calibration,outliers,report,mosaic} ... (docs/outputs.md).
 
 Exit status 0 when the figures were written, 2 for bad input or usage (with the reason on
 stderr), 1 when something else failed."""
@@ -31,7 +31,7 @@ def _common(p: argparse.ArgumentParser) -> None:
 def _parser() -> argparse.ArgumentParser:
     ap = argparse.ArgumentParser(prog=PROG, description="Figures (PNG, PDF, SVG) and a calibration report "
                                  "(self-contained HTML) from planarvo's output files.")
-    sub = ap.add_subparsers(dest="command", metavar="{track,calibration,report,mosaic}")
+    sub = ap.add_subparsers(dest="command", metavar="{track,calibration,outliers,report,mosaic}")
     t = sub.add_parser("track", help="trajectory, velocity, velocity histogram and tracking figures",
                        description="trajectory.FMT, velocity.FMT, velocity_hist.FMT (needs ground truth) and "
                        "tracking.FMT (needs --stats) from a data set and the trajectory that track wrote.")
@@ -53,6 +53,15 @@ def _parser() -> argparse.ArgumentParser:
                    "scale at SCALE (1 for a laser) as calibrate --motions --fix-scale does")
     c.add_argument("--report", metavar="HTML", help="also write a self-contained HTML report here")
     _common(c)
+    o = sub.add_parser("outliers", help="the pixels the tracker's robust norm down-weighted in one frame",
+                       description="outliers_N.FMT: tracks frames 0..N with the extrinsics and draws frame N's "
+                       "residuals against its keyframe: the down-weighted pixels over the keyframe's image, and "
+                       "the residual image (the paper's Figure 20).")
+    o.add_argument("dataset", metavar="DATASET", help="the data set folder, bag or MCAP file")
+    o.add_argument("--extrinsics", required=True, help="the camera's extrinsics YAML")
+    o.add_argument("--frame", required=True, type=int, metavar="N", help="the frame (index from 0; at least 1)")
+    o.add_argument("--level", type=int, default=0, metavar="L", help="pyramid level (default 0: full resolution)")
+    _common(o)
     r = sub.add_parser("report", help="track and calibration figures in one HTML file",
                        description="Everything above for one data set: the track figures (with --trajectory) "
                        "and the calibration figures (with --extrinsics), in one self-contained HTML file.")
@@ -97,6 +106,11 @@ def _run(args: argparse.Namespace) -> List[str]:
         os.makedirs(args.out_dir, exist_ok=True)
         from ._mosaic_figure import mosaic_figure
         return mosaic_figure(args.images, args.title, args.trajectory, args.zoom, args.out_dir, args.name, formats)
+    if args.command == "outliers":
+        _formats(args.format)
+        os.makedirs(args.out_dir, exist_ok=True)
+        from ._outliers import plot_outliers
+        return plot_outliers(args)
     from ._report import full_report
     return full_report(args)
 

@@ -195,6 +195,11 @@ PLANARVO_API planarvo_status planarvo_tracker_reset(planarvo_tracker* tracker) {
   return fn ? fn(tracker) : PLANARVO_ERROR_INTERNAL;
 }
 
+PLANARVO_API planarvo_status planarvo_tracker_residuals(planarvo_tracker* tracker, int32_t level, float* residual, float* weight, float* intensity, size_t capacity, int32_t* width, int32_t* height, double* threshold) {
+  PLANARVO_FORWARD(planarvo_tracker_residuals);
+  return fn ? fn(tracker, level, residual, weight, intensity, capacity, width, height, threshold) : PLANARVO_ERROR_INTERNAL;
+}
+
 PLANARVO_API planarvo_status planarvo_evaluate_motions(const planarvo_se2* estimated, const planarvo_se2* truth, const double* dt, const int32_t* valid, size_t count, double gross_threshold, planarvo_motion_accuracy* accuracy) {
   PLANARVO_FORWARD(planarvo_evaluate_motions);
   return fn ? fn(estimated, truth, dt, valid, count, gross_threshold, accuracy) : PLANARVO_ERROR_INTERNAL;

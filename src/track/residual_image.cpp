@@ -1,0 +1,82 @@
+#include "track/residual_image.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include "core/error.h"
+#include "ocl/runtime.h"
+#include "track/warp_model.h"
+
+namespace planarvo::track {
+
+WarpReduceOptions ResidualImager::kernel_options(const WarpReduceOptions& tracker_kernel) {
+  WarpReduceOptions k = tracker_kernel;
+  k.stats = false;
+  k.select_block = 0;  // every pixel of the level
+  k.debug_output = true;
+  return k;
+}
+
+ResidualImager::ResidualImager(ocl::Runtime& runtime, const Eigen::Matrix3d& K, const WarpReduceOptions& kernel)
+    : runtime_(runtime), K_(K), pass_(runtime, kMotionParams, kernel_options(kernel)) {}
+
+ResidualImager::~ResidualImager() = default;
+
+void ResidualImager::compute(const AlignmentRecord& a, const Extrinsics& extrinsics, int level, ResidualImage* out) {
+  const int levels = std::min(a.reference.num_levels(), a.live.num_levels());
+  if (level < 0 || level >= levels)
+    throw_invalid_argument("residual image: level " + std::to_string(level) + " is not one of the pyramid's 0.." +
+                           std::to_string(levels - 1));
+  const PyramidLevel& R = a.reference.levels[static_cast<size_t>(level)];
+  const PyramidLevel& L = a.live.levels[static_cast<size_t>(level)];
+  if (L.width < 2 || L.height < 2)
+    throw_invalid_argument("residual image: level " + std::to_string(level) + " is smaller than 2 x 2 pixels");
+
+  // The final alignment's warp at this level; the generators only feed the sums, unused here.
+  const MotionHomography mh = motion_homography(level_camera_matrix(K_, level), extrinsics, a.motion);
+  WarpInputs in;
+  in.H = mh.H;
+  in.nparam = kMotionParams;
+  for (size_t i = 0; i < static_cast<size_t>(kMotionParams); ++i) in.G[i] = mh.G[i];
+  in.gain = std::exp(a.log_gain);
+  in.bias = a.bias;
+  in.huber_k = a.huber_k;
+
+  const size_t n = static_cast<size_t>(R.width) * static_cast<size_t>(R.height);
+  if (n > debug_capacity_) {
+    debug_ = cl::Buffer(runtime_.context(), CL_MEM_WRITE_ONLY, n * 4 * sizeof(float));
+    debug_capacity_ = n;
+  }
+  ReduceSums sums;
+  pass_.run(R.data, R.width, R.height, L.data, L.width, L.height, in, &sums, &debug_);
+  host_debug_.resize(4 * n);
+  host_ref_.resize(4 * n);
+  cl::CommandQueue& q = runtime_.queue();
+  q.enqueueReadBuffer(debug_, CL_FALSE, 0, n * 4 * sizeof(float), host_debug_.data());
+  q.enqueueReadBuffer(R.data, CL_TRUE, 0, n * 4 * sizeof(float), host_ref_.data());
+
+  out->level = level;
+  out->width = R.width;
+  out->height = R.height;
+  out->residual.resize(n);
+  out->weight.resize(n);
+  out->intensity.resize(n);
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  for (size_t i = 0; i < n; ++i) {
+    // (r, weight, valid, rho): r and the weight are already 0 where the pair is not valid.
+    out->residual[i] = host_debug_[4 * i];
+    out->weight[i] = host_debug_[4 * i + 1];
+    out->intensity[i] = host_ref_[4 * i + 3] != 0.0f ? host_ref_[4 * i] : nan;
+  }
+  out->H = mh.H;
+  out->gain = in.gain;
+  out->bias = in.bias;
+  out->huber_k = in.huber_k;
+  out->tracked_level = a.finest_level;
+  out->valid = sums.valid;
+  out->inliers = sums.inlier;
+}
+
+}  // namespace planarvo::track
