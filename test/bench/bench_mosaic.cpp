@@ -6,7 +6,7 @@
 // texture where its YAML places it (test/common/mosaic_check.h; the trajectory is mapped to the
 // world by the data set's first ground-truth pose). Through the C API, as `planarvo mosaic` uses it.
 //
-//   bench_mosaic DATASET TRAJECTORY.txt EXTRINSICS.yaml [rounds=3] [out=DIR]
+//   bench_mosaic DATASET TRAJECTORY.txt EXTRINSICS.yaml [rounds=3] [out=DIR] [variants=N (the first N)]
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -66,10 +66,12 @@ int main(int argc, char** argv) {
   }
   const std::string dir = argv[1], traj = argv[2];
   int rounds = 3;
+  size_t nvariants = 100;
   fs::path out = fs::temp_directory_path() / "bench_mosaic";
   for (int i = 4; i < argc; ++i) {
     if (std::strncmp(argv[i], "rounds=", 7) == 0) rounds = std::max(1, std::atoi(argv[i] + 7));
     if (std::strncmp(argv[i], "out=", 4) == 0) out = argv[i] + 4;
+    if (std::strncmp(argv[i], "variants=", 9) == 0) nvariants = std::max(1, std::atoi(argv[i] + 9));
   }
   fs::create_directories(out);
   planarvo_extrinsics e{};
@@ -99,7 +101,7 @@ int main(int argc, char** argv) {
   std::printf("%s: %zu poses, %dx%d frames\n\n", dir.c_str(), n, info.camera.width, info.camera.height);
   std::printf("| variant | frames used | image px | decode s | warp s | blend s | build s | tile MB | NCC |\n");
   std::printf("|---|---|---|---|---|---|---|---|---|\n");
-  for (size_t vi = 0; vi < variants.size(); ++vi) {
+  for (size_t vi = 0; vi < std::min(nvariants, variants.size()); ++vi) {
     const Variant& v = variants[vi];
     std::vector<double> dec, warp, blend, total;
     planarvo_mosaic_info mi{};
