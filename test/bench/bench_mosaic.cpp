@@ -13,7 +13,6 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
-#include <regex>
 #include <string>
 #include <vector>
 
@@ -48,12 +47,11 @@ struct Variant {
 // The texture and texel size simulate wrote into simulation.yaml, if any.
 bool simulation_texture(const fs::path& dir, std::string* texture, double* texel) {
   std::ifstream in(dir / "simulation.yaml");
-  const std::string s((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  std::smatch m;
-  if (!std::regex_search(s, m, std::regex(R"(\ntexture: \"?([^\"\n]+)\"?)"))) return false;
-  *texture = m[1];
-  if (!std::regex_search(s, m, std::regex(R"(\ntexel_size: (\S+))"))) return false;
-  *texel = std::stod(m[1]);
+  const std::string s = "\n" + std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  *texture = planarvo::test::yaml_value(s, "texture");
+  const std::string t = planarvo::test::yaml_value(s, "texel_size");
+  if (texture->empty() || t.empty()) return false;
+  *texel = std::stod(t);
   return true;
 }
 
