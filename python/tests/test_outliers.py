@@ -8,11 +8,14 @@ import shutil
 
 import numpy as np
 import pytest
-from PIL import Image
 
-import planarvo
-from planarvo.plot import _cli
-from planarvo.plot._outliers import track_frame
+pytest.importorskip("matplotlib")  # planarvo.plot, and PIL with it (python3-matplotlib)
+
+from PIL import Image  # noqa: E402
+
+import planarvo  # noqa: E402
+from planarvo.plot import _cli  # noqa: E402
+from planarvo.plot._outliers import track_frame  # noqa: E402
 
 FRAME = 12
 RECT = (140, 150, 30, 25)  # x, y, width, height in the live frame's (distorted) pixels, where the keyframe saw the ground
