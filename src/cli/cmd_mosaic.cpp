@@ -80,16 +80,7 @@ int cmd_mosaic(int argc, char** argv) {
   o.frame_spacing = args.has("every-frame") ? -1.0 : args.get_double("frame-spacing", 0.0);
   if (!(o.frame_spacing >= -1.0) || !std::isfinite(o.frame_spacing)) throw UsageError("--frame-spacing must be positive");
   o.estimate_gain = args.has("no-gain") ? 0 : 1;
-  std::string extr = args.get("extrinsics");
-  if (extr.empty() && is_bag_path(dir))
-    throw UsageError("a bag carries no extrinsics: give --extrinsics FILE (planarvo calibrate writes one)");
-  if (extr.empty()) {
-    extr = (std::filesystem::path(dir) / "extrinsics.yaml").string();
-    if (!std::filesystem::exists(extr))
-      throw UsageError("no --extrinsics given and " + extr + " does not exist (calibrate first, or pass the file)");
-  }
-  planarvo_extrinsics e{};
-  check(planarvo_extrinsics_load(extr.c_str(), &e));
+  const planarvo_extrinsics e = extrinsics_for(args, dir);
   ContextPtr ctx = make_context(args);
   Progress progress(!args.has("quiet"));
   DatasetPtr ds = open_dataset(dir, args, false, &progress);

@@ -305,16 +305,7 @@ int cmd_track(int argc, char** argv) {
   const double max_lost = args.get_double("max-lost", 5.0);
   if (!(max_lost >= 0.0 && max_lost <= 100.0))
     throw UsageError("--max-lost must be a percentage within 0..100, not " + args.get("max-lost"));
-  std::string extr = args.get("extrinsics");
-  if (extr.empty() && is_bag_path(dir))
-    throw UsageError("a bag carries no extrinsics: give --extrinsics FILE (planarvo calibrate writes one)");
-  if (extr.empty()) {
-    extr = (std::filesystem::path(dir) / "extrinsics.yaml").string();
-    if (!std::filesystem::exists(extr))
-      throw UsageError("no --extrinsics given and " + extr + " does not exist (calibrate first, or pass the file)");
-  }
-  planarvo_extrinsics e{};
-  check(planarvo_extrinsics_load(extr.c_str(), &e));
+  const planarvo_extrinsics e = extrinsics_for(args, dir);
   ContextPtr ctx = make_context(args);
   Progress progress(!args.has("quiet"));
   DatasetPtr ds = open_dataset(dir, args, false, &progress, args.has("skip-bad-frames"));

@@ -119,6 +119,20 @@ bool is_bag_path(const std::string& path) {
   return fs::is_regular_file(path, ec) || (fs::is_directory(path, ec) && fs::exists(fs::path(path) / "metadata.yaml", ec));
 }
 
+planarvo_extrinsics extrinsics_for(const Args& args, const std::string& dataset) {
+  std::string path = args.get("extrinsics");
+  if (path.empty() && is_bag_path(dataset))
+    throw UsageError("a bag carries no extrinsics: give --extrinsics FILE (planarvo calibrate writes one)");
+  if (path.empty()) {
+    path = (std::filesystem::path(dataset) / "extrinsics.yaml").string();
+    if (!std::filesystem::exists(path))
+      throw UsageError("no --extrinsics given and " + path + " does not exist (calibrate first, or pass the file)");
+  }
+  planarvo_extrinsics e{};
+  check(planarvo_extrinsics_load(path.c_str(), &e));
+  return e;
+}
+
 DatasetPtr open_dataset(const std::string& path, const Args& args, bool verify, Progress* progress,
                         bool allow_missing) {
   if (!is_bag_path(path)) {

@@ -72,6 +72,10 @@ DatasetPtr open_dataset(const std::string& path, const Args& args, bool verify, 
                         bool allow_missing = false);
 // True when path is a file (a bag), not a data set folder.
 bool is_bag_path(const std::string& path);
+// The camera's extrinsics for a command on a data set: --extrinsics FILE, else
+// DATASET/extrinsics.yaml (a bag carries none, so it needs the option); UsageError when neither is
+// there, ApiError when the file does not read.
+planarvo_extrinsics extrinsics_for(const Args& args, const std::string& dataset);
 DatasetPtr open_dataset(const std::string& dir, const std::string& video, bool verify, Progress* progress,
                         bool allow_missing = false);
 

@@ -16,6 +16,20 @@ struct PixelRegion {
   }
 };
 
+// Calls f(u, v) (ints) for the pixels on the border of region r: the top and bottom rows, then
+// the left and right columns, every `step` pixels from the first (step 1: every border pixel).
+template <class F>
+void for_each_border_pixel(const PixelRegion& r, int step, F&& f) {
+  for (int u = r.x; u < r.x + r.width; u += step) {
+    f(u, r.y);
+    f(u, r.y + r.height - 1);
+  }
+  for (int v = r.y; v < r.y + r.height; v += step) {
+    f(r.x, v);
+    f(r.x + r.width - 1, v);
+  }
+}
+
 // The smallest region of interest a camera may have, pixels per side.
 inline constexpr int kMinRegionSide = 16;
 

@@ -62,15 +62,7 @@ std::vector<Eigen::Vector2d> footprint(const WarpSetup& s) {
     }
     pts.push_back(foot + s.max_range * dir.normalized());
   };
-  const int step = 4;
-  for (int x = r.x; x < r.x + r.width; x += step) {
-    add_pixel(x, r.y);
-    add_pixel(x, r.y + r.height - 1);
-  }
-  for (int y = r.y; y < r.y + r.height; y += step) {
-    add_pixel(r.x, y);
-    add_pixel(r.x + r.width - 1, y);
-  }
+  for_each_border_pixel(r, 4, add_pixel);
   add_pixel(r.x + r.width - 1, r.y + r.height - 1);
   // The range circle where the camera sees it.
   const Eigen::Matrix3d R_cv = R.transpose();
@@ -138,9 +130,13 @@ class Blender {
   Blender(const MosaicGrid& grid, int tile, const std::vector<Window>& windows)
       : grid_(grid), tile_(tile), nx_((grid.width + tile - 1) / tile), ny_((grid.height + tile - 1) / tile) {
     tiles_.resize(static_cast<size_t>(nx_) * static_cast<size_t>(ny_));
-    last_use_.assign(tiles_.size(), -1);
+    // Each tile is finished after the last frame whose window touches it.
+    std::vector<int64_t> last_use(tiles_.size(), -1);
     for (size_t k = 0; k < windows.size(); ++k)
-      for_tiles(windows[k], [&](size_t t) { last_use_[t] = static_cast<int64_t>(k); });
+      for_tiles(windows[k], [&](size_t t) { last_use[t] = static_cast<int64_t>(k); });
+    finish_at_.resize(windows.size());
+    for (size_t t = 0; t < tiles_.size(); ++t)
+      if (last_use[t] >= 0) finish_at_[static_cast<size_t>(last_use[t])].push_back(t);
     image_ = cv::Mat::zeros(grid.height, grid.width, CV_8UC1);
   }
 
@@ -192,9 +188,8 @@ class Blender {
   }
 
   // Finishes (to 8 bits) and frees the tiles no later frame touches.
-  void finish_after(int64_t k, int64_t* covered) {
-    for (size_t ti = 0; ti < tiles_.size(); ++ti) {
-      if (last_use_[ti] != k) continue;
+  void finish_after(size_t k, int64_t* covered) {
+    for (const size_t ti : finish_at_[k]) {
       Tile& t = tiles_[ti];
       if (t.sum.empty()) continue;
       const int tx = static_cast<int>(ti % static_cast<size_t>(nx_)), ty = static_cast<int>(ti / static_cast<size_t>(nx_));
@@ -241,10 +236,6 @@ class Blender {
       for (int tx = w.x / tile_; tx <= (w.x + w.width - 1) / tile_; ++tx)
         f(static_cast<size_t>(ty) * static_cast<size_t>(nx_) + static_cast<size_t>(tx));
   }
-  Tile* tile_at(int x, int y) { return &tiles_[static_cast<size_t>(y / tile_) * static_cast<size_t>(nx_) + static_cast<size_t>(x / tile_)]; }
-  const Tile* tile_at(int x, int y) const {
-    return &tiles_[static_cast<size_t>(y / tile_) * static_cast<size_t>(nx_) + static_cast<size_t>(x / tile_)];
-  }
   size_t index_in_tile(int x, int y) const {
     return static_cast<size_t>(y % tile_) * static_cast<size_t>(tile_) + static_cast<size_t>(x % tile_);
   }
@@ -259,7 +250,7 @@ class Blender {
   MosaicGrid grid_;
   int tile_, nx_, ny_;
   std::vector<Tile> tiles_;
-  std::vector<int64_t> last_use_;
+  std::vector<std::vector<size_t>> finish_at_;  // per frame used, the tiles it is the last to touch
   cv::Mat image_;
   int64_t held_ = 0, peak_ = 0;
 };
@@ -396,7 +387,7 @@ Mosaic build_mosaic(ocl::Runtime& runtime, io::Dataset& dataset, const Extrinsic
   double decode_seconds = 0;  // the decoding thread's, read after each get()
   const auto decode = [&](size_t k) {
     const Clock::time_point t = Clock::now();
-    cv::Mat f = windows[k].empty() ? cv::Mat() : dataset.frame(frames[used[k]].frame).clone();
+    cv::Mat f = windows[k].empty() ? cv::Mat() : dataset.frame(frames[used[k]].frame);
     decode_seconds += seconds_since(t);
     return f;
   };
@@ -404,14 +395,12 @@ Mosaic build_mosaic(ocl::Runtime& runtime, io::Dataset& dataset, const Extrinsic
   for (size_t k = 0; k < used.size(); ++k) {
     if (options.progress && !options.progress(static_cast<double>(k) / static_cast<double>(used.size()), "mosaic"))
       throw Error(ErrorCode::Cancelled, "mosaic: cancelled");
-    Clock::time_point t = Clock::now();
     const cv::Mat frame = next.get();
-    m.stats.seconds_decode_wait += seconds_since(t);
     if (k + 1 < used.size()) next = std::async(std::launch::async, decode, k + 1);
     const Window& w = windows[k];
     if (w.empty()) continue;
     const PosedFrame& f = frames[used[k]];
-    t = Clock::now();
+    Clock::time_point t = Clock::now();
     warp.run(frame, warp_params(setup, f.pose, m.grid, w), w.width, w.height, &samples);
     m.stats.seconds_warp += seconds_since(t);
     t = Clock::now();
@@ -424,7 +413,7 @@ Mosaic build_mosaic(ocl::Runtime& runtime, io::Dataset& dataset, const Extrinsic
     m.stats.gain_min = std::min(m.stats.gain_min, g);
     m.stats.gain_max = std::max(m.stats.gain_max, g);
     blender.add(samples, w, static_cast<float>(g));
-    blender.finish_after(static_cast<int64_t>(k), &m.stats.covered_pixels);
+    blender.finish_after(k, &m.stats.covered_pixels);
     m.stats.seconds_blend += seconds_since(t);
   }
   m.stats.seconds_decode = decode_seconds;

@@ -50,9 +50,9 @@ struct MosaicStats {
   int64_t covered_pixels = 0;
   double gain_min = 1, gain_max = 1;
   int64_t peak_tile_bytes = 0;  // float accumulators held at once
-  // Decoding runs on a second thread, one frame ahead: seconds_decode is its time,
-  // seconds_decode_wait the part the build waited for it.
-  double seconds_decode = 0, seconds_decode_wait = 0, seconds_warp = 0, seconds_blend = 0, seconds_total = 0;
+  // Decoding runs on a second thread, one frame ahead: seconds_decode is its time, which overlaps
+  // the warp and the blending.
+  double seconds_decode = 0, seconds_warp = 0, seconds_blend = 0, seconds_total = 0;
 };
 
 struct Mosaic {

@@ -23,17 +23,9 @@ WarpSetup make_warp_setup(const CameraModel& camera, const Extrinsics& extrinsic
   s.max_range = max_range;
   s.feather = feather;
   // The border of the region of interest, every pixel: its undistorted rays bound the domain.
-  const PixelRegion r = camera.region();
   double m = 0;
-  const auto take = [&](double u, double v) { m = std::max(m, camera.unproject({u, v}).squaredNorm()); };
-  for (int x = r.x; x < r.x + r.width; ++x) {
-    take(x, r.y);
-    take(x, r.y + r.height - 1);
-  }
-  for (int y = r.y; y < r.y + r.height; ++y) {
-    take(r.x, y);
-    take(r.x + r.width - 1, y);
-  }
+  for_each_border_pixel(camera.region(), 1,
+                        [&](double u, double v) { m = std::max(m, camera.unproject({u, v}).squaredNorm()); });
   s.max_radius2 = m;
   return s;
 }

@@ -62,15 +62,7 @@ double farthest_ground_view(const CameraModel& camera, const Extrinsics& extrins
   // The border of the region of interest (the whole image by default): a line of the ground is
   // a line of the undistorted image, so the farthest ground point and the horizon a rectangle of
   // pixels sees are on its border (up to the lens distortion's bending).
-  const PixelRegion r = camera.region();
-  for (int u = r.x; u < r.x + r.width; ++u) {
-    look(u, r.y);
-    look(u, r.y + r.height - 1);
-  }
-  for (int v = r.y; v < r.y + r.height; ++v) {
-    look(r.x, v);
-    look(r.x + r.width - 1, v);
-  }
+  for_each_border_pixel(camera.region(), 1, look);
   if (pixel) *pixel = at;
   return farthest;
 }

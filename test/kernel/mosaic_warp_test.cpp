@@ -8,6 +8,7 @@
 
 #include <gtest/gtest.h>
 
+#include "common/random_scene.h"
 #include "mosaic/mosaic_warp.h"
 #include "ocl/runtime.h"
 #include "sim/simulator.h"
@@ -15,29 +16,14 @@
 namespace planarvo::mosaic {
 namespace {
 
+// The render test's random camera, and half of the time a region of interest.
 CameraModel random_camera(sim::Random& r, int w, int h) {
-  CameraModel c = sim::default_camera(w, h, r.uniform(50.0, 90.0));
-  c.fy = c.fx * r.uniform(0.97, 1.03);
-  c.cx += r.uniform(-5, 5);
-  c.cy += r.uniform(-5, 5);
-  c.k1 = r.uniform(-0.15, 0.0);
-  c.k2 = r.uniform(0.0, 0.03);
-  c.p1 = r.uniform(-0.002, 0.002);
-  c.p2 = r.uniform(-0.002, 0.002);
+  CameraModel c = test::random_camera(r, w, h);
   if (r.uniform() < 0.5) c.roi = {static_cast<int>(r.uniform(0, 20)), static_cast<int>(r.uniform(0, 20)), w - 40, h - 30};
   return c;
 }
 
-Extrinsics random_extrinsics(sim::Random& r, double max_tilt_deg) {
-  Extrinsics e;
-  e.x = r.uniform(-0.3, 0.3);
-  e.y = r.uniform(-0.1, 0.1);
-  e.z = r.uniform(0.08, 0.5);
-  e.roll = r.uniform(-max_tilt_deg, max_tilt_deg) * M_PI / 180;
-  e.pitch = r.uniform(-max_tilt_deg, max_tilt_deg) * M_PI / 180;
-  e.yaw = r.uniform(-M_PI, M_PI);
-  return e;
-}
+using test::random_extrinsics;
 
 cv::Mat noise_frame(sim::Random& r, int w, int h) {
   cv::Mat f(h, w, CV_8UC1);
