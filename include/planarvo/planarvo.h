@@ -291,6 +291,14 @@ typedef struct planarvo_sim_options {
   void* progress_user_data;
   double min_turn_radius;     /* PLANARVO_MOTION_CAR: the tightest turn, metres; default 0 (only
                                  max_turn_rate limits it). Read only when struct_size covers it. */
+  /* Light fixed to the camera (a real camera's own lamp, its reflection, the robot's shadow),
+   * each 0 = none (the default). Read only when struct_size covers them. */
+  double lamp_falloff;        /* a lamp beside the lens: the darkest image corner gets 1 - this
+                                 of the brightest point's light; 0..0.95 */
+  double reflection;          /* the lamp's reflection on a glossy floor: peak grey levels added
+                                 (a bright spot that saturates); 0..1000 */
+  double shadow;              /* the robot's shadow over the image's bottom: fraction of light
+                                 taken; 0..0.95 */
 } planarvo_sim_options;
 
 PLANARVO_API void planarvo_sim_options_init(planarvo_sim_options* options);

@@ -33,6 +33,9 @@ PLANARVO_API void planarvo_sim_options_init(planarvo_sim_options* o) {
   o->odometry_noise = d.odometry_noise;
   o->supersampling = d.supersampling;
   o->min_turn_radius = d.min_turn_radius;
+  o->lamp_falloff = d.lamp_falloff;
+  o->reflection = d.reflection;
+  o->shadow = d.shadow;
 }
 
 PLANARVO_API planarvo_status planarvo_sim_default_camera(int32_t width, int32_t height, double fov_deg,
@@ -76,6 +79,11 @@ PLANARVO_API planarvo_status planarvo_simulate(planarvo_context* context, const 
     s.max_turn_rate = o->max_turn_rate;
     if (o->struct_size >= offsetof(planarvo_sim_options, min_turn_radius) + sizeof(double))
       s.min_turn_radius = o->min_turn_radius;
+    if (o->struct_size >= offsetof(planarvo_sim_options, shadow) + sizeof(double)) {
+      s.lamp_falloff = o->lamp_falloff;
+      s.reflection = o->reflection;
+      s.shadow = o->shadow;
+    }
     s.pixel_noise = o->pixel_noise;
     s.gain_variation = o->gain_variation;
     s.odometry_noise = o->odometry_noise;

@@ -51,6 +51,9 @@ std::vector<OptionSpec> simulate_options() {
       {"noise", "SIGMA", "pixel noise standard deviation, grey levels", "1"},
       {"gain-variation", "REL", "amplitude of slow camera gain changes", "0.05"},
       {"odometry-noise", "REL", "wheel odometry error per unit of wheel travel", "0.01"},
+      {"lamp", "F", "a camera-mounted lamp: the darkest corner gets 1 - F of the light (0..0.95)", "0 (even light)"},
+      {"reflection", "GREY", "the lamp's reflection on a glossy floor: peak grey levels added (saturates)", "0"},
+      {"shadow", "F", "the robot's shadow over the image's bottom: fraction of light taken (0..0.95)", "0"},
       {"width", "PX", "image width", "640"},
       {"height", "PX", "image height", "480"},
       {"fov", "DEG", "horizontal field of view", "80"},
@@ -91,6 +94,9 @@ void apply_simulate_args(const Args& a, planarvo_sim_options* o, std::string* te
   o->max_turn_rate = a.get_double("max-turn-rate", o->max_turn_rate);
   o->pixel_noise = a.get_double("noise", o->pixel_noise);
   o->gain_variation = a.get_double("gain-variation", o->gain_variation);
+  o->lamp_falloff = a.get_double("lamp", o->lamp_falloff);
+  o->reflection = a.get_double("reflection", o->reflection);
+  o->shadow = a.get_double("shadow", o->shadow);
   o->odometry_noise = a.get_double("odometry-noise", o->odometry_noise);
   o->supersampling = static_cast<int32_t>(a.get_int("supersampling", o->supersampling));
   planarvo_camera& c = o->camera;

@@ -87,6 +87,13 @@ struct Options {
   int supersampling = 3;            // samples per pixel along each axis (ray tables take
                                     // 8 S^2 + 24 bytes per pixel: 29 MB at 640x480, S = 3)
   bool mipmap = true;               // prefilter the texture (off only for tests/references)
+  // Real-camera light (fixed to the camera, not to the ground; see Lighting below).
+  double lamp_falloff = 0.0;   // a lamp beside the lens: the darkest corner's brightness is
+                               // 1 - lamp_falloff of the brightest point's; 0: even light
+  double reflection = 0.0;     // the lamp's reflection on a glossy floor: peak grey levels added
+                               // (saturates above about 130 on the default texture); 0: none
+  double shadow = 0.0;         // the robot's own shadow over the image's bottom: the fraction of
+                               // light it takes; 0: none
   // Called with the fraction done and the stage; return false to cancel (Error Cancelled).
   std::function<bool(double, const char*)> progress;
 };
@@ -207,6 +214,23 @@ struct Exposure {
   double gain = 1.0, offset = 0.0;
 };
 std::vector<Exposure> exposure_series(const Options& options, const std::vector<double>& t);
+
+// The light fixed to the camera (Options::lamp_falloff, reflection, shadow), per pixel of the
+// camera image: radiance = gain * ground + add. The lamp is a point source beside the lens
+// (centred at 58 % of the width, 42 % of the height): gain = (1 + rho^2)^(-3/2) (inverse square
+// and Lambert's cosine over a plane), rho scaled so that the darkest image corner is at
+// 1 - lamp_falloff. The reflection is a Gaussian spot (sigma 7 % of the width) at 45 % of the
+// width, 62 % of the height, plus a halo a third as bright and three times as wide. The shadow
+// darkens the image below a slanted line through 75 % of the height by `shadow`, with a soft
+// edge 6 px wide. All 1 and 0 when the options are 0.
+struct Lighting {
+  cv::Mat gain, add;  // CV_32FC1, the camera image's size
+  bool empty() const { return gain.empty(); }
+};
+Lighting camera_lighting(const Options& options);
+// image = lighting.gain * image + lighting.add, in place (CV_32FC1 of the lighting's size); no
+// change when the lighting is empty.
+void apply_lighting(const Lighting& lighting, cv::Mat& image);
 // round(clamp(gain * image + offset + noise)), noise ~ N(0, sigma^2) per pixel from a generator
 // seeded with frame_seed. image: CV_32FC1; returns CV_8UC1.
 cv::Mat apply_camera(const cv::Mat& image, const Exposure& exposure, double sigma,

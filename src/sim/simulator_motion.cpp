@@ -225,6 +225,11 @@ void validate(const Options& o) {
           "odometry_noise_floor must be >= 0");
   require(std::isfinite(o.wheel_base) && o.wheel_base > 0, "wheel_base must be positive");
   require(o.supersampling >= 1 && o.supersampling <= 16, "supersampling must be 1 to 16");
+  require(std::isfinite(o.lamp_falloff) && o.lamp_falloff >= 0 && o.lamp_falloff <= 0.95,
+          "lamp_falloff must be in [0, 0.95]");
+  require(std::isfinite(o.reflection) && o.reflection >= 0 && o.reflection <= 1000,
+          "reflection must be in [0, 1000] grey levels");
+  require(std::isfinite(o.shadow) && o.shadow >= 0 && o.shadow <= 0.95, "shadow must be in [0, 0.95]");
   Eigen::Vector2d px;
   const double reach = farthest_ground_view(o.camera, o.extrinsics, &px);
   const std::string at = "pixel (" + std::to_string(static_cast<int>(px.x())) + ", " +

@@ -49,6 +49,7 @@ void write_simulation_yaml(const std::string& path, const Options& o, const Eige
     fs << "odometry_noise" << o.odometry_noise << "odometry_noise_floor" << o.odometry_noise_floor;
     fs << "wheel_base" << o.wheel_base;
     fs << "supersampling" << o.supersampling << "mipmap" << static_cast<int>(o.mipmap);
+    fs << "lamp_falloff" << o.lamp_falloff << "reflection" << o.reflection << "shadow" << o.shadow;
     fs.release();
   } catch (const cv::Exception& e) {
     throw Error(ErrorCode::Io, path + ": cannot be written (" + e.err + ")");
@@ -76,6 +77,7 @@ void simulate(ocl::Runtime& runtime, const Options& options, const std::string& 
   // program (e.g. no prebuilt binary of it) leaves nothing behind.
   Renderer renderer(runtime, texture, options);
   const std::vector<Exposure> exposure = exposure_series(options, tr.t);
+  const Lighting lighting = camera_lighting(options);
 
   namespace fs = std::filesystem;
   const fs::path dir(out_dir), images = dir / "images";
@@ -111,10 +113,11 @@ void simulate(ocl::Runtime& runtime, const Options& options, const std::string& 
   for (size_t k = 0; k < n; ++k) {
     report(options, static_cast<double>(k) / static_cast<double>(n), "rendering");
     t0 = Clock::now();
-    const cv::Mat clean = renderer.render_float(tr.pose[k]);
+    cv::Mat clean = renderer.render_float(tr.pose[k]);
     st.render += seconds_since(t0);
 
     t0 = Clock::now();
+    apply_lighting(lighting, clean);
     const cv::Mat image = apply_camera(clean, exposure[k], options.pixel_noise,
                                        derive_seed(options.seed, 1000 + k));
     st.camera += seconds_since(t0);

@@ -49,6 +49,7 @@ struct Scene {
   bool mipmap = true;     // mip=0: no prefiltered texture (only the subsamples average)
   bool distortion = true; // dist=0: a pinhole camera (no lens distortion, so no resampling of the noise)
   sim::MotionProfile motion = sim::MotionProfile::Mixed;
+  double lamp = 0.0, reflection = 0.0, shadow = 0.0;  // the light fixed to the camera (sim::Options)
 
   Extrinsics extrinsics() const { return has_ext ? ext : sim::paper_configuration(config); }
 
@@ -87,6 +88,12 @@ struct Scene {
       mipmap = std::atoi(v.c_str()) != 0;
     } else if (k == "dist") {
       distortion = std::atoi(v.c_str()) != 0;
+    } else if (k == "lamp") {
+      lamp = std::atof(v.c_str());
+    } else if (k == "reflection") {
+      reflection = std::atof(v.c_str());
+    } else if (k == "shadow") {
+      shadow = std::atof(v.c_str());
     } else {
       return false;
     }
@@ -111,15 +118,21 @@ struct Scene {
     so.extrinsics = extrinsics();
     so.supersampling = supersampling;
     so.mipmap = mipmap;
+    so.lamp_falloff = lamp;
+    so.reflection = reflection;
+    so.shadow = shadow;
     return so;
   }
 
   std::string summary() const {
     char r[64] = "";
     if (radius > 0) std::snprintf(r, sizeof r, ", turning radius >= %.1f m", radius);
-    char b[320];
-    std::snprintf(b, sizeof b, "camera %s, fov %.0f deg; %s motion up to %.2f m/s and %.2f rad/s%s; noise %.1f grey levels",
-                  describe(extrinsics()).c_str(), fov, sim::motion_profile_name(motion), speed, turn, r, noise);
+    char l[128] = "";
+    if (lamp > 0 || reflection > 0 || shadow > 0)
+      std::snprintf(l, sizeof l, "; lamp falloff %.2f, reflection %.0f, shadow %.2f", lamp, reflection, shadow);
+    char b[448];
+    std::snprintf(b, sizeof b, "camera %s, fov %.0f deg; %s motion up to %.2f m/s and %.2f rad/s%s; noise %.1f grey levels%s",
+                  describe(extrinsics()).c_str(), fov, sim::motion_profile_name(motion), speed, turn, r, noise, l);
     return b;
   }
 
@@ -132,9 +145,11 @@ struct Scene {
 // Frame k of a simulated sequence as the camera gives it: rendered at the true pose, then the
 // camera's gain, offset and noise, seeded per frame (every benchmark sees the same frames).
 inline cv::Mat camera_frame(sim::Renderer& renderer, const sim::Options& so, const sim::Trajectory& traj,
-                            const std::vector<sim::Exposure>& exposure, size_t k) {
-  return sim::apply_camera(renderer.render_float(traj.pose[k]), exposure[k], so.pixel_noise,
-                           sim::derive_seed(so.seed, 1000 + k));
+                            const std::vector<sim::Exposure>& exposure, size_t k,
+                            const sim::Lighting& lighting = {}) {
+  cv::Mat clean = renderer.render_float(traj.pose[k]);
+  sim::apply_lighting(lighting, clean);
+  return sim::apply_camera(clean, exposure[k], so.pixel_noise, sim::derive_seed(so.seed, 1000 + k));
 }
 
 // Every frame of a sequence, rendered once into memory.
@@ -142,7 +157,8 @@ inline std::vector<cv::Mat> render_sequence(ocl::Runtime& rt, const sim::Options
   const std::vector<sim::Exposure> exposure = sim::exposure_series(so, traj.t);
   sim::Renderer renderer(rt, cv::imread(so.texture, cv::IMREAD_GRAYSCALE), so);
   std::vector<cv::Mat> frames;
-  for (size_t k = 0; k < traj.t.size(); ++k) frames.push_back(camera_frame(renderer, so, traj, exposure, k));
+  const sim::Lighting lighting = sim::camera_lighting(so);
+  for (size_t k = 0; k < traj.t.size(); ++k) frames.push_back(camera_frame(renderer, so, traj, exposure, k, lighting));
   return frames;
 }
 
