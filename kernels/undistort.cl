@@ -60,3 +60,70 @@ void undistort(__global const uchar* src, __global const int* index,
   else
     pv_store_head(value, dst + p, width - x);
 }
+
+// The photometric correction (src/image/photometric.h; plain C++ reference:
+// photometric_reference): the light fixed to the camera taken out of the level-0 intensity
+// image, between the undistortion and the prefilter. Per pixel, with raw the undistorted
+// intensity:
+//   dst = raw * scale + offset        where raw is valid, raw < saturation and scale > 0
+//   dst = PV_INVALID                  otherwise (saturated, or the model says no value)
+//
+//   raw      width x height floats (PV_INVALID where no source)
+//   model    2 planes of width x height floats: scale, then offset
+//   dst      width x height floats
+// Each work-item makes 8 consecutive pixels of a row (the launch shape of `undistort`).
+__kernel __attribute__((reqd_work_group_size(UNDISTORT_WG_X, UNDISTORT_WG_Y, 1)))
+void photometric(__global const float* raw, __global const float* model, const float saturation,
+                 const int width, const int height, __global float* dst) {
+  const int x = (int)get_global_id(0) * 8;
+  const int y = (int)get_global_id(1);
+  if (x >= width || y >= height) return;
+  const int n = width * height;
+  const int p = y * width + x;
+  if (x + 8 <= width) {
+    const float8 v = vload8(0, raw + p);
+    const float8 scale = vload8(0, model + p), offset = vload8(0, model + n + p);
+    const int8 use = (v > (float8)(0.5f * PV_INVALID)) & (v < (float8)(saturation)) & (scale > (float8)(0.0f));
+    vstore8(select((float8)(PV_INVALID), v * scale + offset, use), 0, dst + p);
+    return;
+  }
+  for (int i = p; i < y * width + width; ++i) {
+    const float v = raw[i];
+    const float scale = model[i];
+    dst[i] = v > 0.5f * PV_INVALID && v < saturation && scale > 0.0f ? v * scale + model[n + i] : PV_INVALID;
+  }
+}
+
+// The photometric model's statistics (plain C++ reference: photometric_learn_reference): from
+// a frame in motion, every valid raw value (saturated ones included: a pixel that stays
+// saturated has no contrast, which is how the model learns to leave it out) updates the
+// pixel's exponential moving averages of the value and of its square,
+//   mean += alpha (raw - mean);  square += alpha (raw^2 - square);
+// with alpha = 1/n for the n-th frame these are the exact means.
+//
+//   raw      width x height floats (PV_INVALID where no source)
+//   stats    2 planes of width x height floats: mean, then mean square (read and written)
+__kernel __attribute__((reqd_work_group_size(UNDISTORT_WG_X, UNDISTORT_WG_Y, 1)))
+void photometric_learn(__global const float* raw, __global float* stats, const float alpha,
+                       const int width, const int height) {
+  const int x = (int)get_global_id(0) * 8;
+  const int y = (int)get_global_id(1);
+  if (x >= width || y >= height) return;
+  const int n = width * height;
+  const int p = y * width + x;
+  if (x + 8 <= width) {
+    const float8 v = vload8(0, raw + p);
+    const int8 valid = v > (float8)(0.5f * PV_INVALID);
+    const float8 mean = vload8(0, stats + p), square = vload8(0, stats + n + p);
+    vstore8(select(mean, mean + alpha * (v - mean), valid), 0, stats + p);
+    vstore8(select(square, square + alpha * (v * v - square), valid), 0, stats + n + p);
+    return;
+  }
+  for (int i = p; i < y * width + width; ++i) {
+    const float v = raw[i];
+    if (v > 0.5f * PV_INVALID) {
+      stats[i] += alpha * (v - stats[i]);
+      stats[n + i] += alpha * (v * v - stats[n + i]);
+    }
+  }
+}

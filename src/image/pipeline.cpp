@@ -159,8 +159,10 @@ PipelineKernels::PipelineKernels(ocl::Runtime& runtime, const ImagePipelineOptio
   ocl::Runtime::register_build_options("pyramid", pyramid_opts);
   try {
     cl::Device& dev = runtime.device();
-    undistort_ = make_kernel(runtime.program("undistort", undistort_opts), "undistort", dev,
-                             undistort_wg_);
+    cl::Program& undistort = runtime.program("undistort", undistort_opts);
+    undistort_ = make_kernel(undistort, "undistort", dev, undistort_wg_);
+    photometric_ = make_kernel(undistort, "photometric", dev, undistort_wg_);
+    photometric_learn_ = make_kernel(undistort, "photometric_learn", dev, undistort_wg_);
     cl::Program& pyramid = runtime.program("pyramid", pyramid_opts);
     smooth_ = make_kernel(pyramid, "smooth", dev, pyramid_wg_);
     downsample_ = make_kernel(pyramid, "downsample", dev, pyramid_wg_);
@@ -215,6 +217,27 @@ void PipelineKernels::downsample(const cl::Buffer& src, int src_width, int src_h
   launch(runtime_.queue(), downsample_, pyramid_wg_, dw, dh);
 }
 
+void PipelineKernels::photometric(const cl::Buffer& raw, const cl::Buffer& model, float saturation,
+                                  int width, int height, const cl::Buffer& dst) {
+  photometric_.setArg(0, raw);
+  photometric_.setArg(1, model);
+  photometric_.setArg(2, saturation);
+  photometric_.setArg(3, static_cast<cl_int>(width));
+  photometric_.setArg(4, static_cast<cl_int>(height));
+  photometric_.setArg(5, dst);
+  launch(runtime_.queue(), photometric_, undistort_wg_, width, height);
+}
+
+void PipelineKernels::photometric_learn(const cl::Buffer& raw, const cl::Buffer& stats, float alpha,
+                                        int width, int height) {
+  photometric_learn_.setArg(0, raw);
+  photometric_learn_.setArg(1, stats);
+  photometric_learn_.setArg(2, alpha);
+  photometric_learn_.setArg(3, static_cast<cl_int>(width));
+  photometric_learn_.setArg(4, static_cast<cl_int>(height));
+  launch(runtime_.queue(), photometric_learn_, undistort_wg_, width, height);
+}
+
 void PipelineKernels::smooth(const cl::Buffer& src, int width, int height, const cl::Buffer& dst) {
   smooth_.setArg(0, src);
   smooth_.setArg(1, static_cast<cl_int>(width));
@@ -244,6 +267,9 @@ struct ImagePipeline::Impl {
   std::vector<cl::Buffer> intensity;  // per level, its intensity image
   bool prefilter = true;
   cl::Buffer raw;                     // level 0 before the prefilter (when it is on)
+  std::unique_ptr<PhotometricModel> photometric;  // when on
+  cl::Buffer uncorrected;             // level 0 before the photometric correction (when on)
+  bool has_frame = false;             // a frame is in `frame` (reprocess)
   Impl(ocl::Runtime& r, const ImagePipelineOptions& o) : rt(r), kernels(r, o), prefilter(o.prefilter) {}
 
   int w(int l) const { return level_size(camera.width, l); }
@@ -282,12 +308,15 @@ struct ImagePipeline::Impl {
   }
 
   void undistort() {
-    if (!prefilter) {
-      kernels.undistort(frame, map_index, map_weights, w(0), h(0), intensity[0]);
-      return;
+    const cl::Buffer& level0 = prefilter ? raw : intensity[0];
+    if (photometric) {
+      kernels.undistort(frame, map_index, map_weights, w(0), h(0), uncorrected);
+      kernels.photometric(uncorrected, photometric->model(),
+                          static_cast<float>(photometric->options().saturation), w(0), h(0), level0);
+    } else {
+      kernels.undistort(frame, map_index, map_weights, w(0), h(0), level0);
     }
-    kernels.undistort(frame, map_index, map_weights, w(0), h(0), raw);
-    kernels.smooth(raw, w(0), h(0), intensity[0]);
+    if (prefilter) kernels.smooth(raw, w(0), h(0), intensity[0]);
   }
   void pyramid() {
     for (int l = 1; l < levels; ++l)
@@ -325,6 +354,12 @@ ImagePipeline::ImagePipeline(ocl::Runtime& runtime, const CameraModel& camera, i
     if (m.prefilter)
       m.raw = cl::Buffer(ctx, CL_MEM_READ_WRITE,
                          static_cast<size_t>(m.w(0)) * static_cast<size_t>(m.h(0)) * sizeof(float));
+    if (options.photometric.enabled) {
+      m.uncorrected = cl::Buffer(ctx, CL_MEM_READ_WRITE,
+                                 static_cast<size_t>(m.w(0)) * static_cast<size_t>(m.h(0)) * sizeof(float));
+      const cv::Mat valid(camera.height, camera.width, CV_8UC1, m.map.valid.data());
+      m.photometric = std::make_unique<PhotometricModel>(runtime, valid, options.photometric);
+    }
   } catch (const cl::Error& e) {
     throw_opencl("allocating buffers for " + size_text(camera.width, camera.height), e);
   }
@@ -344,6 +379,7 @@ void ImagePipeline::process(const uint8_t* gray, int width, int height, size_t s
   m.ensure(out);
   try {
     m.upload(gray, stride);
+    m.has_frame = true;
     m.undistort();
     m.pyramid();
     m.gradients(out);
@@ -358,6 +394,33 @@ void ImagePipeline::process(const cv::Mat& gray, Pyramid& out) {
   process(gray.ptr<uint8_t>(), gray.cols, gray.rows, gray.step[0], out);
 }
 
+void ImagePipeline::learn() {
+  Impl& m = *impl_;
+  if (!m.photometric || !m.photometric->learning() || !m.has_frame) return;
+  try {
+    // The undistorted frame is still in `uncorrected` (until the next process or reprocess).
+    m.kernels.photometric_learn(m.uncorrected, m.photometric->statistics(), m.photometric->next_alpha(),
+                                m.w(0), m.h(0));
+  } catch (const cl::Error& e) {
+    throw_opencl("learning the photometric model", e);
+  }
+}
+
+void ImagePipeline::reprocess(Pyramid& out) {
+  Impl& m = *impl_;
+  if (!m.has_frame) throw_invalid_argument("image pipeline: reprocess before any frame");
+  m.ensure(out);
+  try {
+    m.undistort();
+    m.pyramid();
+    m.gradients(out);
+  } catch (const cl::Error& e) {
+    throw_opencl("reprocessing a frame", e);
+  }
+}
+
+PhotometricModel* ImagePipeline::photometric() { return impl_->photometric.get(); }
+
 PipelineTimings ImagePipeline::process_timed(const cv::Mat& gray, Pyramid& out) {
   if (gray.type() != CV_8UC1)
     throw_invalid_argument("image pipeline: the frame must be 8-bit grey (CV_8UC1)");
@@ -370,6 +433,7 @@ PipelineTimings ImagePipeline::process_timed(const cv::Mat& gray, Pyramid& out) 
     q.finish();
     auto t0 = std::chrono::steady_clock::now();
     m.upload(gray.ptr<uint8_t>(), gray.step[0]);
+    m.has_frame = true;
     q.finish();
     t.upload_ms = ms_since(t0);
     t0 = std::chrono::steady_clock::now();

@@ -13,6 +13,7 @@
 #include <opencv2/core.hpp>
 
 #include "image/camera.h"
+#include "image/photometric.h"
 #include "image/pyramid.h"
 #include "image/undistort.h"
 
@@ -94,6 +95,10 @@ struct ImagePipelineOptions {
   // resampled bilinearly by the alignment, otherwise biases it (src/track/README.md, "The
   // prefilter").
   bool prefilter = true;
+  // The photometric model (photometric.h): between the undistortion and the prefilter, the
+  // light fixed to the camera is taken out and saturated pixels left out; learnt from the
+  // frames process() is told are in motion. Off by default here (the tracker turns it on).
+  PhotometricOptions photometric{false};
 };
 
 // Host wall time of each stage when the queue is drained after each (ImagePipeline::
@@ -132,6 +137,13 @@ class PipelineKernels {
   // intensity image.
   void undistort(const cl::Buffer& frame, const cl::Buffer& index, const cl::Buffer& weights,
                  int width, int height, const cl::Buffer& dst);
+  // The photometric correction: raw -> dst (intensity images of width x height, not the same
+  // buffer), model PhotometricModel's planes.
+  void photometric(const cl::Buffer& raw, const cl::Buffer& model, float saturation, int width,
+                   int height, const cl::Buffer& dst);
+  // The photometric statistics' update from raw (PhotometricModel's planes) with weight alpha.
+  void photometric_learn(const cl::Buffer& raw, const cl::Buffer& stats, float alpha, int width,
+                         int height);
   // src, dst: intensity images of width x height (not the same buffer).
   void smooth(const cl::Buffer& src, int width, int height, const cl::Buffer& dst);
   // src: an intensity image of src_width x src_height; dst: the next level's
@@ -142,7 +154,7 @@ class PipelineKernels {
 
  private:
   ocl::Runtime& runtime_;
-  cl::Kernel undistort_, smooth_, downsample_, gradient_;
+  cl::Kernel undistort_, photometric_, photometric_learn_, smooth_, downsample_, gradient_;
   size_t undistort_wg_[2] = {1, 1}, pyramid_wg_[2] = {1, 1};
 };
 
@@ -173,6 +185,16 @@ class ImagePipeline {
   void process(const uint8_t* gray, int width, int height, size_t stride, Pyramid& out);
   // The same for a CV_8UC1 image (any other type is InvalidArgument).
   void process(const cv::Mat& gray, Pyramid& out);
+  // The photometric model learns from the last frame processed (its caller knows the frame is
+  // in motion relative to the last one learnt from). Nothing when the model is off or not
+  // learning.
+  void learn();
+  // The last frame again (already on the device) into `out`, with the photometric model as it
+  // is now and without learning from it: after PhotometricModel::refit, so that a keyframe and
+  // the frames aligned with it are corrected alike. InvalidArgument before any frame.
+  void reprocess(Pyramid& out);
+  // The photometric model, or null when it is off.
+  PhotometricModel* photometric();
 
   // process(), draining the queue before and after each stage to time it (benchmarks only).
   PipelineTimings process_timed(const cv::Mat& gray, Pyramid& out);

@@ -42,6 +42,7 @@ Eigen::Matrix3d adjoint(const SE2& T) {
 // Reasons (compared by address).
 constexpr const char* kNoTexture = "no texture";
 constexpr const char* kMismatch = "images do not match";
+constexpr const char* kMisaligned = "misaligned: the images match only where something fixed to the camera is";
 constexpr const char* kBrightness = "brightness changed too much";
 constexpr const char* kWrongSize = "frame size differs from the camera's";
 constexpr const char* kTimeGap = "time gap";
@@ -111,6 +112,8 @@ struct Tracker::Impl {
   int live_slot = 0;
   bool keyframe_is_slot = false;
   SE2 pose;             // accumulated robot pose
+  SE2 since_learnt;     // the motion since the last frame the photometric model learnt from
+  bool light_holds = false;  // this frame was misaligned (held by the light fixed to the camera?)
   Estimate prev;        // the previous frame relative to the keyframe
   // Covariance of prev.T less the part the next frame shares with it ((1 - 2 rho) C; zero when
   // the previous frame is the keyframe, lost_covariance() after a Lost frame).
@@ -141,6 +144,7 @@ struct Tracker::Impl {
     forget_alignment(nullptr);
     has_keyframe = false;
     pose = SE2();
+    since_learnt = SE2();
     prev = Estimate();
     prev_covariance.setZero();
     velocity.setZero();
@@ -290,9 +294,15 @@ struct Tracker::Impl {
     const ReduceSums& st = report.match_stats[0];
     const double var_ref = st.valid > 0 ? st.iref2 / st.valid - std::pow(st.iref / st.valid, 2) : 0.0;
     const double ratio = st.valid > 0 && var_ref > 0 ? (st.rr / st.valid) / var_ref : HUGE_VAL;
+    const double grad2 = 0.5 * (st.gref + st.glive);
+    res->misalignment = grad2 > 0 ? std::sqrt(st.rr / grad2) : HUGE_VAL;
+    light_holds = res->misalignment > opt.max_misalignment_px && std::isfinite(res->misalignment);
     if (!(ratio <= opt.lost_residual_ratio)) {
       res->status = Status::Lost;
       res->reason = kMismatch;
+    } else if (!(res->misalignment <= opt.max_misalignment_px)) {
+      res->status = Status::Lost;
+      res->reason = kMisaligned;
     } else if (!(std::abs(e.a) <= opt.max_log_gain)) {
       res->status = Status::Lost;
       res->reason = kBrightness;
@@ -318,6 +328,13 @@ struct Tracker::Impl {
       keyframe = live;
       keyframe_is_slot = true;
       live_slot ^= 1;
+      // A new photometric model is taken into use with a new keyframe: the frame (still in the
+      // pipeline) is corrected again with it.
+      PhotometricModel* photometric = pipeline ? pipeline->photometric() : nullptr;
+      if (photometric && photometric->refit_due(light_holds)) {
+        photometric->refit(light_holds);
+        pipeline->reprocess(keyframe);
+      }
     } else {
       // Copied into the spare pyramid, which then swaps with the keyframe's: the old keyframe's
       // contents stay for residuals() until the next frame (no more copying than in place).
@@ -381,6 +398,24 @@ struct Tracker::Impl {
     return cached;
   }
 
+  // The photometric model learns from frames in motion: the image has moved by learn_motion_px
+  // since the last frame it learnt from (by the motions tracked since), or the frame's content
+  // does not match its keyframe's (misaligned: the floor moved, whatever the alignment says; an
+  // alignment held by the light's own pattern must not keep the model from learning it).
+  void learn_photometric(const FrameResult& r) {
+    PhotometricModel* photometric = pipeline->photometric();
+    if (!photometric || !photometric->learning() || r.status == Status::First) return;
+    const bool tracked = r.status == Status::Ok || r.status == Status::Degraded;
+    if (tracked) since_learnt = since_learnt * r.motion.value;
+    const bool moved = tracked && max_pixel_displacement(camera.K(), ext, SE2(), since_learnt, camera.width,
+                                                         camera.height) >= opt.learn_motion_px;
+    const bool changed = r.misalignment > opt.max_misalignment_px && std::isfinite(r.misalignment);
+    if (moved || changed) {
+      pipeline->learn();
+      since_learnt = SE2();
+    }
+  }
+
   FrameResult track_gray(const uint8_t* gray, int width, int height, size_t stride, double t) {
     if (!gray) throw_invalid_argument("Tracker::track: the image is null");
     forget_alignment(kNotAligned);  // the pipeline is about to overwrite the live slot
@@ -392,6 +427,7 @@ struct Tracker::Impl {
     if (!pipeline) {
       ImagePipelineOptions po;
       po.prefilter = opt.prefilter;
+      po.photometric = opt.photometric;
       pipeline = std::make_unique<ImagePipeline>(rt, camera, opt.levels, po);
     }
     pipeline->process(gray, width, height, stride, slots[live_slot]);
@@ -400,6 +436,7 @@ struct Tracker::Impl {
     rt.queue().finish();
     const auto t1 = std::chrono::steady_clock::now();
     FrameResult r = track(slots[live_slot], t);
+    learn_photometric(r);
     r.pipeline_ms = std::chrono::duration<double, std::milli>(t1 - t0).count();
     r.ms += r.pipeline_ms;
     return r;

@@ -14,6 +14,7 @@
 #include "core/motion.h"
 #include "core/se2.h"
 #include "image/camera.h"
+#include "image/photometric.h"
 #include "image/pyramid.h"
 #include "track/aligner.h"
 #include "track/residual_image.h"
@@ -62,6 +63,12 @@ struct TrackerOptions : AlignerOptions {
   double max_position_std = 1e-4;  // metres
   double max_std_ratio = 10.0;
   double max_heading_std = 1e-3;   // radians
+  // Lost when FrameResult::misalignment (the residual as an equivalent shift of the images, at
+  // the half-resolution level, in its pixels) exceeds this: the images do not match as aligned,
+  // whatever else agreed with the alignment (a pattern fixed to the camera, such as a lamp's
+  // falloff or reflection, holds an alignment while the floor moves). Aligned frames measure
+  // 0.2-0.4 on the simulator, frames held by the camera's light 1-2.
+  double max_misalignment_px = 0.8;
   // Covariance (src/track/README.md, "Covariance"). The alignment's is the M-estimator's
   // sandwich B^-1 M B^-1 (B: J^T J over the Huber inliers, M: the scores' outer product over
   // clusters of neighbouring pixels, ReduceSums::score_outer) plus (f delta)(f delta)^T, delta
@@ -79,6 +86,15 @@ struct TrackerOptions : AlignerOptions {
   // prefilter; src/track/README.md, "The prefilter"). Pyramids given to track(Pyramid) are
   // taken as they are.
   bool prefilter = true;
+  // The camera-frame path takes the light fixed to the camera out of each frame before its
+  // pyramid (image/photometric.h: learnt online, saturated and contrast-less pixels left out).
+  // The model learns from a frame when the image has moved by at least learn_motion_px
+  // (level-0 pixels, anywhere in the image) since the last frame it learnt from, by the
+  // tracked motions and the constant-velocity prediction; a new model is taken into use when a
+  // frame becomes the keyframe (the keyframe is corrected again with it, so that a keyframe and
+  // the frames aligned with it are always corrected alike).
+  PhotometricOptions photometric;
+  double learn_motion_px = 8.0;
 
   static WarpReduceOptions default_kernel_options();
 };
@@ -121,6 +137,12 @@ struct FrameResult {
   double overlap = 0;          // valid keyframe pixels landing on valid live pixels
   double sigma = 0;            // robust residual scale at the finest level, grey levels
   double log_gain = 0, bias = 0;  // brightness relative to the keyframe
+  // The residual as a misalignment: sqrt(mean r^2 / mean |grad I|^2) over the match level's
+  // valid pixels (both images' gradients), in that level's pixels. A residual this large is
+  // what shifting the images by this much would leave; an alignment held by a pattern fixed to
+  // the camera while the floor moved leaves the floor's texture misaligned (TrackerOptions::
+  // max_misalignment_px).
+  double misalignment = 0;
   bool keyframe = false;       // this frame became the keyframe
   double ms = 0;               // wall time of track(), milliseconds
   double pipeline_ms = 0;      // of which the image pipeline (camera-frame API only)

@@ -262,5 +262,62 @@ TEST(PipelineKernels, OtherWorkGroupShapesAgree) {
   EXPECT_EQ(download(rt, ua, gray.total()), download(rt, ub, gray.total()));
 }
 
+
+// The photometric correction against photometric_reference, and the statistics' update against
+// photometric_learn_reference, on random raw intensities with invalid pixels and saturated
+// values, a random model with pixels that have no value (scale 0), and random running
+// statistics.
+TEST(PipelineKernels, PhotometricMatchesReference) {
+  ocl::Runtime rt;
+  PipelineKernels kernels(rt);
+  uint32_t seed = 31;
+  for (const auto& s : kSizes) {
+    for (const float alpha : {1.0f, 0.25f, 1.0f / 300.0f}) {
+      const std::string what = std::to_string(s[0]) + "x" + std::to_string(s[1]) + " alpha=" + std::to_string(alpha);
+      const cv::Mat raw = random_level(s[0], s[1], seed++);
+      std::mt19937 rng(seed++);
+      std::uniform_real_distribution<float> unit(0.0f, 1.0f);
+      PhotometricFit fit = identity_photometric(s[0], s[1]);
+      cv::Mat mean(s[1], s[0], CV_32FC1), var(s[1], s[0], CV_32FC1);
+      for (int y = 0; y < s[1]; ++y)
+        for (int x = 0; x < s[0]; ++x) {
+          fit.scale.at<float>(y, x) = unit(rng) < 0.05f ? 0.0f : 0.3f + 3.0f * unit(rng);
+          fit.offset.at<float>(y, x) = -100.0f + 200.0f * unit(rng);
+          mean.at<float>(y, x) = 255.0f * unit(rng);
+          var.at<float>(y, x) = 2000.0f * unit(rng);
+        }
+      const size_t n = raw.total();
+      std::vector<float> model(2 * n), stats(2 * n);
+      std::copy_n(fit.scale.ptr<float>(), n, model.begin());
+      std::copy_n(fit.offset.ptr<float>(), n, model.begin() + static_cast<std::ptrdiff_t>(n));
+      std::copy_n(mean.ptr<float>(), n, stats.begin());
+      std::copy_n(var.ptr<float>(), n, stats.begin() + static_cast<std::ptrdiff_t>(n));
+      const cl::Buffer src = upload(rt, raw.ptr(), n * sizeof(float));
+      const cl::Buffer m = upload(rt, model.data(), model.size() * sizeof(float));
+      const cl::Buffer st = upload(rt, stats.data(), stats.size() * sizeof(float));
+      const cl::Buffer dst = poisoned(rt, n);
+      kernels.photometric(src, m, 200.0f, s[0], s[1], dst);
+      kernels.photometric_learn(src, st, alpha, s[0], s[1]);
+      expect_intensity_matches(download(rt, dst, n), photometric_reference(raw, fit, 200.0), what);
+      cv::Mat ref_mean = mean.clone(), ref_var = var.clone();
+      photometric_learn_reference(raw, alpha, &ref_mean, &ref_var);
+      std::vector<float> out(2 * n);
+      rt.queue().enqueueReadBuffer(st, CL_TRUE, 0, out.size() * sizeof(float), out.data());
+      double worst_mean = 0.0, worst_var = 0.0;
+      size_t changed = 0, valid = 0;
+      for (size_t i = 0; i < n; ++i) {
+        valid += raw.ptr<float>()[i] > 0.5f * kInvalidIntensity;
+        worst_mean = std::max(worst_mean, std::abs(static_cast<double>(out[i]) - ref_mean.ptr<float>()[i]));
+        worst_var = std::max(worst_var, std::abs(static_cast<double>(out[n + i]) - ref_var.ptr<float>()[i]));
+        changed += out[i] != mean.ptr<float>()[i];
+      }
+      EXPECT_LE(worst_mean, kTolerance) << what;
+      // Mean squares reach 255^2: a contracted multiply-add differs by an ulp or two of that (2^-7).
+      EXPECT_LE(worst_var, 0.02) << what;
+      EXPECT_GE(changed, valid * 9 / 10) << what;  // the statistics were updated at all
+    }
+  }
+}
+
 }  // namespace
 }  // namespace planarvo

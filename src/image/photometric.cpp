@@ -1,0 +1,320 @@
+// The photometric model (photometric.h): the fit from per-pixel statistics, the plain C++
+// reference of the correction kernel, and the model's device buffers.
+#include "image/photometric.h"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include <opencv2/imgproc.hpp>
+
+#include "core/error.h"
+#include "image/pipeline.h"
+#include "ocl/runtime.h"
+
+namespace planarvo {
+
+namespace {
+
+// Frames in motion after which a pixel's own variance over time says whether it sees the floor.
+constexpr int kOwnVarianceFrames = 30;
+
+// The q-quantile (0..1) of m's values where mask is non-zero (0 when none).
+double masked_quantile(const cv::Mat& m, const cv::Mat& mask, double q) {
+  std::vector<float> v;
+  v.reserve(m.total());
+  for (int r = 0; r < m.rows; ++r) {
+    const float* a = m.ptr<float>(r);
+    const uint8_t* k = mask.ptr<uint8_t>(r);
+    for (int c = 0; c < m.cols; ++c)
+      if (k[c]) v.push_back(a[c]);
+  }
+  if (v.empty()) return 0.0;
+  auto at = v.begin() + static_cast<std::ptrdiff_t>(q * static_cast<double>(v.size() - 1));
+  std::nth_element(v.begin(), at, v.end());
+  return *at;
+}
+
+// The mean of m over the valid pixels in a (2r + 1)^2 box (edges: the box clipped), 0 where
+// the box holds none.
+cv::Mat masked_box(const cv::Mat& m, const cv::Mat& valid01, int r) {
+  cv::Mat num, den;
+  const cv::Size k(2 * r + 1, 2 * r + 1);
+  cv::boxFilter(m.mul(valid01), num, CV_32F, k, cv::Point(-1, -1), false, cv::BORDER_CONSTANT);
+  cv::boxFilter(valid01, den, CV_32F, k, cv::Point(-1, -1), false, cv::BORDER_CONSTANT);
+  cv::Mat out(m.size(), CV_32FC1);
+  for (int y = 0; y < m.rows; ++y) {
+    const float* n = num.ptr<float>(y);
+    const float* d = den.ptr<float>(y);
+    float* o = out.ptr<float>(y);
+    for (int x = 0; x < m.cols; ++x) o[x] = d[x] > 0.5f ? n[x] / d[x] : 0.0f;
+  }
+  return out;
+}
+
+}  // namespace
+
+void validate(const PhotometricOptions& o) {
+  auto require = [](bool ok, const char* what) {
+    if (!ok) throw_invalid_argument(std::string("photometric options: ") + what);
+  };
+  require(std::isfinite(o.saturation) && o.saturation > 0, "saturation must be a positive grey level");
+  require(o.min_frames >= 1, "min_frames must be >= 1");
+  require(o.memory_frames >= o.min_frames, "memory_frames must be >= min_frames");
+  require(o.radius >= 0 && o.radius <= 256, "radius must be 0..256 pixels");
+  require(std::isfinite(o.min_contrast) && o.min_contrast >= 0 && o.min_contrast < 1,
+          "min_contrast must be in [0, 1)");
+}
+
+PhotometricFit identity_photometric(int width, int height) {
+  PhotometricFit f;
+  f.scale = cv::Mat(height, width, CV_32FC1, cv::Scalar(1.0f));
+  f.offset = cv::Mat(height, width, CV_32FC1, cv::Scalar(0.0f));
+  return f;
+}
+
+PhotometricFit fit_photometric(const cv::Mat& mean, const cv::Mat& square, const cv::Mat& valid,
+                               int frames, const PhotometricOptions& o, bool needed) {
+  if (mean.type() != CV_32FC1 || square.type() != CV_32FC1 || valid.type() != CV_8UC1 ||
+      mean.size() != square.size() || mean.size() != valid.size())
+    throw_invalid_argument("fit_photometric: mean, square (CV_32FC1) and valid (CV_8UC1) of one size");
+  cv::Mat valid01;
+  valid.convertTo(valid01, CV_32F);
+  cv::threshold(valid01, valid01, 0.5, 1.0, cv::THRESH_BINARY);
+  // The light: the pixel's mean over the frames, smoothed over a box (the light is smooth; the
+  // floor's own large patches, which the frames have not yet averaged out, are not).
+  // Multiplicative: its gain is the mean's ratio to the reference. (The floor's contrast is not
+  // used for the gain: on a tilted camera it changes over the image with the ground's scale in
+  // it, which no correction should undo.)
+  const cv::Mat m = masked_box(mean, valid01, o.radius);
+  // The floor's contrast as the pixel sees it: its own variance over the frames, smoothed.
+  cv::Mat own_var = cv::max(square - mean.mul(mean), 0.0f);
+  cv::Mat sd;
+  cv::sqrt(masked_box(own_var, valid01, o.radius), sd);
+  cv::Mat rel(mean.size(), CV_32FC1, cv::Scalar(0.0f));
+  for (int y = 0; y < mean.rows; ++y)
+    for (int x = 0; x < mean.cols; ++x) {
+      const float mm = m.at<float>(y, x);
+      rel.at<float>(y, x) = mm > 0 ? sd.at<float>(y, x) / mm : 0.0f;
+    }
+  const double mean_ref = masked_quantile(m, valid, 0.5);
+  const double rel_ref = masked_quantile(rel, valid, 0.5);
+  PhotometricFit f;
+  f.frames = frames;
+  f.mean_ref = mean_ref;
+  f.sd_ref = rel_ref * mean_ref;
+  f.scale = cv::Mat(mean.size(), CV_32FC1, cv::Scalar(0.0f));
+  f.offset = cv::Mat(mean.size(), CV_32FC1, cv::Scalar(0.0f));
+  // A pixel's own variance is trusted to say "static" only once it has seen enough frames.
+  const bool own = frames >= kOwnVarianceFrames;
+  long n_valid = 0, n_unusable = 0;
+  for (int y = 0; y < mean.rows; ++y) {
+    const uint8_t* k = valid.ptr<uint8_t>(y);
+    const float* mm = m.ptr<float>(y);
+    const float* mo = mean.ptr<float>(y);
+    const float* rr = rel.ptr<float>(y);
+    const float* ov = own_var.ptr<float>(y);
+    float* sc = f.scale.ptr<float>(y);
+    for (int x = 0; x < mean.cols; ++x) {
+      if (!k[x]) continue;
+      ++n_valid;
+      // No value: the floor's texture shows too faintly against what the light adds (saturated
+      // spots, a reflection's core, static structure), relative to the median pixel; or the
+      // smoothed light does not describe the pixel (a shadow's edge, a reflection's rim: its
+      // own mean departs from the smoothed one by more than a tenth and three of its contrasts).
+      const double own_sd = std::sqrt(ov[x]);
+      const bool faint = rr[x] < o.min_contrast * rel_ref ||
+                         (own && mm[x] > 0 && own_sd / mm[x] < o.min_contrast * rel_ref);
+      const bool misfit = std::abs(mo[x] - mm[x]) > std::max(0.1 * mm[x], 3.0 * own_sd);
+      if (!(mm[x] > 0) || faint || misfit) {
+        ++n_unusable;
+        continue;
+      }
+      sc[x] = static_cast<float>(mean_ref / mm[x]);
+    }
+  }
+  f.unusable = n_valid > 0 ? static_cast<double>(n_unusable) / static_cast<double>(n_valid) : 0.0;
+  // Nothing fixed to the camera that the statistics can tell from their own noise: the mean
+  // level varies over the image by less than uniform_spread (10th to 90th percentile, relative
+  // to the median), and no pixel lacks a value. The correction would only add its own noise (a
+  // faint pattern fixed to the camera); the identity is used.
+  const double m_spread = masked_quantile(m, valid, 0.9) - masked_quantile(m, valid, 0.1);
+  f.uniform = m_spread < o.uniform_spread * mean_ref && f.unusable < 0.005;
+  if (f.uniform && !needed) {
+    f.scale.setTo(1.0f, valid);
+    f.offset.setTo(0.0f);
+  }
+  return f;
+}
+
+PhotometricFit flat_field_photometric(const cv::Mat& gain, const cv::Mat& valid,
+                                      const PhotometricOptions& o) {
+  if (gain.type() != CV_32FC1 || valid.type() != CV_8UC1 || gain.size() != valid.size())
+    throw_invalid_argument("flat_field_photometric: gain (CV_32FC1) and valid (CV_8UC1) of one size");
+  double top = 0.0;
+  cv::minMaxLoc(gain, nullptr, &top, nullptr, nullptr, valid);
+  PhotometricFit f = identity_photometric(gain.cols, gain.rows);
+  f.offset.setTo(0.0f);
+  f.frames = 0;
+  long n_valid = 0, n_unusable = 0;
+  for (int y = 0; y < gain.rows; ++y) {
+    const float* g = gain.ptr<float>(y);
+    const uint8_t* k = valid.ptr<uint8_t>(y);
+    float* sc = f.scale.ptr<float>(y);
+    for (int x = 0; x < gain.cols; ++x) {
+      if (!k[x]) continue;
+      ++n_valid;
+      if (top > 0 && g[x] > o.min_contrast * top) {
+        sc[x] = static_cast<float>(top / g[x]);
+      } else {
+        sc[x] = 0.0f;
+        ++n_unusable;
+      }
+    }
+  }
+  f.unusable = n_valid > 0 ? static_cast<double>(n_unusable) / static_cast<double>(n_valid) : 0.0;
+  return f;
+}
+
+cv::Mat photometric_reference(const cv::Mat& raw, const PhotometricFit& fit, double saturation) {
+  if (raw.type() != CV_32FC1 || fit.scale.size() != raw.size() || fit.offset.size() != raw.size())
+    throw_invalid_argument("photometric_reference: raw (CV_32FC1) and the model of one size");
+  const float sat = static_cast<float>(saturation);
+  cv::Mat out(raw.size(), CV_32FC1);
+  for (int y = 0; y < raw.rows; ++y) {
+    const float* v = raw.ptr<float>(y);
+    const float* sc = fit.scale.ptr<float>(y);
+    const float* of = fit.offset.ptr<float>(y);
+    float* o = out.ptr<float>(y);
+    for (int x = 0; x < raw.cols; ++x) {
+      const bool use = v[x] > 0.5f * kInvalidIntensity && v[x] < sat && sc[x] > 0.0f;
+      o[x] = use ? v[x] * sc[x] + of[x] : kInvalidIntensity;
+    }
+  }
+  return out;
+}
+
+void photometric_learn_reference(const cv::Mat& raw, float alpha, cv::Mat* mean, cv::Mat* square) {
+  if (raw.type() != CV_32FC1 || !mean || !square || mean->size() != raw.size() ||
+      square->size() != raw.size() || mean->type() != CV_32FC1 || square->type() != CV_32FC1)
+    throw_invalid_argument("photometric_learn_reference: raw, mean and square CV_32FC1 of one size");
+  for (int y = 0; y < raw.rows; ++y) {
+    const float* v = raw.ptr<float>(y);
+    float* mu = mean->ptr<float>(y);
+    float* var = square->ptr<float>(y);
+    for (int x = 0; x < raw.cols; ++x) {
+      if (!(v[x] > 0.5f * kInvalidIntensity)) continue;
+      mu[x] += alpha * (v[x] - mu[x]);
+      var[x] += alpha * (v[x] * v[x] - var[x]);
+    }
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+
+struct PhotometricModel::Impl {
+  ocl::Runtime& rt;
+  PhotometricOptions options;
+  cv::Mat valid;
+  int width = 0, height = 0;
+  cl::Buffer model, stats;
+  PhotometricFit fit, known;
+  bool has_known = false;
+  int frames = 0, frames_at_fit = 0;
+
+  Impl(ocl::Runtime& r, const cv::Mat& v, const PhotometricOptions& o)
+      : rt(r), options(o), valid(v.clone()), width(v.cols), height(v.rows) {}
+
+  size_t plane() const { return static_cast<size_t>(width) * static_cast<size_t>(height); }
+
+  void upload(const PhotometricFit& f) {
+    const size_t bytes = plane() * sizeof(float);
+    rt.queue().enqueueWriteBuffer(model, CL_TRUE, 0, bytes, f.scale.ptr<float>());
+    rt.queue().enqueueWriteBuffer(model, CL_TRUE, bytes, bytes, f.offset.ptr<float>());
+    fit = f;
+  }
+};
+
+PhotometricModel::PhotometricModel(ocl::Runtime& runtime, const cv::Mat& valid,
+                                   const PhotometricOptions& options) {
+  validate(options);
+  if (valid.type() != CV_8UC1 || valid.empty())
+    throw_invalid_argument("PhotometricModel: valid must be a non-empty CV_8UC1 image");
+  impl_ = std::make_unique<Impl>(runtime, valid, options);
+  Impl& m = *impl_;
+  try {
+    m.model = cl::Buffer(runtime.context(), CL_MEM_READ_ONLY, 2 * m.plane() * sizeof(float));
+    m.stats = cl::Buffer(runtime.context(), CL_MEM_READ_WRITE, 2 * m.plane() * sizeof(float));
+  } catch (const cl::Error& e) {
+    throw Error(ErrorCode::OpenCL, std::string("photometric model: allocating buffers failed: ") +
+                                       e.what() + " " + ocl::error_name(e.err()));
+  }
+  reset();
+}
+
+PhotometricModel::~PhotometricModel() = default;
+
+const PhotometricOptions& PhotometricModel::options() const { return impl_->options; }
+const cl::Buffer& PhotometricModel::model() const { return impl_->model; }
+cl::Buffer& PhotometricModel::statistics() { return impl_->stats; }
+int PhotometricModel::frames() const { return impl_->frames; }
+const PhotometricFit& PhotometricModel::fit() const { return impl_->fit; }
+
+bool PhotometricModel::learning() const { return impl_->options.learn && !impl_->has_known; }
+
+float PhotometricModel::next_alpha() {
+  Impl& m = *impl_;
+  if (!learning()) return 0.0f;
+  ++m.frames;
+  return 1.0f / static_cast<float>(std::min(m.frames, m.options.memory_frames));
+}
+
+bool PhotometricModel::refit_due(bool needed) const {
+  const Impl& m = *impl_;
+  if (!learning() || m.frames < (needed ? m.options.min_frames : kOwnVarianceFrames)) return false;
+  const int since = m.frames - m.frames_at_fit;
+  return m.frames_at_fit == 0 || since >= std::max(4, m.frames_at_fit / 4);
+}
+
+void PhotometricModel::refit(bool needed) {
+  Impl& m = *impl_;
+  cv::Mat mean(m.height, m.width, CV_32FC1), square(m.height, m.width, CV_32FC1);
+  const size_t bytes = m.plane() * sizeof(float);
+  try {
+    m.rt.queue().enqueueReadBuffer(m.stats, CL_TRUE, 0, bytes, mean.ptr<float>());
+    m.rt.queue().enqueueReadBuffer(m.stats, CL_TRUE, bytes, bytes, square.ptr<float>());
+    m.upload(fit_photometric(mean, square, m.valid, m.frames, m.options, needed));
+  } catch (const cl::Error& e) {
+    throw Error(ErrorCode::OpenCL, std::string("photometric model: refit failed: ") + e.what() +
+                                       " " + ocl::error_name(e.err()));
+  }
+  m.frames_at_fit = m.frames;
+}
+
+void PhotometricModel::set(const PhotometricFit& fit) {
+  Impl& m = *impl_;
+  if (fit.scale.type() != CV_32FC1 || fit.offset.type() != CV_32FC1 || fit.scale.cols != m.width ||
+      fit.scale.rows != m.height || fit.offset.size() != fit.scale.size())
+    throw_invalid_argument("PhotometricModel::set: the model must be two CV_32FC1 images of " +
+                           std::to_string(m.width) + "x" + std::to_string(m.height));
+  m.known = fit;
+  m.has_known = true;
+  reset();
+}
+
+void PhotometricModel::reset() {
+  Impl& m = *impl_;
+  m.frames = m.frames_at_fit = 0;
+  try {
+    // A write, not clEnqueueFillBuffer: OpenCL 1.1 devices have none.
+    const std::vector<float> zeros(2 * m.plane(), 0.0f);
+    m.rt.queue().enqueueWriteBuffer(m.stats, CL_TRUE, 0, zeros.size() * sizeof(float), zeros.data());
+    m.upload(m.has_known ? m.known : identity_photometric(m.width, m.height));
+  } catch (const cl::Error& e) {
+    throw Error(ErrorCode::OpenCL, std::string("photometric model: reset failed: ") + e.what() +
+                                       " " + ocl::error_name(e.err()));
+  }
+}
+
+}  // namespace planarvo

@@ -1,0 +1,133 @@
+// The light fixed to the camera (a camera's own lamp and vignetting, the lamp's reflection on a
+// glossy floor, the robot's shadow): a per-pixel affine photometric model of the undistorted
+// image, learnt online from the frames themselves, and the correction the image pipeline
+// applies with it before the pyramid. See README.md, "The photometric model".
+//
+// Why it can be learnt: the floor moves through the image and the light does not. Over frames
+// in motion, a pixel sees many different patches of the same floor, so its temporal mean and
+// variance are the floor's (the same at every pixel) passed through what is fixed to the camera
+// at that pixel: with radiance gain(x) * albedo + add(x),
+//     mean(x) = gain(x) * mean_albedo + add(x),   sd(x) = gain(x) * sd_albedo.
+// The correction (raw - mean(x)) * sd_ref / sd(x) + mean_ref takes both out: every pixel then
+// sees the floor with the same mean and contrast. Pixels with no contrast left (saturated, or
+// static structure) have no value. The means and variances are smoothed over a window (the
+// light is smooth; the estimate's noise is not), so a few seconds of driving suffice.
+#pragma once
+#include <memory>
+#include <string>
+
+#include <CL/opencl.hpp>
+#include <opencv2/core.hpp>
+
+namespace planarvo {
+
+namespace ocl {
+class Runtime;
+}
+
+struct PhotometricOptions {
+  // Correct each frame with the model and leave saturated pixels out. false: the pipeline as it
+  // was without a model (the raw intensity, every pixel).
+  bool enabled = true;
+  // Learn the model from frames in motion (false: identity, or the flat field given).
+  bool learn = true;
+  // A raw grey level at or above this is saturated: the pixel has no value in that frame
+  // (above 255: never).
+  double saturation = 250.0;
+  // Frames in motion accumulated before a learnt model replaces the identity when the tracker
+  // sees the light hold its alignments (otherwise 30, and only a model that differs from the
+  // identity by more than the statistics' noise: uniform_spread).
+  int min_frames = 3;
+  // The statistics' memory: the n-th frame has weight 1/n up to n = memory_frames, then
+  // 1/memory_frames (an exponential moving average, so a lamp that changes is followed).
+  int memory_frames = 300;
+  // Half-width of the box over which the means and variances are smoothed, level-0 pixels.
+  int radius = 16;
+  // No value where the smoothed contrast, or after 30 frames a pixel's own, is below
+  // this fraction of the median contrast (saturated spots, deep shadow, static structure).
+  double min_contrast = 0.3;
+  // The identity is kept while the learnt mean level varies over the image by less than this
+  // (10th to 90th percentile, relative to the median) and every pixel has a value: an evenly lit
+  // camera tracks exactly as without the model.
+  double uniform_spread = 0.06;
+};
+
+// Throws InvalidArgument naming the first bad value.
+void validate(const PhotometricOptions& options);
+
+// The model: per pixel of the undistorted image, corrected = raw * scale + offset, scale 0
+// where the pixel has no value. CV_32FC1 each.
+struct PhotometricFit {
+  cv::Mat scale, offset;
+  double mean_ref = 0, sd_ref = 0;  // the corrected image's mean and contrast (medians)
+  int frames = 0;                   // frames in motion the fit is made from (0: identity)
+  double unusable = 0;              // fraction of the valid pixels left without a value
+  // The statistics found no light fixed to the camera beyond their own noise: the model is the
+  // identity (fit_photometric).
+  bool uniform = false;
+};
+
+// The identity model (scale 1, offset 0) of a width x height image.
+PhotometricFit identity_photometric(int width, int height);
+
+// The fit from the statistics (plain C++; what PhotometricModel::refit runs on the host):
+// per pixel, the mean and the mean square of its values (CV_32FC1) over `frames` frames in
+// motion; valid (CV_8UC1, non-zero where the undistortion has a source) marks the pixels that
+// have statistics. Mean and contrast over a box of the options' radius and the frames
+// together; references the medians over valid pixels.
+// `needed`: the caller has seen the light hold its alignments, so the model is used even where
+// the statistics cannot yet tell the light from their own noise (PhotometricFit::uniform).
+PhotometricFit fit_photometric(const cv::Mat& mean, const cv::Mat& square, const cv::Mat& valid,
+                               int frames, const PhotometricOptions& options, bool needed = false);
+
+// A known multiplicative flat field (CV_32FC1, the undistorted image's size, positive where
+// valid): scale = max(gain) / gain, offset 0; pixels with gain <= min_contrast * max have no
+// value.
+PhotometricFit flat_field_photometric(const cv::Mat& gain, const cv::Mat& valid,
+                                      const PhotometricOptions& options);
+
+// Plain C++ reference of the `photometric` kernel (kernels/undistort.cl): raw level-0 intensity
+// (kInvalidIntensity where not valid) -> corrected.
+cv::Mat photometric_reference(const cv::Mat& raw, const PhotometricFit& fit, double saturation);
+// Plain C++ reference of the `photometric_learn` kernel: updates the mean and mean square
+// (CV_32FC1) in place from raw with weight alpha, in the kernel's float arithmetic.
+void photometric_learn_reference(const cv::Mat& raw, float alpha, cv::Mat* mean, cv::Mat* square);
+
+// The model on the device: its two planes (scale, offset), the statistics' two planes (mean,
+// variance), the count of frames accumulated and when to refit.
+class PhotometricModel {
+ public:
+  // valid: CV_8UC1 of width x height, non-zero where the undistortion has a source.
+  PhotometricModel(ocl::Runtime& runtime, const cv::Mat& valid, const PhotometricOptions& options);
+  ~PhotometricModel();
+  PhotometricModel(const PhotometricModel&) = delete;
+  PhotometricModel& operator=(const PhotometricModel&) = delete;
+
+  const PhotometricOptions& options() const;
+  const cl::Buffer& model() const;  // 2 planes: scale, offset
+  cl::Buffer& statistics();         // 2 planes: mean, mean square
+  // Whether it learns (options().learn and no known model given).
+  bool learning() const;
+  // The weight of the next frame's statistics update, 1/(n + 1) capped at 1/memory_frames; the
+  // frame is counted. 0 when not learning.
+  float next_alpha();
+  int frames() const;
+  // A refit is due: learning, at least 30 frames (min_frames when the model is `needed`: the
+  // caller sees the light hold its alignments), and a quarter more (at least 4) since the last
+  // fit.
+  bool refit_due(bool needed = false) const;
+  // Reads the statistics back (blocking), fits (fit_photometric) and uploads the model.
+  void refit(bool needed = false);
+  // Uses a known model (and stops learning); its size must be the image's.
+  void set(const PhotometricFit& fit);
+  // The model in use.
+  const PhotometricFit& fit() const;
+  // Forgets the statistics; back to the identity (or the known model given with set()).
+  void reset();
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace planarvo
