@@ -43,6 +43,11 @@ class SimOptions:
     odometry_noise: Optional[float] = None
     supersampling: Optional[int] = None
     min_turn_radius: Optional[float] = None
+    # Light fixed to the camera: a lamp's falloff (the darkest corner gets 1 - lamp_falloff),
+    # its reflection on a glossy floor (peak grey levels added), the robot's shadow (fraction).
+    lamp_falloff: Optional[float] = None
+    reflection: Optional[float] = None
+    shadow: Optional[float] = None
 
 
 def default_texture() -> str:

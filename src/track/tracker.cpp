@@ -294,8 +294,10 @@ struct Tracker::Impl {
     const ReduceSums& st = report.match_stats[0];
     const double var_ref = st.valid > 0 ? st.iref2 / st.valid - std::pow(st.iref / st.valid, 2) : 0.0;
     const double ratio = st.valid > 0 && var_ref > 0 ? (st.rr / st.valid) / var_ref : HUGE_VAL;
-    const double grad2 = 0.5 * (st.gref + st.glive);
-    res->misalignment = grad2 > 0 ? std::sqrt(st.rr / grad2) : HUGE_VAL;
+    // Robust: the residual's scale from its median, so that an occluder or a few bad pixels do
+    // not count as misalignment.
+    const double grad2 = st.valid > 0 ? 0.5 * (st.gref + st.glive) / st.valid : 0.0;
+    res->misalignment = grad2 > 0 ? 1.4826 * st.median_abs_residual() / std::sqrt(grad2) : HUGE_VAL;
     light_holds = res->misalignment > opt.max_misalignment_px && std::isfinite(res->misalignment);
     if (!(ratio <= opt.lost_residual_ratio)) {
       res->status = Status::Lost;

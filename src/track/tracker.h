@@ -137,8 +137,8 @@ struct FrameResult {
   double overlap = 0;          // valid keyframe pixels landing on valid live pixels
   double sigma = 0;            // robust residual scale at the finest level, grey levels
   double log_gain = 0, bias = 0;  // brightness relative to the keyframe
-  // The residual as a misalignment: sqrt(mean r^2 / mean |grad I|^2) over the match level's
-  // valid pixels (both images' gradients), in that level's pixels. A residual this large is
+  // The residual as a misalignment: the residual's robust scale (1.4826 median |r|) over the
+  // root mean square gradient (both images') at the match level, in that level's pixels. A residual this large is
   // what shifting the images by this much would leave; an alignment held by a pattern fixed to
   // the camera while the floor moved leaves the floor's texture misaligned (TrackerOptions::
   // max_misalignment_px).
