@@ -19,6 +19,9 @@ namespace {
 
 // Frames in motion after which a pixel's own variance over time says whether it sees the floor.
 constexpr int kOwnVarianceFrames = 30;
+// A box whose spread relative to its level exceeds this many times the median pixel's holds an
+// edge of the light.
+constexpr double kMaxRelativeSpread = 2.0;
 
 // The q-quantile (0..1) of m's values where mask is non-zero (0 when none).
 double masked_quantile(const cv::Mat& m, const cv::Mat& mask, double q) {
@@ -88,10 +91,12 @@ PhotometricFit fit_photometric(const cv::Mat& mean, const cv::Mat& square, const
   // used for the gain: on a tilted camera it changes over the image with the ground's scale in
   // it, which no correction should undo.)
   const cv::Mat m = masked_box(mean, valid01, o.radius);
-  // The floor's contrast as the pixel sees it: its own variance over the frames, smoothed.
+  // The floor's contrast as the pixel sees it: the spread of the values over the box and the
+  // frames together (the texture within the box varies from the first frame on).
   cv::Mat own_var = cv::max(square - mean.mul(mean), 0.0f);
+  const cv::Mat q = masked_box(square, valid01, o.radius);
   cv::Mat sd;
-  cv::sqrt(masked_box(own_var, valid01, o.radius), sd);
+  cv::sqrt(cv::max(q - m.mul(m), 0.0f), sd);
   cv::Mat rel(mean.size(), CV_32FC1, cv::Scalar(0.0f));
   for (int y = 0; y < mean.rows; ++y)
     for (int x = 0; x < mean.cols; ++x) {
@@ -106,28 +111,44 @@ PhotometricFit fit_photometric(const cv::Mat& mean, const cv::Mat& square, const
   f.sd_ref = rel_ref * mean_ref;
   f.scale = cv::Mat(mean.size(), CV_32FC1, cv::Scalar(0.0f));
   f.offset = cv::Mat(mean.size(), CV_32FC1, cv::Scalar(0.0f));
-  // A pixel's own variance is trusted to say "static" only once it has seen enough frames.
+  // A pixel's own spread over the frames says "static" only once it has seen enough frames;
+  // smoothed over 5 x 5 pixels, so that it marks regions, not single noisy pixels.
   const bool own = frames >= kOwnVarianceFrames;
-  long n_valid = 0, n_unusable = 0;
+  cv::Mat own_sd;
+  if (own) cv::sqrt(masked_box(own_var, valid01, 2), own_sd);
+  // No value (each test on smoothed statistics, so that it marks regions: the pyramid leaves
+  // out every coarse pixel that has one fine pixel without a value, so scattered holes would
+  // empty the coarse levels):
+  // - faint: the floor's texture shows too faintly against what the light adds (saturated spots,
+  //   a reflection's core, static structure), relative to the median pixel;
+  // - an edge of the light: the box's spread relative to its level far above the median's (a
+  //   shadow's edge, a reflection's rim), which a smooth model cannot follow.
+  cv::Mat bad(mean.size(), CV_8UC1, cv::Scalar(0));
   for (int y = 0; y < mean.rows; ++y) {
     const uint8_t* k = valid.ptr<uint8_t>(y);
     const float* mm = m.ptr<float>(y);
-    const float* mo = mean.ptr<float>(y);
     const float* rr = rel.ptr<float>(y);
-    const float* ov = own_var.ptr<float>(y);
+    uint8_t* b = bad.ptr<uint8_t>(y);
+    for (int x = 0; x < mean.cols; ++x) {
+      if (!k[x]) continue;
+      const bool faint = rr[x] < o.min_contrast * rel_ref ||
+                         (own && mm[x] > 0 && own_sd.at<float>(y, x) / mm[x] < o.min_contrast * rel_ref);
+      const bool edge = rr[x] > kMaxRelativeSpread * rel_ref;
+      b[x] = !(mm[x] > 0) || faint || edge ? 255 : 0;
+    }
+  }
+  // Specks smaller than 5 x 5 pixels are noise of the tests, not light.
+  cv::morphologyEx(bad, bad, cv::MORPH_OPEN, cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(5, 5)));
+  long n_valid = 0, n_unusable = 0;
+  for (int y = 0; y < mean.rows; ++y) {
+    const uint8_t* k = valid.ptr<uint8_t>(y);
+    const uint8_t* b = bad.ptr<uint8_t>(y);
+    const float* mm = m.ptr<float>(y);
     float* sc = f.scale.ptr<float>(y);
     for (int x = 0; x < mean.cols; ++x) {
       if (!k[x]) continue;
       ++n_valid;
-      // No value: the floor's texture shows too faintly against what the light adds (saturated
-      // spots, a reflection's core, static structure), relative to the median pixel; or the
-      // smoothed light does not describe the pixel (a shadow's edge, a reflection's rim: its
-      // own mean departs from the smoothed one by more than a tenth and three of its contrasts).
-      const double own_sd = std::sqrt(ov[x]);
-      const bool faint = rr[x] < o.min_contrast * rel_ref ||
-                         (own && mm[x] > 0 && own_sd / mm[x] < o.min_contrast * rel_ref);
-      const bool misfit = std::abs(mo[x] - mm[x]) > std::max(0.1 * mm[x], 3.0 * own_sd);
-      if (!(mm[x] > 0) || faint || misfit) {
+      if (b[x] || !(mm[x] > 0)) {
         ++n_unusable;
         continue;
       }
@@ -274,7 +295,7 @@ bool PhotometricModel::refit_due(bool needed) const {
   const Impl& m = *impl_;
   if (!learning() || m.frames < (needed ? m.options.min_frames : kOwnVarianceFrames)) return false;
   const int since = m.frames - m.frames_at_fit;
-  return m.frames_at_fit == 0 || since >= std::max(4, m.frames_at_fit / 4);
+  return m.frames_at_fit == 0 || since >= (needed ? 1 : std::max(4, m.frames_at_fit / 4));
 }
 
 void PhotometricModel::refit(bool needed) {

@@ -37,7 +37,7 @@ struct PhotometricOptions {
   // Frames in motion accumulated before a learnt model replaces the identity when the tracker
   // sees the light hold its alignments (otherwise 30, and only a model that differs from the
   // identity by more than the statistics' noise: uniform_spread).
-  int min_frames = 3;
+  int min_frames = 2;
   // The statistics' memory: the n-th frame has weight 1/n up to n = memory_frames, then
   // 1/memory_frames (an exponential moving average, so a lamp that changes is followed).
   int memory_frames = 300;
@@ -112,9 +112,9 @@ class PhotometricModel {
   // frame is counted. 0 when not learning.
   float next_alpha();
   int frames() const;
-  // A refit is due: learning, at least 30 frames (min_frames when the model is `needed`: the
-  // caller sees the light hold its alignments), and a quarter more (at least 4) since the last
-  // fit.
+  // A refit is due: learning, at least 30 frames and a quarter more (at least 4) since the last
+  // fit; or, when the model is `needed` (the caller sees the light hold its alignments), at
+  // least min_frames frames and one more since the last fit.
   bool refit_due(bool needed = false) const;
   // Reads the statistics back (blocking), fits (fit_photometric) and uploads the model.
   void refit(bool needed = false);

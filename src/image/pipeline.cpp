@@ -270,6 +270,8 @@ struct ImagePipeline::Impl {
   std::unique_ptr<PhotometricModel> photometric;  // when on
   cl::Buffer uncorrected;             // level 0 before the photometric correction (when on)
   bool has_frame = false;             // a frame is in `frame` (reprocess)
+  cl::Buffer kept;                    // a copy of `frame` (keep, reprocess_kept)
+  bool has_kept = false;
   Impl(ocl::Runtime& r, const ImagePipelineOptions& o) : rt(r), kernels(r, o), prefilter(o.prefilter) {}
 
   int w(int l) const { return level_size(camera.width, l); }
@@ -307,14 +309,15 @@ struct ImagePipeline::Impl {
     }
   }
 
-  void undistort() {
+  void undistort() { undistort(frame); }
+  void undistort(const cl::Buffer& source) {
     const cl::Buffer& level0 = prefilter ? raw : intensity[0];
     if (photometric) {
-      kernels.undistort(frame, map_index, map_weights, w(0), h(0), uncorrected);
+      kernels.undistort(source, map_index, map_weights, w(0), h(0), uncorrected);
       kernels.photometric(uncorrected, photometric->model(),
                           static_cast<float>(photometric->options().saturation), w(0), h(0), level0);
     } else {
-      kernels.undistort(frame, map_index, map_weights, w(0), h(0), level0);
+      kernels.undistort(source, map_index, map_weights, w(0), h(0), level0);
     }
     if (prefilter) kernels.smooth(raw, w(0), h(0), intensity[0]);
   }
@@ -416,6 +419,32 @@ void ImagePipeline::reprocess(Pyramid& out) {
     m.gradients(out);
   } catch (const cl::Error& e) {
     throw_opencl("reprocessing a frame", e);
+  }
+}
+
+void ImagePipeline::keep() {
+  Impl& m = *impl_;
+  if (!m.has_frame) throw_invalid_argument("image pipeline: keep before any frame");
+  const size_t bytes = PipelineKernels::frame_buffer_size(m.camera.width, m.camera.height);
+  try {
+    if (!m.has_kept) m.kept = cl::Buffer(m.rt.context(), CL_MEM_READ_WRITE, bytes);
+    m.rt.queue().enqueueCopyBuffer(m.frame, m.kept, 0, 0, bytes);
+    m.has_kept = true;
+  } catch (const cl::Error& e) {
+    throw_opencl("keeping a frame", e);
+  }
+}
+
+void ImagePipeline::reprocess_kept(Pyramid& out) {
+  Impl& m = *impl_;
+  if (!m.has_kept) throw_invalid_argument("image pipeline: reprocess_kept before keep");
+  m.ensure(out);
+  try {
+    m.undistort(m.kept);
+    m.pyramid();
+    m.gradients(out);
+  } catch (const cl::Error& e) {
+    throw_opencl("reprocessing the kept frame", e);
   }
 }
 

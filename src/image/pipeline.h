@@ -193,6 +193,13 @@ class ImagePipeline {
   // is now and without learning from it: after PhotometricModel::refit, so that a keyframe and
   // the frames aligned with it are corrected alike. InvalidArgument before any frame.
   void reprocess(Pyramid& out);
+  // Keeps the last frame on the device (a copy), for reprocess_kept: a tracker keeps its
+  // keyframe's, so that a new photometric model can correct the keyframe again at any frame.
+  void keep();
+  // The kept frame into `out`, as reprocess() does the last one. It leaves the photometric
+  // learning's frame (learn()) to the kept one until the next process or reprocess.
+  // InvalidArgument when nothing was kept.
+  void reprocess_kept(Pyramid& out);
   // The photometric model, or null when it is off.
   PhotometricModel* photometric();
 

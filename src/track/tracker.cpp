@@ -114,6 +114,8 @@ struct Tracker::Impl {
   SE2 pose;             // accumulated robot pose
   SE2 since_learnt;     // the motion since the last frame the photometric model learnt from
   bool light_holds = false;  // this frame was misaligned (held by the light fixed to the camera?)
+  bool keyframe_kept = false;  // the keyframe's camera frame is kept in the pipeline
+  bool learnt_this_frame = false;
   Estimate prev;        // the previous frame relative to the keyframe
   // Covariance of prev.T less the part the next frame shares with it ((1 - 2 rho) C; zero when
   // the previous frame is the keyframe, lost_covariance() after a Lost frame).
@@ -337,6 +339,12 @@ struct Tracker::Impl {
         photometric->refit(light_holds);
         pipeline->reprocess(keyframe);
       }
+      // Its frame stays on the device, so that a model made at a later frame can correct the
+      // keyframe again (correct_again).
+      if (photometric) {
+        pipeline->keep();
+        keyframe_kept = true;
+      }
     } else {
       // Copied into the spare pyramid, which then swaps with the keyframe's: the old keyframe's
       // contents stay for residuals() until the next frame (no more copying than in place).
@@ -354,9 +362,18 @@ struct Tracker::Impl {
         rt.queue().enqueueCopyBuffer(src.data, dst.data, 0, 0, bytes);
       }
       std::swap(keyframe, spare);
+      keyframe_kept = false;
       if (keyframe_is_slot) spare = Pyramid();  // a slot's buffers are the pipeline's, not spare
       keyframe_is_slot = false;
     }
+    select_keyframe_pixels();
+    has_keyframe = true;
+    prev = Estimate();
+    prev_covariance.setZero();
+  }
+
+  // The keyframe's subsampled pixels per level (AlignmentLevels::select_block).
+  void select_keyframe_pixels() {
     const AlignmentLevels levels = aligner.levels(keyframe, keyframe);
     for (int l = 0; l < keyframe.num_levels() && l < kMaxLevels; ++l) {
       const auto L = static_cast<size_t>(l);
@@ -365,9 +382,6 @@ struct Tracker::Impl {
       else
         selection[L] = SelectedPixels();
     }
-    has_keyframe = true;
-    prev = Estimate();
-    prev_covariance.setZero();
   }
 
   void forget_alignment(const char* why) {
@@ -406,7 +420,13 @@ struct Tracker::Impl {
   // alignment held by the light's own pattern must not keep the model from learning it).
   void learn_photometric(const FrameResult& r) {
     PhotometricModel* photometric = pipeline->photometric();
-    if (!photometric || !photometric->learning() || r.status == Status::First) return;
+    if (!photometric || !photometric->learning()) return;
+    if (learnt_this_frame || r.status == Status::First) {
+      if (!learnt_this_frame) pipeline->learn();
+      learnt_this_frame = false;
+      since_learnt = SE2();
+      return;
+    }
     const bool tracked = r.status == Status::Ok || r.status == Status::Degraded;
     if (tracked) since_learnt = since_learnt * r.motion.value;
     const bool moved = tracked && max_pixel_displacement(camera.K(), ext, SE2(), since_learnt, camera.width,
@@ -416,6 +436,24 @@ struct Tracker::Impl {
       pipeline->learn();
       since_learnt = SE2();
     }
+  }
+
+  // A frame misaligned with its keyframe by the light fixed to the camera: the model learns from
+  // it at once and, when a model can be made, the keyframe and the frame are corrected with it
+  // so that the frame can be aligned again. False when nothing changed.
+  bool correct_again(const Pyramid& live) {
+    PhotometricModel* photometric = pipeline ? pipeline->photometric() : nullptr;
+    if (!photometric || !photometric->learning() || &live != &slots[live_slot] || !keyframe_kept) return false;
+    if (!learnt_this_frame) {
+      pipeline->learn();
+      learnt_this_frame = true;
+    }
+    if (!photometric->refit_due(true)) return false;
+    photometric->refit(true);
+    pipeline->reprocess_kept(keyframe);
+    pipeline->reprocess(slots[live_slot]);
+    select_keyframe_pixels();
+    return true;
   }
 
   FrameResult track_gray(const uint8_t* gray, int width, int height, size_t stride, double t) {
@@ -554,6 +592,21 @@ struct Tracker::Impl {
           est = est2;
           ok = true;
         }
+      }
+    }
+    // Held by the light fixed to the camera: once more with the photometric model made now.
+    if (ok && res.status == Status::Lost && res.reason == kMisaligned && correct_again(live)) {
+      FrameResult again = res;
+      const char* reason3 = "";
+      Estimate est3;
+      if (align(live, init, &est3, &again, &reason3)) {
+        finish(&again, est3);
+        for (size_t l = 0; l < res.iterations.size(); ++l) {
+          again.iterations[l] += res.iterations[l];
+          again.level_ms[l] += res.level_ms[l];
+        }
+        res = again;
+        est = est3;
       }
     }
     if (ok) remember(live, est);  // before a new keyframe replaces the one aligned with

@@ -163,7 +163,7 @@ TEST(Photometric, OptionsAreChecked) {
   bad([](PhotometricOptions& o) { o.saturation = 0; });
   bad([](PhotometricOptions& o) { o.saturation = NAN; });
   bad([](PhotometricOptions& o) { o.min_frames = 0; });
-  bad([](PhotometricOptions& o) { o.memory_frames = 2; });
+  bad([](PhotometricOptions& o) { o.memory_frames = 1; });
   bad([](PhotometricOptions& o) { o.radius = -1; });
   bad([](PhotometricOptions& o) { o.min_contrast = 1.0; });
   EXPECT_NO_THROW(validate(PhotometricOptions{}));
