@@ -97,7 +97,8 @@ typedef struct planarvo_region {
 } planarvo_region;
 
 /* Pinhole camera with OpenCV's radial-tangential distortion (k1 k2 p1 p2 k3), pixel (0,0) the
- * centre of the top-left pixel. Zero-initialise it before filling it in (roi was added in 0.2). */
+ * centre of the top-left pixel. Zero-initialise it before filling it in (roi and
+ * rolling_shutter_readout were added in 0.2). */
 typedef struct planarvo_camera {
   int32_t width, height;
   double fx, fy, cx, cy;
@@ -107,6 +108,11 @@ typedef struct planarvo_camera {
    * region_of_interest). All zero: the whole image. Otherwise it must lie inside the image and be
    * at least 16 pixels on a side (else PLANARVO_ERROR_INVALID_INPUT). */
   planarvo_region roi;
+  /* Rolling shutter (camera.yaml's rolling_shutter_readout, added in 0.2): seconds from reading
+   * the first image row to reading the last; 0 = global shutter. A frame's time stamp is when
+   * its first row is read; row r of H rows is read at stamp + r / (H - 1) * readout. Negative or
+   * not finite: PLANARVO_ERROR_INVALID_INPUT. */
+  double rolling_shutter_readout;
 } planarvo_camera;
 
 /* Camera pose on the robot: centre (x, y, z) in metres, z the height above the ground;

@@ -193,6 +193,9 @@ void print_dataset(planarvo_dataset* ds, const std::string& dir) {
                 c.roi.height);
   else
     std::printf("  region      the whole image\n");
+  if (c.rolling_shutter_readout > 0)
+    std::printf("  shutter     rolling, %.3f ms from the first row's read to the last's\n",
+                c.rolling_shutter_readout * 1e3);
   std::printf("  odometry    %s\n  direction   %s\n  groundtruth %s\n", info.has_odometry ? "yes" : "no",
               info.has_direction ? "yes" : "no", info.has_groundtruth ? "yes" : "no");
   auto ext = [](const char* label, int has, const planarvo_extrinsics& e) {
