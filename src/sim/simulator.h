@@ -168,8 +168,19 @@ FrameParams frame_params(const SE2& robot_pose, const Extrinsics& extrinsics,
                          const Eigen::Vector2d& texel, const MipPyramid& pyramid,
                          int supersampling, bool mipmap);
 
-// The plain C++ reference of the render kernel: CV_32FC1, grey levels.
+// The kernel takes its homography per output row (a rolling shutter sees each row from its own
+// pose): height x 9 floats, row y's the homography (FrameParams kParamH..kParamH+8) for row y.
+// row_homographies(p, height) repeats one frame's (a global shutter); the other builds them
+// from one parameter block per row.
+std::vector<float> row_homographies(const FrameParams& p, int height);
+std::vector<float> row_homographies(const std::vector<FrameParams>& rows);
+
+// The plain C++ reference of the render kernel: CV_32FC1, grey levels. The first uses p's
+// homography for every row; the second row y's of `rows` (height x 9 floats) and p's other
+// entries (kParamInvS and after).
 cv::Mat render_reference(const MipPyramid& pyramid, const RayTable& rays, const FrameParams& p);
+cv::Mat render_reference(const MipPyramid& pyramid, const RayTable& rays, const FrameParams& p,
+                         const std::vector<float>& rows);
 
 class Renderer {
  public:
@@ -183,6 +194,10 @@ class Renderer {
   // The noise-free, gain-free image at a robot pose: CV_32FC1 grey levels, or rounded CV_8UC1.
   cv::Mat render_float(const SE2& robot_pose);
   cv::Mat render(const SE2& robot_pose);
+  // Row y seen from robot pose row_poses[y] (one per image row), CV_32FC1: one frame of a
+  // rolling shutter at one instant of its exposure. Row y equals row y of
+  // render_float(row_poses[y]) bit for bit.
+  cv::Mat render_float_rows(const std::vector<SE2>& row_poses);
 
   const MipPyramid& pyramid() const;
   const RayTable& rays() const;
