@@ -297,6 +297,13 @@ typedef struct planarvo_sim_options {
   void* progress_user_data;
   double min_turn_radius;     /* PLANARVO_MOTION_CAR: the tightest turn, metres; default 0 (only
                                  max_turn_rate limits it). Read only when struct_size covers it. */
+  /* Real-camera geometry; each read only when struct_size covers it. */
+  double readout_time;        /* rolling shutter: seconds from the first row's read to the last's,
+                                 at most 1 / fps; written into camera.yaml as
+                                 rolling_shutter_readout; default 0 (global shutter). The camera's
+                                 own rolling_shutter_readout is replaced by it. */
+  double exposure_time;       /* seconds each row integrates the moving scene before it is read
+                                 (motion blur), at most 1 / fps; default 0 (instantaneous) */
 } planarvo_sim_options;
 
 PLANARVO_API void planarvo_sim_options_init(planarvo_sim_options* options);

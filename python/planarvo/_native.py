@@ -98,7 +98,7 @@ class SimOptions(ctypes.Structure):
                 ("seed", c_uint64), ("motion", c_enum), ("max_speed", c_double), ("max_turn_rate", c_double),
                 ("pixel_noise", c_double), ("gain_variation", c_double), ("odometry_noise", c_double),
                 ("supersampling", c_int32), ("progress", PROGRESS_FN), ("progress_user_data", c_void_p),
-                ("min_turn_radius", c_double)]
+                ("min_turn_radius", c_double), ("readout_time", c_double), ("exposure_time", c_double)]
 
 
 class TrackerOptions(ctypes.Structure):

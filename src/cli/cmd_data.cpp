@@ -51,6 +51,10 @@ std::vector<OptionSpec> simulate_options() {
       {"noise", "SIGMA", "pixel noise standard deviation, grey levels", "1"},
       {"gain-variation", "REL", "amplitude of slow camera gain changes", "0.05"},
       {"odometry-noise", "REL", "wheel odometry error per unit of wheel travel", "0.01"},
+      {"readout-time", "SECONDS", "rolling shutter: first row's read to last row's, at most 1/fps; written to "
+       "camera.yaml as rolling_shutter_readout (0: global shutter)", "0"},
+      {"exposure", "SECONDS", "exposure time: each row averages the moving ground over this long before it is read "
+       "(motion blur), at most 1/fps", "0"},
       {"width", "PX", "image width", "640"},
       {"height", "PX", "image height", "480"},
       {"fov", "DEG", "horizontal field of view", "80"},
@@ -92,6 +96,8 @@ void apply_simulate_args(const Args& a, planarvo_sim_options* o, std::string* te
   o->pixel_noise = a.get_double("noise", o->pixel_noise);
   o->gain_variation = a.get_double("gain-variation", o->gain_variation);
   o->odometry_noise = a.get_double("odometry-noise", o->odometry_noise);
+  o->readout_time = a.get_double("readout-time", o->readout_time);
+  o->exposure_time = a.get_double("exposure", o->exposure_time);
   o->supersampling = static_cast<int32_t>(a.get_int("supersampling", o->supersampling));
   planarvo_camera& c = o->camera;
   if (a.has("width") || a.has("height") || a.has("fov")) {

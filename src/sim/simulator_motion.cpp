@@ -225,6 +225,16 @@ void validate(const Options& o) {
           "odometry_noise_floor must be >= 0");
   require(std::isfinite(o.wheel_base) && o.wheel_base > 0, "wheel_base must be positive");
   require(o.supersampling >= 1 && o.supersampling <= 16, "supersampling must be 1 to 16");
+  require(std::isfinite(o.readout_time) && o.readout_time >= 0,
+          "readout_time must be a finite number of seconds >= 0");
+  require(o.readout_time <= 1.0 / o.fps,
+          "readout_time (" + std::to_string(o.readout_time) + " s) must not exceed the frame period 1 / fps (" +
+              std::to_string(1.0 / o.fps) + " s): a rolling shutter reads every row of a frame before the next");
+  require(std::isfinite(o.exposure_time) && o.exposure_time >= 0,
+          "exposure_time must be a finite number of seconds >= 0");
+  require(o.exposure_time <= 1.0 / o.fps,
+          "exposure_time (" + std::to_string(o.exposure_time) + " s) must not exceed the frame period 1 / fps (" +
+              std::to_string(1.0 / o.fps) + " s)");
   Eigen::Vector2d px;
   const double reach = farthest_ground_view(o.camera, o.extrinsics, &px);
   const std::string at = "pixel (" + std::to_string(static_cast<int>(px.x())) + ", " +

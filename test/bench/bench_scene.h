@@ -48,11 +48,14 @@ struct Scene {
   int supersampling = 3;  // ss=N: the renderer's subsamples per pixel along each axis
   bool mipmap = true;     // mip=0: no prefiltered texture (only the subsamples average)
   bool distortion = true; // dist=0: a pinhole camera (no lens distortion, so no resampling of the noise)
+  double readout = 0.0;   // readout=SECONDS: rolling shutter, first row's read to last's (0: global)
+  double exposure = 0.0;  // exposure=SECONDS: motion blur over this long before each row's read
   sim::MotionProfile motion = sim::MotionProfile::Mixed;
 
   Extrinsics extrinsics() const { return has_ext ? ext : sim::paper_configuration(config); }
 
-  // Takes one key=value argument: config, ext, fov, motion, speed, turn, radius, noise, ss, mip, dist. False
+  // Takes one key=value argument: config, ext, fov, motion, speed, turn, radius, noise, ss, mip, dist,
+  // readout, exposure. False
   // for another key; exits with a message on a bad value.
   bool parse(const std::string& k, const std::string& v) {
     if (k == "config") {
@@ -87,6 +90,10 @@ struct Scene {
       mipmap = std::atoi(v.c_str()) != 0;
     } else if (k == "dist") {
       distortion = std::atoi(v.c_str()) != 0;
+    } else if (k == "readout") {
+      readout = std::atof(v.c_str());
+    } else if (k == "exposure") {
+      exposure = std::atof(v.c_str());
     } else {
       return false;
     }
@@ -111,6 +118,9 @@ struct Scene {
     so.extrinsics = extrinsics();
     so.supersampling = supersampling;
     so.mipmap = mipmap;
+    so.readout_time = readout;
+    so.exposure_time = exposure;
+    so.camera.rolling_shutter_readout = readout;
     return so;
   }
 
@@ -120,7 +130,13 @@ struct Scene {
     char b[320];
     std::snprintf(b, sizeof b, "camera %s, fov %.0f deg; %s motion up to %.2f m/s and %.2f rad/s%s; noise %.1f grey levels",
                   describe(extrinsics()).c_str(), fov, sim::motion_profile_name(motion), speed, turn, r, noise);
-    return b;
+    std::string out = b;
+    if (readout > 0 || exposure > 0) {
+      char c[96];
+      std::snprintf(c, sizeof c, "; rolling shutter readout %.1f ms, exposure %.1f ms", readout * 1e3, exposure * 1e3);
+      out += c;
+    }
+    return out;
   }
 
   [[noreturn]] static void fail(const char* what) {
@@ -129,11 +145,12 @@ struct Scene {
   }
 };
 
-// Frame k of a simulated sequence as the camera gives it: rendered at the true pose, then the
-// camera's gain, offset and noise, seeded per frame (every benchmark sees the same frames).
+// Frame k of a simulated sequence as the camera gives it: rendered as sim::render_frame sees it
+// (each row at its read time, averaged over the exposure), then the camera's gain, offset and
+// noise, seeded per frame (every benchmark sees the same frames).
 inline cv::Mat camera_frame(sim::Renderer& renderer, const sim::Options& so, const sim::Trajectory& traj,
                             const std::vector<sim::Exposure>& exposure, size_t k) {
-  return sim::apply_camera(renderer.render_float(traj.pose[k]), exposure[k], so.pixel_noise,
+  return sim::apply_camera(sim::render_frame(renderer, so, traj, k), exposure[k], so.pixel_noise,
                            sim::derive_seed(so.seed, 1000 + k));
 }
 
