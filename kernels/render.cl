@@ -1,8 +1,9 @@
 // The simulator's ground renderer (src/sim/simulator.h, src/sim/SIMULATOR.md).
 //
 // One work-item per output pixel. Each pixel averages S*S subsamples; a subsample's undistorted
-// ray (from a table computed on the host in 64-bit precision) maps through the frame's homography to
-// texture coordinates, and is looked up trilinearly in the mirror-tiled mip pyramid at the
+// ray (from a table computed on the host in 64-bit precision) maps through its row's homography
+// to texture coordinates (one per row: a rolling shutter sees each row from its own pose; a global
+// shutter repeats one), and is looked up trilinearly in the mirror-tiled mip pyramid at the
 // level of the pixel's footprint on the ground divided by S. render_reference() in
 // src/sim/simulator_render.cpp is the plain C++ reference of this kernel: keep them in step.
 //
@@ -11,8 +12,9 @@
 //   levels  per level: offset into tex, width, height (powers of two)
 //   pix     6 planes of width*height: pixel-centre ray x, y; d(ray)/d(pixel) j00 j01 j10 j11
 //   sub     2*ns planes of width*height: subsample rays x, y
-//   prm     H[9] (ray -> texture coordinates), 1/S, highest level, far value, 1/ns
+//   prm     H[9] (unused here: see hrows), 1/S, highest level, far value, 1/ns
 //   out     width x height floats with the given row stride
+//   hrows   height x 9 floats: row y's homography (ray -> texture coordinates), row-major
 
 #ifndef RENDER_WG_X
 #define RENDER_WG_X 16
@@ -45,16 +47,18 @@ inline float rnd_bilinear(__global const float* tex, int offset, int w, int h, f
 __kernel __attribute__((reqd_work_group_size(RENDER_WG_X, RENDER_WG_Y, 1)))
 void render_ground(__global const float* tex, __constant int* levels, __global const float* pix,
                    __global const float* sub, const int ns, __constant float* prm,
-                   const int width, const int height, __global float* out, const int out_stride) {
+                   const int width, const int height, __global float* out, const int out_stride,
+                   __global const float* hrows) {
   const int x = (int)get_global_id(0);
   const int y = (int)get_global_id(1);
   if (x >= width || y >= height) return;
   const int n = width * height;
   const int p = y * width + x;
 
-  const float H0 = prm[0], H1 = prm[1], H2 = prm[2];
-  const float H3 = prm[3], H4 = prm[4], H5 = prm[5];
-  const float H6 = prm[6], H7 = prm[7], H8 = prm[8];
+  __global const float* hy = hrows + 9 * y;
+  const float H0 = hy[0], H1 = hy[1], H2 = hy[2];
+  const float H3 = hy[3], H4 = hy[4], H5 = hy[5];
+  const float H6 = hy[6], H7 = hy[7], H8 = hy[8];
   const float inv_s = prm[9], lod_max = prm[10], far_value = prm[11], inv_count = prm[12];
 
   // Level of detail from the pixel centre: the longer side of the subsample's footprint,

@@ -97,7 +97,8 @@ typedef struct planarvo_region {
 } planarvo_region;
 
 /* Pinhole camera with OpenCV's radial-tangential distortion (k1 k2 p1 p2 k3), pixel (0,0) the
- * centre of the top-left pixel. Zero-initialise it before filling it in (roi was added in 0.2). */
+ * centre of the top-left pixel. Zero-initialise it before filling it in (roi and
+ * rolling_shutter_readout were added in 0.2). */
 typedef struct planarvo_camera {
   int32_t width, height;
   double fx, fy, cx, cy;
@@ -107,6 +108,11 @@ typedef struct planarvo_camera {
    * region_of_interest). All zero: the whole image. Otherwise it must lie inside the image and be
    * at least 16 pixels on a side (else PLANARVO_ERROR_INVALID_INPUT). */
   planarvo_region roi;
+  /* Rolling shutter (camera.yaml's rolling_shutter_readout, added in 0.2): seconds from reading
+   * the first image row to reading the last; 0 = global shutter. A frame's time stamp is when
+   * its first row is read; row r of H rows is read at stamp + r / (H - 1) * readout. Negative or
+   * not finite: PLANARVO_ERROR_INVALID_INPUT. */
+  double rolling_shutter_readout;
 } planarvo_camera;
 
 /* Camera pose on the robot: centre (x, y, z) in metres, z the height above the ground;
@@ -291,6 +297,13 @@ typedef struct planarvo_sim_options {
   void* progress_user_data;
   double min_turn_radius;     /* PLANARVO_MOTION_CAR: the tightest turn, metres; default 0 (only
                                  max_turn_rate limits it). Read only when struct_size covers it. */
+  /* Real-camera geometry; each read only when struct_size covers it. */
+  double readout_time;        /* rolling shutter: seconds from the first row's read to the last's,
+                                 at most 1 / fps; written into camera.yaml as
+                                 rolling_shutter_readout; default 0 (global shutter). The camera's
+                                 own rolling_shutter_readout is replaced by it. */
+  double exposure_time;       /* seconds each row integrates the moving scene before it is read
+                                 (motion blur), at most 1 / fps; default 0 (instantaneous) */
   /* Light fixed to the camera (a real camera's own lamp, its reflection, the robot's shadow),
    * each 0 = none (the default). Read only when struct_size covers them. */
   double lamp_falloff;        /* a lamp beside the lens: the darkest image corner gets 1 - this

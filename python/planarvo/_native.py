@@ -30,7 +30,8 @@ class Region(ctypes.Structure):
 
 class Camera(ctypes.Structure):
     _fields_ = [("width", c_int32), ("height", c_int32)] + [
-        (n, c_double) for n in ("fx", "fy", "cx", "cy", "k1", "k2", "p1", "p2", "k3")] + [("roi", Region)]
+        (n, c_double) for n in ("fx", "fy", "cx", "cy", "k1", "k2", "p1", "p2", "k3")] + [
+        ("roi", Region), ("rolling_shutter_readout", c_double)]
 
 
 class Extrinsics(ctypes.Structure):
@@ -97,8 +98,8 @@ class SimOptions(ctypes.Structure):
                 ("seed", c_uint64), ("motion", c_enum), ("max_speed", c_double), ("max_turn_rate", c_double),
                 ("pixel_noise", c_double), ("gain_variation", c_double), ("odometry_noise", c_double),
                 ("supersampling", c_int32), ("progress", PROGRESS_FN), ("progress_user_data", c_void_p),
-                ("min_turn_radius", c_double), ("lamp_falloff", c_double), ("reflection", c_double),
-                ("shadow", c_double)]
+                ("min_turn_radius", c_double), ("readout_time", c_double), ("exposure_time", c_double),
+                ("lamp_falloff", c_double), ("reflection", c_double), ("shadow", c_double)]
 
 
 class TrackerOptions(ctypes.Structure):

@@ -43,6 +43,8 @@ class SimOptions:
     odometry_noise: Optional[float] = None
     supersampling: Optional[int] = None
     min_turn_radius: Optional[float] = None
+    readout_time: Optional[float] = None    # rolling shutter, seconds first row to last; default 0
+    exposure_time: Optional[float] = None   # seconds of motion blur before each row's read; default 0
     # Light fixed to the camera: a lamp's falloff (the darkest corner gets 1 - lamp_falloff),
     # its reflection on a glossy floor (peak grey levels added), the robot's shadow (fraction).
     lamp_falloff: Optional[float] = None

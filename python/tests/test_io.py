@@ -15,6 +15,19 @@ def test_camera_round_trip(tmp_path):
     assert planarvo.Camera.load(tmp_path / "camera.yaml") == cam
 
 
+def test_rolling_shutter_readout_round_trip_and_simulated(context, tmp_path):
+    cam = planarvo.Camera(640, 480, 501.25, 499.5, 319.75, 241.125, rolling_shutter_readout=0.0271)
+    cam.save(tmp_path / "camera.yaml")
+    assert planarvo.Camera.load(tmp_path / "camera.yaml") == cam
+    assert planarvo.Camera.simulator_default(96, 64, 80.0).rolling_shutter_readout == 0.0
+    options = planarvo.SimOptions(camera=planarvo.Camera.simulator_default(96, 64, 80.0), seconds=0.2,
+                                  readout_time=0.02, exposure_time=0.004)
+    planarvo.simulate(context, tmp_path / "rs", options)
+    assert planarvo.Camera.load(tmp_path / "rs" / "camera.yaml").rolling_shutter_readout == 0.02
+    with pytest.raises(planarvo.Error):
+        planarvo.simulate(context, tmp_path / "bad", planarvo.SimOptions(seconds=0.2, readout_time=-1.0))
+
+
 def test_extrinsics_round_trip_and_matrix(tmp_path):
     e = planarvo.Extrinsics(0.2441, -0.0185, 0.1787, math.radians(12.4), math.radians(17.6), math.radians(-9.2))
     cov = np.diag([1e-6, 2e-6, 3e-6, 1e-4, 2e-4, 3e-4])

@@ -33,6 +33,8 @@ PLANARVO_API void planarvo_sim_options_init(planarvo_sim_options* o) {
   o->odometry_noise = d.odometry_noise;
   o->supersampling = d.supersampling;
   o->min_turn_radius = d.min_turn_radius;
+  o->readout_time = d.readout_time;
+  o->exposure_time = d.exposure_time;
   o->lamp_falloff = d.lamp_falloff;
   o->reflection = d.reflection;
   o->shadow = d.shadow;
@@ -79,6 +81,10 @@ PLANARVO_API planarvo_status planarvo_simulate(planarvo_context* context, const 
     s.max_turn_rate = o->max_turn_rate;
     if (o->struct_size >= offsetof(planarvo_sim_options, min_turn_radius) + sizeof(double))
       s.min_turn_radius = o->min_turn_radius;
+    if (o->struct_size >= offsetof(planarvo_sim_options, readout_time) + sizeof(double))
+      s.readout_time = o->readout_time;
+    if (o->struct_size >= offsetof(planarvo_sim_options, exposure_time) + sizeof(double))
+      s.exposure_time = o->exposure_time;
     if (o->struct_size >= offsetof(planarvo_sim_options, shadow) + sizeof(double)) {
       s.lamp_falloff = o->lamp_falloff;
       s.reflection = o->reflection;

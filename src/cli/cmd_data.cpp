@@ -51,6 +51,10 @@ std::vector<OptionSpec> simulate_options() {
       {"noise", "SIGMA", "pixel noise standard deviation, grey levels", "1"},
       {"gain-variation", "REL", "amplitude of slow camera gain changes", "0.05"},
       {"odometry-noise", "REL", "wheel odometry error per unit of wheel travel", "0.01"},
+      {"readout-time", "SECONDS", "rolling shutter: first row's read to last row's, at most 1/fps; written to "
+       "camera.yaml as rolling_shutter_readout (0: global shutter)", "0"},
+      {"exposure", "SECONDS", "exposure time: each row averages the moving ground over this long before it is read "
+       "(motion blur), at most 1/fps", "0"},
       {"lamp", "F", "a camera-mounted lamp: the darkest corner gets 1 - F of the light (0..0.95)", "0 (even light)"},
       {"reflection", "GREY", "the lamp's reflection on a glossy floor: peak grey levels added (saturates)", "0"},
       {"shadow", "F", "the robot's shadow over the image's bottom: fraction of light taken (0..0.95)", "0"},
@@ -98,6 +102,8 @@ void apply_simulate_args(const Args& a, planarvo_sim_options* o, std::string* te
   o->reflection = a.get_double("reflection", o->reflection);
   o->shadow = a.get_double("shadow", o->shadow);
   o->odometry_noise = a.get_double("odometry-noise", o->odometry_noise);
+  o->readout_time = a.get_double("readout-time", o->readout_time);
+  o->exposure_time = a.get_double("exposure", o->exposure_time);
   o->supersampling = static_cast<int32_t>(a.get_int("supersampling", o->supersampling));
   planarvo_camera& c = o->camera;
   if (a.has("width") || a.has("height") || a.has("fov")) {
@@ -199,6 +205,9 @@ void print_dataset(planarvo_dataset* ds, const std::string& dir) {
                 c.roi.height);
   else
     std::printf("  region      the whole image\n");
+  if (c.rolling_shutter_readout > 0)
+    std::printf("  shutter     rolling, %.3f ms from the first row's read to the last's\n",
+                c.rolling_shutter_readout * 1e3);
   std::printf("  odometry    %s\n  direction   %s\n  groundtruth %s\n", info.has_odometry ? "yes" : "no",
               info.has_direction ? "yes" : "no", info.has_groundtruth ? "yes" : "no");
   auto ext = [](const char* label, int has, const planarvo_extrinsics& e) {

@@ -1,6 +1,7 @@
 #include "image/camera.h"
 
 #include <cmath>
+#include <cstdio>
 #include <string>
 
 #include <Eigen/Dense>
@@ -63,6 +64,12 @@ void CameraModel::validate(const char* what) const {
     if (!std::isfinite(v)) throw_invalid_input(where + ": camera parameters contain NaN or inf");
   if (!(fx > 0) || !(fy > 0))
     throw_invalid_input(where + ": focal lengths fx, fy must be positive");
+  if (!std::isfinite(rolling_shutter_readout) || rolling_shutter_readout < 0) {
+    char got[32];
+    std::snprintf(got, sizeof got, "%g", rolling_shutter_readout);
+    throw_invalid_input(where + ": rolling_shutter_readout must be a finite number of seconds >= 0 (got " +
+                        got + ")");
+  }
   if (roi.width != 0 || roi.height != 0) {
     const std::string r = "region of interest [" + std::to_string(roi.x) + ", " + std::to_string(roi.y) + ", " +
                           std::to_string(roi.width) + ", " + std::to_string(roi.height) + "] (x, y, width, height)";

@@ -42,6 +42,10 @@ struct CameraModel {
   // from an image treats pixels outside it as having no value, through the undistortion map
   // (image/undistort.h). Empty: the whole image.
   PixelRegion roi;
+  // Rolling shutter: seconds from reading the first image row to reading the last (camera.yaml's
+  // rolling_shutter_readout); 0 = global shutter. A frame's stamp is when its first row is read:
+  // row r of H is read at stamp + r / (H - 1) * rolling_shutter_readout (docs/conventions.md).
+  double rolling_shutter_readout = 0;
   // The region of interest, or the whole image when none is given.
   PixelRegion region() const { return roi.empty() ? PixelRegion{0, 0, width, height} : roi; }
 
@@ -60,8 +64,8 @@ struct CameraModel {
   Eigen::Vector2d unproject(const Eigen::Vector2d& pixel) const;
 
   // Throws InvalidInput (naming `what`, e.g. the file) when sizes or focal lengths are not
-  // positive or a value is not finite, or the region of interest is not inside the image or is
-  // smaller than kMinRegionSide pixels on a side.
+  // positive or a value is not finite, the rolling shutter readout is negative, or the region
+  // of interest is not inside the image or is smaller than kMinRegionSide pixels on a side.
   void validate(const char* what) const;
 };
 

@@ -456,6 +456,10 @@ CameraModel read_camera_yaml(const std::string& path) {
       if (cam.roi.empty())
         fail(path, "'region_of_interest' has no pixels (width and height must be positive)");
     }
+    // planarvo's own, optional: absent is a global shutter. Range checked by validate().
+    const cv::FileNode readout = fs["rolling_shutter_readout"];
+    if (!readout.empty() && !readout.isNone())
+      cam.rolling_shutter_readout = read_real(readout, path, "rolling_shutter_readout");
     cam.validate(path.c_str());
     return cam;
   });
@@ -477,6 +481,7 @@ void write_camera_yaml(const std::string& path, const CameraModel& camera) {
   fs << "distortion_coefficients" << D;
   if (!camera.roi.empty())
     fs << "region_of_interest" << "[:" << camera.roi.x << camera.roi.y << camera.roi.width << camera.roi.height << "]";
+  if (camera.rolling_shutter_readout != 0) fs << "rolling_shutter_readout" << camera.rolling_shutter_readout;
   write_storage_text(path, fs);
 }
 

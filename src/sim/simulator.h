@@ -84,6 +84,13 @@ struct Options {
   double odometry_noise = 0.01;     // relative standard deviation of each wheel's travel
   double odometry_noise_floor = 1e-6;  // absolute floor of that standard deviation, metres
   double wheel_base = 0.33;         // distance between the wheels, metres (a Pioneer 3-DX)
+  // Real-camera geometry (rolling shutter, exposure)
+  double readout_time = 0.0;        // rolling shutter: seconds from reading the first row to the
+                                    // last, at most 1 / fps (0: global shutter); the rendered
+                                    // camera's rolling_shutter_readout, written into camera.yaml
+                                    // (camera.rolling_shutter_readout is not used)
+  double exposure_time = 0.0;       // seconds each row integrates the moving scene before it is
+                                    // read, at most 1 / fps (0: instantaneous, no motion blur)
   int supersampling = 3;            // samples per pixel along each axis (ray tables take
                                     // 8 S^2 + 24 bytes per pixel: 29 MB at 640x480, S = 3)
   bool mipmap = true;               // prefilter the texture (off only for tests/references)
@@ -114,6 +121,11 @@ struct Trajectory {
 // (a controller commanding at the frame rate), so each interval is an exact arc:
 // pose[k+1] = pose[k] * SE2::exp((v dt, 0, omega dt)).
 Trajectory generate_trajectory(const Options& options);
+
+// The robot's true pose at time t: exact arcs between frames,
+// pose[k] * SE2::exp((t - t_k) * (v, 0, omega)) for t in [t_k, t_k+1), exactly pose[k] at t_k;
+// standing at pose[0] before t_0; after the last frame, the last interval's velocity continued.
+SE2 pose_at(const Trajectory& trajectory, double t);
 
 // ---------------------------------------------------------------------------------------------
 // Rendering. The texture is prefiltered into a float mip pyramid; every output pixel averages
@@ -175,8 +187,19 @@ FrameParams frame_params(const SE2& robot_pose, const Extrinsics& extrinsics,
                          const Eigen::Vector2d& texel, const MipPyramid& pyramid,
                          int supersampling, bool mipmap);
 
-// The plain C++ reference of the render kernel: CV_32FC1, grey levels.
+// The kernel takes its homography per output row (a rolling shutter sees each row from its own
+// pose): height x 9 floats, row y's the homography (FrameParams kParamH..kParamH+8) for row y.
+// row_homographies(p, height) repeats one frame's (a global shutter); the other builds them
+// from one parameter block per row.
+std::vector<float> row_homographies(const FrameParams& p, int height);
+std::vector<float> row_homographies(const std::vector<FrameParams>& rows);
+
+// The plain C++ reference of the render kernel: CV_32FC1, grey levels. The first uses p's
+// homography for every row; the second row y's of `rows` (height x 9 floats) and p's other
+// entries (kParamInvS and after).
 cv::Mat render_reference(const MipPyramid& pyramid, const RayTable& rays, const FrameParams& p);
+cv::Mat render_reference(const MipPyramid& pyramid, const RayTable& rays, const FrameParams& p,
+                         const std::vector<float>& rows);
 
 class Renderer {
  public:
@@ -190,6 +213,10 @@ class Renderer {
   // The noise-free, gain-free image at a robot pose: CV_32FC1 grey levels, or rounded CV_8UC1.
   cv::Mat render_float(const SE2& robot_pose);
   cv::Mat render(const SE2& robot_pose);
+  // Row y seen from robot pose row_poses[y] (one per image row), CV_32FC1: one frame of a
+  // rolling shutter at one instant of its exposure. Row y equals row y of
+  // render_float(row_poses[y]) bit for bit.
+  cv::Mat render_float_rows(const std::vector<SE2>& row_poses);
 
   const MipPyramid& pyramid() const;
   const RayTable& rays() const;
@@ -203,6 +230,28 @@ class Renderer {
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
+
+// ---------------------------------------------------------------------------------------------
+// What a real camera sees of the moving ground: a rolling shutter and a finite exposure.
+
+// How fast the image moves for a robot driving at velocity (v, omega) (m/s, rad/s): the largest
+// image speed, pixels per second, of the ground points seen at a 9 x 9 grid of pixels over the
+// image (corners included), for options.camera on options.extrinsics.
+double image_speed(const Options& options, const Eigen::Vector2d& velocity);
+
+// The number of sub-renders that frame k's exposure is averaged from: with E = exposure_time and
+// s the largest image_speed over the trajectory's intervals during [t_k - E, t_k + readout_time]
+// (standing before t_0, the last velocity after the last frame), ceil(2 s E), so that the image
+// moves less than half a pixel between sub-renders, clamped to [1, 64]; 1 when E is 0.
+int exposure_samples(const Options& options, const Trajectory& trajectory, size_t k);
+
+// The ground as camera frame k sees it (before gain, noise and quantisation): each row at its
+// own read time (rolling shutter), each averaged over the exposure before that time. Row r of H
+// is read at t_r = t_k + r / (H - 1) * readout_time, and is the mean of N = exposure_samples()
+// renders at t_r - E + (i + 0.5) E / N, i = 0 .. N-1 (the midpoints of N equal parts of
+// [t_r - E, t_r]); the robot at pose_at(trajectory, time). CV_32FC1, grey levels. With neither
+// readout nor exposure it is renderer.render_float(trajectory.pose[k]) bit for bit.
+cv::Mat render_frame(Renderer& renderer, const Options& options, const Trajectory& trajectory, size_t k);
 
 // ---------------------------------------------------------------------------------------------
 // The camera: slow smooth gain change, additive Gaussian noise, 8-bit quantisation.

@@ -225,6 +225,16 @@ void validate(const Options& o) {
           "odometry_noise_floor must be >= 0");
   require(std::isfinite(o.wheel_base) && o.wheel_base > 0, "wheel_base must be positive");
   require(o.supersampling >= 1 && o.supersampling <= 16, "supersampling must be 1 to 16");
+  require(std::isfinite(o.readout_time) && o.readout_time >= 0,
+          "readout_time must be a finite number of seconds >= 0");
+  require(o.readout_time <= 1.0 / o.fps,
+          "readout_time (" + std::to_string(o.readout_time) + " s) must not exceed the frame period 1 / fps (" +
+              std::to_string(1.0 / o.fps) + " s): a rolling shutter reads every row of a frame before the next");
+  require(std::isfinite(o.exposure_time) && o.exposure_time >= 0,
+          "exposure_time must be a finite number of seconds >= 0");
+  require(o.exposure_time <= 1.0 / o.fps,
+          "exposure_time (" + std::to_string(o.exposure_time) + " s) must not exceed the frame period 1 / fps (" +
+              std::to_string(1.0 / o.fps) + " s)");
   require(std::isfinite(o.lamp_falloff) && o.lamp_falloff >= 0 && o.lamp_falloff <= 0.95,
           "lamp_falloff must be in [0, 0.95]");
   require(std::isfinite(o.reflection) && o.reflection >= 0 && o.reflection <= 1000,

@@ -197,21 +197,42 @@ FrameParams frame_params(const SE2& robot_pose, const Extrinsics& extrinsics,
   return p;
 }
 
+std::vector<float> row_homographies(const FrameParams& p, int height) {
+  std::vector<float> rows(9 * static_cast<size_t>(std::max(height, 0)));
+  for (size_t i = 0; i < rows.size(); ++i) rows[i] = p[static_cast<size_t>(kParamH) + i % 9];
+  return rows;
+}
+
+std::vector<float> row_homographies(const std::vector<FrameParams>& params) {
+  std::vector<float> rows(9 * params.size());
+  for (size_t y = 0; y < params.size(); ++y)
+    for (size_t i = 0; i < 9; ++i) rows[9 * y + i] = params[y][static_cast<size_t>(kParamH) + i];
+  return rows;
+}
+
 cv::Mat render_reference(const MipPyramid& pyramid, const RayTable& rays, const FrameParams& prm) {
+  return render_reference(pyramid, rays, prm, row_homographies(prm, rays.height));
+}
+
+cv::Mat render_reference(const MipPyramid& pyramid, const RayTable& rays, const FrameParams& prm,
+                         const std::vector<float>& hrows) {
   const int width = rays.width, height = rays.height;
+  if (hrows.size() != 9 * static_cast<size_t>(height))
+    throw_invalid_argument("render_reference: needs 9 homography entries per image row");
   const int ns = rays.supersampling * rays.supersampling;
   const size_t n = static_cast<size_t>(width) * static_cast<size_t>(height);
   cv::Mat out(height, width, CV_32FC1);
-  const float H0 = prm[0], H1 = prm[1], H2 = prm[2];
-  const float H3 = prm[3], H4 = prm[4], H5 = prm[5];
-  const float H6 = prm[6], H7 = prm[7], H8 = prm[8];
   const float inv_s = prm[kParamInvS], lod_max = prm[kParamLodMax];
   const float far_value = prm[kParamFar], inv_count = prm[kParamInvCount];
   const float* tex = pyramid.data.data();
   const int* levels = pyramid.levels.data();
   const float* pix = rays.pixel.data();
   const float* sub = rays.sub.data();
-  for (int y = 0; y < height; ++y)
+  for (int y = 0; y < height; ++y) {
+    const float* hy = hrows.data() + 9 * static_cast<size_t>(y);
+    const float H0 = hy[0], H1 = hy[1], H2 = hy[2];
+    const float H3 = hy[3], H4 = hy[4], H5 = hy[5];
+    const float H6 = hy[6], H7 = hy[7], H8 = hy[8];
     for (int x = 0; x < width; ++x) {
       const size_t p = static_cast<size_t>(y) * static_cast<size_t>(width) + static_cast<size_t>(x);
       const float cx = pix[p], cy = pix[n + p];
@@ -261,6 +282,7 @@ cv::Mat render_reference(const MipPyramid& pyramid, const RayTable& rays, const 
       }
       out.at<float>(y, x) = acc * inv_count;
     }
+  }
   return out;
 }
 
@@ -274,8 +296,11 @@ struct Renderer::Impl {
   RayTable rays;
   cl::Kernel kernel;
   size_t wg_x = 1, wg_y = 1;  // the kernel's reqd_work_group_size
-  cl::Buffer tex, levels, pix, sub, prm, out;
+  cl::Buffer tex, levels, pix, sub, prm, out, hrows;
   explicit Impl(ocl::Runtime& r) : rt(r) {}
+
+  // One launch: the parameter block p (its homography unused) and height x 9 row homographies.
+  cv::Mat launch(const FrameParams& p, const std::vector<float>& rows);
 };
 
 // The kernel's defaults (RENDER_WG_X x RENDER_WG_Y = 16 x 4; PoCL measured within 10 % of each
@@ -333,6 +358,8 @@ Renderer::Renderer(ocl::Runtime& runtime, const cv::Mat& texture, const Options&
     m.kernel.setArg(7, static_cast<cl_int>(m.rays.height));
     m.kernel.setArg(8, m.out);
     m.kernel.setArg(9, static_cast<cl_int>(m.rays.width));
+    m.hrows = cl::Buffer(ctx, CL_MEM_READ_ONLY, 9 * static_cast<size_t>(m.rays.height) * sizeof(float));
+    m.kernel.setArg(10, m.hrows);
   } catch (const cl::Error& e) {
     throw Error(ErrorCode::OpenCL, std::string("simulator: setting up the render kernel failed: ") +
                                        e.what() + " " + ocl::error_name(e.err()));
@@ -351,21 +378,37 @@ FrameParams Renderer::params(const SE2& robot_pose) const {
 }
 
 cv::Mat Renderer::render_float(const SE2& robot_pose) {
-  Impl& m = *impl_;
   const FrameParams p = params(robot_pose);
-  cv::Mat out(m.rays.height, m.rays.width, CV_32FC1);
+  return impl_->launch(p, row_homographies(p, impl_->rays.height));
+}
+
+cv::Mat Renderer::render_float_rows(const std::vector<SE2>& row_poses) {
+  Impl& m = *impl_;
+  if (row_poses.size() != static_cast<size_t>(m.rays.height))
+    throw_invalid_argument("Renderer::render_float_rows: needs one pose per image row (" +
+                           std::to_string(m.rays.height) + "), got " + std::to_string(row_poses.size()));
+  std::vector<FrameParams> rows;
+  rows.reserve(row_poses.size());
+  for (const SE2& pose : row_poses) rows.push_back(params(pose));
+  return m.launch(rows.front(), row_homographies(rows));
+}
+
+cv::Mat Renderer::Impl::launch(const FrameParams& p, const std::vector<float>& rows) {
+  Impl& m = *this;
+  cv::Mat image(m.rays.height, m.rays.width, CV_32FC1);
   try {
     cl::CommandQueue& q = m.rt.queue();
     q.enqueueWriteBuffer(m.prm, CL_TRUE, 0, sizeof(float) * p.size(), p.data());
+    q.enqueueWriteBuffer(m.hrows, CL_TRUE, 0, sizeof(float) * rows.size(), rows.data());
     const size_t gx = (static_cast<size_t>(m.rays.width) + m.wg_x - 1) / m.wg_x * m.wg_x;
     const size_t gy = (static_cast<size_t>(m.rays.height) + m.wg_y - 1) / m.wg_y * m.wg_y;
     q.enqueueNDRangeKernel(m.kernel, cl::NullRange, cl::NDRange(gx, gy), cl::NDRange(m.wg_x, m.wg_y));
-    q.enqueueReadBuffer(m.out, CL_TRUE, 0, out.total() * sizeof(float), out.ptr<float>());
+    q.enqueueReadBuffer(m.out, CL_TRUE, 0, image.total() * sizeof(float), image.ptr<float>());
   } catch (const cl::Error& e) {
     throw Error(ErrorCode::OpenCL, std::string("simulator: rendering failed: ") + e.what() + " " +
                                        ocl::error_name(e.err()));
   }
-  return out;
+  return image;
 }
 
 cv::Mat Renderer::render(const SE2& robot_pose) {

@@ -48,6 +48,7 @@ void write_simulation_yaml(const std::string& path, const Options& o, const Eige
     fs << "pixel_noise" << o.pixel_noise << "gain_variation" << o.gain_variation;
     fs << "odometry_noise" << o.odometry_noise << "odometry_noise_floor" << o.odometry_noise_floor;
     fs << "wheel_base" << o.wheel_base;
+    fs << "readout_time" << o.readout_time << "exposure_time" << o.exposure_time;
     fs << "supersampling" << o.supersampling << "mipmap" << static_cast<int>(o.mipmap);
     fs << "lamp_falloff" << o.lamp_falloff << "reflection" << o.reflection << "shadow" << o.shadow;
     fs.release();
@@ -88,7 +89,9 @@ void simulate(ocl::Runtime& runtime, const Options& options, const std::string& 
   st.setup = seconds_since(t0);
 
   t0 = Clock::now();
-  io::write_camera_yaml((dir / "camera.yaml").string(), options.camera);
+  CameraModel camera = options.camera;
+  camera.rolling_shutter_readout = options.readout_time;
+  io::write_camera_yaml((dir / "camera.yaml").string(), camera);
   io::ExtrinsicsFile gt;
   gt.value = options.extrinsics;
   gt.method = "simulator";
@@ -113,7 +116,7 @@ void simulate(ocl::Runtime& runtime, const Options& options, const std::string& 
   for (size_t k = 0; k < n; ++k) {
     report(options, static_cast<double>(k) / static_cast<double>(n), "rendering");
     t0 = Clock::now();
-    cv::Mat clean = renderer.render_float(tr.pose[k]);
+    cv::Mat clean = render_frame(renderer, options, tr, k);
     st.render += seconds_since(t0);
 
     t0 = Clock::now();

@@ -100,7 +100,7 @@ int main(int argc, char** argv) {
       }
       track::RollPitchEstimator est(rt, so.camera, o);
       for (size_t k = 0; k < traj.t.size(); ++k) {
-        const cv::Mat img = sim::apply_camera(renderer.render_float(traj.pose[k]), exposure[k], so.pixel_noise,
+        const cv::Mat img = sim::apply_camera(sim::render_frame(renderer, so, traj, k), exposure[k], so.pixel_noise,
                                               sim::derive_seed(so.seed, 1000 + k));
         if (est.add_frame(img.data, img.cols, img.rows, img.step, traj.t[k])) break;
       }

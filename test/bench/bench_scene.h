@@ -48,12 +48,15 @@ struct Scene {
   int supersampling = 3;  // ss=N: the renderer's subsamples per pixel along each axis
   bool mipmap = true;     // mip=0: no prefiltered texture (only the subsamples average)
   bool distortion = true; // dist=0: a pinhole camera (no lens distortion, so no resampling of the noise)
+  double readout = 0.0;   // readout=SECONDS: rolling shutter, first row's read to last's (0: global)
+  double exposure = 0.0;  // exposure=SECONDS: motion blur over this long before each row's read
   sim::MotionProfile motion = sim::MotionProfile::Mixed;
   double lamp = 0.0, reflection = 0.0, shadow = 0.0;  // the light fixed to the camera (sim::Options)
 
   Extrinsics extrinsics() const { return has_ext ? ext : sim::paper_configuration(config); }
 
-  // Takes one key=value argument: config, ext, fov, motion, speed, turn, radius, noise, ss, mip, dist. False
+  // Takes one key=value argument: config, ext, fov, motion, speed, turn, radius, noise, ss, mip, dist,
+  // readout, exposure. False
   // for another key; exits with a message on a bad value.
   bool parse(const std::string& k, const std::string& v) {
     if (k == "config") {
@@ -94,6 +97,10 @@ struct Scene {
       reflection = std::atof(v.c_str());
     } else if (k == "shadow") {
       shadow = std::atof(v.c_str());
+    } else if (k == "readout") {
+      readout = std::atof(v.c_str());
+    } else if (k == "exposure") {
+      exposure = std::atof(v.c_str());
     } else {
       return false;
     }
@@ -121,19 +128,30 @@ struct Scene {
     so.lamp_falloff = lamp;
     so.reflection = reflection;
     so.shadow = shadow;
+    so.readout_time = readout;
+    so.exposure_time = exposure;
+    so.camera.rolling_shutter_readout = readout;
     return so;
   }
 
   std::string summary() const {
     char r[64] = "";
     if (radius > 0) std::snprintf(r, sizeof r, ", turning radius >= %.1f m", radius);
-    char l[128] = "";
-    if (lamp > 0 || reflection > 0 || shadow > 0)
+    char b[320];
+    std::snprintf(b, sizeof b, "camera %s, fov %.0f deg; %s motion up to %.2f m/s and %.2f rad/s%s; noise %.1f grey levels",
+                  describe(extrinsics()).c_str(), fov, sim::motion_profile_name(motion), speed, turn, r, noise);
+    std::string out = b;
+    if (readout > 0 || exposure > 0) {
+      char c[96];
+      std::snprintf(c, sizeof c, "; rolling shutter readout %.1f ms, exposure %.1f ms", readout * 1e3, exposure * 1e3);
+      out += c;
+    }
+    if (lamp > 0 || reflection > 0 || shadow > 0) {
+      char l[128];
       std::snprintf(l, sizeof l, "; lamp falloff %.2f, reflection %.0f, shadow %.2f", lamp, reflection, shadow);
-    char b[448];
-    std::snprintf(b, sizeof b, "camera %s, fov %.0f deg; %s motion up to %.2f m/s and %.2f rad/s%s; noise %.1f grey levels%s",
-                  describe(extrinsics()).c_str(), fov, sim::motion_profile_name(motion), speed, turn, r, noise, l);
-    return b;
+      out += l;
+    }
+    return out;
   }
 
   [[noreturn]] static void fail(const char* what) {
@@ -142,12 +160,13 @@ struct Scene {
   }
 };
 
-// Frame k of a simulated sequence as the camera gives it: rendered at the true pose, then the
-// camera's gain, offset and noise, seeded per frame (every benchmark sees the same frames).
+// Frame k of a simulated sequence as the camera gives it: rendered as sim::render_frame sees it
+// (each row at its read time, averaged over the exposure), then the camera's gain, offset and
+// noise, seeded per frame (every benchmark sees the same frames).
 inline cv::Mat camera_frame(sim::Renderer& renderer, const sim::Options& so, const sim::Trajectory& traj,
                             const std::vector<sim::Exposure>& exposure, size_t k,
                             const sim::Lighting& lighting = {}) {
-  cv::Mat clean = renderer.render_float(traj.pose[k]);
+  cv::Mat clean = sim::render_frame(renderer, so, traj, k);
   sim::apply_lighting(lighting, clean);
   return sim::apply_camera(clean, exposure[k], so.pixel_noise, sim::derive_seed(so.seed, 1000 + k));
 }

@@ -263,7 +263,8 @@ int main(int argc, char** argv) {
   std::printf("tracking on %s / %s through the C API\n", info.platform_name, info.device_name);
   const CameraModel& c = so.camera;
   Input in{&loop, &pixels, {}, {}};
-  in.camera = {c.width, c.height, c.fx, c.fy, c.cx, c.cy, c.k1, c.k2, c.p1, c.p2, c.k3, {0, 0, 0, 0}};
+  in.camera = {c.width, c.height, c.fx, c.fy, c.cx, c.cy, c.k1, c.k2, c.p1, c.p2, c.k3, {0, 0, 0, 0},
+               c.rolling_shutter_readout};
   const Extrinsics& e = so.extrinsics;
   in.extrinsics = {e.x, e.y, e.z, e.roll, e.pitch, e.yaw};
   std::printf("per block of %" PRId64 " frames: rss = VmRSS, d_rss its change since frame %" PRId64

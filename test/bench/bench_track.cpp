@@ -13,7 +13,7 @@
 //        levels, select=B0,B1,.. (level l on one pixel per Bl x Bl block), prior=0|1 (a
 //        subsampled level joined with the level before it), prior_chi2=X (its consistency test; 0: off),
 //        prefilter=0|1 (level 0 smoothed before the pyramid; default 1), the fused pass's lanes=1|8, pix=N,
-//        wg=XxY; scene extras ss=N (the renderer's supersampling), mip=0|1, dist=0 (no lens distortion); BENCH_PREBLUR=sigma blurs each camera image first; BENCH_VERBOSE=1 adds per-level
+//        wg=XxY; scene extras ss=N (the renderer's supersampling), mip=0|1, dist=0 (no lens distortion), readout=S, exposure=S (rolling shutter, motion blur; seconds); BENCH_PREBLUR=sigma blurs each camera image first; BENCH_VERBOSE=1 adds per-level
 //        times, the slowest frames and the frames not tracked ok; see main())
 //   bench_track nees [key=value...]         NEES of the covariances (alignment and frame-to-frame
 //       motion) and the lag-1 correlation of the errors per texture x configuration x size x

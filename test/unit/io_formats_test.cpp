@@ -61,6 +61,7 @@ void expect_same_camera(const CameraModel& a, const CameraModel& b) {
   EXPECT_EQ(a.p1, b.p1);
   EXPECT_EQ(a.p2, b.p2);
   EXPECT_EQ(a.k3, b.k3);
+  EXPECT_EQ(a.rolling_shutter_readout, b.rolling_shutter_readout);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -217,6 +218,41 @@ TEST(IoCameraYaml, RegionOfInterestRoundTripsAndIsChecked) {
   bad("tiny.yaml", "[ 0, 0, 8, 100 ]", "at least 16");
   bad("empty.yaml", "[ 0, 0, 0, 0 ]", "no pixels");
   bad("scalar.yaml", "7", "region_of_interest");
+}
+
+// The rolling shutter's readout: planarvo's own optional key beside OpenCV's. Absent is 0 (a
+// global shutter) and then not written; otherwise read back exactly; a negative or non-numeric
+// value is refused naming the file and the key.
+TEST(IoCameraYaml, RollingShutterReadoutRoundTripsAndIsChecked) {
+  ScratchDir dir;
+  const std::string global = (dir / "global.yaml").string();
+  io::write_camera_yaml(global, test_camera());
+  EXPECT_EQ(test::read_text(global).find("rolling_shutter_readout"), std::string::npos);
+  EXPECT_EQ(io::read_camera_yaml(global).rolling_shutter_readout, 0.0);
+  CameraModel c = test_camera();
+  c.rolling_shutter_readout = 0.0271234567890123;
+  const std::string path = (dir / "camera.yaml").string();
+  io::write_camera_yaml(path, c);
+  EXPECT_NE(test::read_text(path).find("rolling_shutter_readout"), std::string::npos);
+  expect_same_camera(io::read_camera_yaml(path), c);
+  const std::string hand = (dir / "hand.yaml").string();
+  write_text(hand, kGoodCameraYaml + std::string("rolling_shutter_readout: 0.025\n"));
+  EXPECT_EQ(io::read_camera_yaml(hand).rolling_shutter_readout, 0.025);
+  write_text(hand, kGoodCameraYaml + std::string("rolling_shutter_readout: 0\n"));
+  EXPECT_EQ(io::read_camera_yaml(hand).rolling_shutter_readout, 0.0);
+  const auto bad = [&](const std::string& name, const std::string& value) {
+    SCOPED_TRACE(name);
+    const std::string p = (dir / name).string();
+    write_text(p, kGoodCameraYaml + std::string("rolling_shutter_readout: ") + value + "\n");
+    const std::string msg = expect_invalid_input([&] { io::read_camera_yaml(p); }, p);
+    EXPECT_THAT(msg, HasSubstr("rolling_shutter_readout"));
+  };
+  bad("negative.yaml", "-0.01");
+  bad("text.yaml", "fast");
+  bad("inf.yaml", ".Inf");
+  // The writer refuses what the reader would (InvalidArgument: a caller's value, not a file).
+  c.rolling_shutter_readout = -1e-3;
+  expect_error([&] { io::write_camera_yaml(path, c); }, ErrorCode::InvalidArgument, "rolling_shutter_readout");
 }
 
 // ---------------------------------------------------------------------------------------------

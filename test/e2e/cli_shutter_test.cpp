@@ -1,0 +1,78 @@
+// `planarvo simulate --readout-time --exposure` and camera.yaml's rolling_shutter_readout as a
+// user meets them: bad values are exit code 2 naming the option or the file; a rolling-shutter
+// data set carries its readout in camera.yaml and simulation.yaml, and `info` prints it.
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "common/test_util.h"
+
+namespace planarvo {
+namespace {
+
+namespace fs = std::filesystem;
+using test::run_cli;
+using test::ScratchDir;
+using ::testing::HasSubstr;
+
+const std::string kSmall = " --quiet --seconds 0.3 --width 96 --height 64";
+
+TEST(CliShutter, BadReadoutOrExposureIsExitCodeTwoNamingTheOption) {
+  ScratchDir d;
+  const auto refused = [&](const std::string& args, const char* says) {
+    SCOPED_TRACE(args);
+    const auto r = run_cli("simulate --out " + (d / "never").string() + kSmall + " " + args);
+    EXPECT_EQ(r.exit_code, 2) << r.output;
+    EXPECT_THAT(r.output, HasSubstr(says));
+  };
+  refused("--readout-time -1", "readout_time");
+  refused("--readout-time 0.04", "readout_time");  // longer than 1/30 s
+  refused("--exposure -0.001", "exposure_time");
+  refused("--exposure 0.05", "exposure_time");
+  refused("--readout-time fast", "--readout-time");
+  EXPECT_FALSE(fs::exists(d / "never" / "frames.txt"));
+}
+
+TEST(CliShutter, ReadoutIsWrittenToCameraYamlAndPrintedByInfo) {
+  ScratchDir d;
+  const std::string out = (d / "rs").string();
+  auto r = run_cli("simulate --out " + out + kSmall + " --readout-time 0.025 --exposure 0.004");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const std::string camera = test::read_file(fs::path(out) / "camera.yaml");
+  EXPECT_THAT(camera, HasSubstr("rolling_shutter_readout"));
+  const std::string sim = test::read_file(fs::path(out) / "simulation.yaml");
+  EXPECT_THAT(sim, HasSubstr("readout_time: 2.5"));
+  EXPECT_THAT(sim, HasSubstr("exposure_time: 4."));
+  r = run_cli("info --verify " + out);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_THAT(r.output, HasSubstr("shutter     rolling, 25.000 ms"));
+
+  // A global-shutter data set says nothing of a shutter.
+  const std::string global = (d / "gs").string();
+  ASSERT_EQ(run_cli("simulate --out " + global + kSmall).exit_code, 0);
+  EXPECT_THAT(test::read_file(fs::path(global) / "camera.yaml"), ::testing::Not(HasSubstr("rolling_shutter")));
+  r = run_cli("info " + global);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_THAT(r.output, ::testing::Not(HasSubstr("shutter")));
+}
+
+TEST(CliShutter, NegativeReadoutInCameraYamlIsExitCodeTwoNamingTheFile) {
+  ScratchDir d;
+  const std::string out = (d / "ds").string();
+  ASSERT_EQ(run_cli("simulate --out " + out + kSmall).exit_code, 0);
+  const fs::path camera = fs::path(out) / "camera.yaml";
+  {
+    std::ofstream f(camera, std::ios::app);
+    f << "rolling_shutter_readout: -0.01\n";
+  }
+  const auto r = run_cli("info " + out);
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_THAT(r.output, HasSubstr("camera.yaml"));
+  EXPECT_THAT(r.output, HasSubstr("rolling_shutter_readout"));
+}
+
+}  // namespace
+}  // namespace planarvo
