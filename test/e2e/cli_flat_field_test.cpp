@@ -5,6 +5,7 @@
 // before one is learnt.
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -38,6 +39,19 @@ TEST(CliFlatField, ABadFlatFieldIsExit2NamingTheFile) {
   r = run_cli("track --quiet " + seq + " --extrinsics " + seq + "/extrinsics_gt.yaml --flat-field " + bad);
   EXPECT_EQ(r.exit_code, 2) << r.output;
   EXPECT_TRUE(has(r.output, bad) && has(r.output, "(11, 7)")) << r.output;
+}
+
+TEST(CliFlatField, NothingLearntIsAWarningAndNoFile) {
+  ScratchDir d;
+  const std::string seq = (d / "seq").string();
+  auto r = run_cli("simulate --quiet --out " + seq + " --seconds 0.5 --width 320 --height 240");  // even light
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const std::string ff = (d / "ff.png").string();
+  r = run_cli("track --quiet " + seq + " --extrinsics " + seq + "/extrinsics_gt.yaml --save-flat-field " + ff);
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_TRUE(has(r.output, "warning") && has(r.output, "learnt") && has(r.output, ff)) << r.output;
+  EXPECT_FALSE(std::filesystem::exists(ff));
+  EXPECT_FALSE(std::filesystem::exists(ff + ".partial"));
 }
 
 TEST(CliFlatField, TheLearntLampIsSavedAndReadBack) {
