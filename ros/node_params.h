@@ -21,6 +21,10 @@ struct NodeParams {
   bool publish_tf = true;
   planarvo_tracker_options tracker{};  // ~levels, ~finest_level, ~level0_subsample, ~max_iterations,
                                        // ~keyframe_overlap, with the library's defaults
+  // ~flat_field: a known flat field (planarvo_tracker_options.flat_field); "" = learnt. The
+  // tracker's options point at it only where the tracker is made (tracker.flat_field stays NULL
+  // here, so that a copy of NodeParams holds no pointer into another).
+  std::string flat_field;
   int queue_size = 100;    // ~queue_size: the image subscriber's roscpp queue
   int max_pending = 300;   // ~max_pending: frames waiting for the tracker before the oldest is dropped
   double drain_seconds = 10;  // ~drain_seconds: on shutdown, time to finish the frames still queued

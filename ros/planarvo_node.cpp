@@ -187,7 +187,9 @@ class Node {
 
   void create_tracker(const planarvo_camera& camera, const planarvo_extrinsics& e) {
     planarvo_tracker* t = nullptr;
-    if (planarvo_tracker_create(context_, &camera, &e, &params_.tracker, &t) != PLANARVO_OK)
+    planarvo_tracker_options options = params_.tracker;
+    options.flat_field = params_.flat_field.empty() ? nullptr : params_.flat_field.c_str();
+    if (planarvo_tracker_create(context_, &camera, &e, &options, &t) != PLANARVO_OK)
       throw std::runtime_error(std::string("planarvo_tracker_create: ") + planarvo_last_error());
     tracker_.reset(t);
   }

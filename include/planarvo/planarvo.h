@@ -350,6 +350,15 @@ typedef struct planarvo_tracker_options {
    * stopping at level 1 for 0.6-0.9 of its RMS error; 320x240: level 0 on every pixel). Explicit
    * finest_level: 0 is every pixel. 1: every pixel; 2..8: B. Unread (so 0) for older struct_size. */
   int32_t level0_subsample;
+  /* A known flat field (NULL or "" = learn the light fixed to the camera from the frames, the
+   * default): an image file of the camera's relative brightness per pixel of the distorted camera
+   * image, brightest = 1 (like DSO's vignette.png), any 8- or 16-bit grey format OpenCV reads
+   * (16-bit divided by 65535, 8-bit by 255, then the image by its maximum), the camera's size,
+   * no zero or non-finite pixel. Read by planarvo_tracker_create (PLANARVO_ERROR_INVALID_INPUT
+   * naming the file otherwise) and used from the first frame, without learning. The string need
+   * not outlive the call. planarvo_tracker_save_flat_field writes such a file. Unread (so NULL)
+   * for older struct_size. */
+  const char* flat_field;
 } planarvo_tracker_options;
 
 typedef enum planarvo_track_status {
@@ -393,6 +402,14 @@ PLANARVO_API planarvo_status planarvo_tracker_track(planarvo_tracker* tracker,
                                                     planarvo_track_result* result);
 /* Forgets the keyframe and the pose: the next frame is FIRST again. */
 PLANARVO_API planarvo_status planarvo_tracker_reset(planarvo_tracker* tracker);
+/* Writes the photometric model in use (the learnt one, or the flat field given) as a flat-field
+ * file that planarvo_tracker_options.flat_field reads back: a 16-bit grey PNG of the camera's size,
+ * the relative brightness per distorted camera pixel (brightest 65535), written complete or not at
+ * all. Pixels where the model has no value (a saturated reflection, no undistorted source) take
+ * the nearest pixel's value. PLANARVO_ERROR_FAILED when no model has been learnt yet: the model
+ * stays the identity until enough frames in motion show light fixed to the camera (an evenly lit
+ * camera never leaves it). PLANARVO_ERROR_IO when the file cannot be written. */
+PLANARVO_API planarvo_status planarvo_tracker_save_flat_field(planarvo_tracker* tracker, const char* path);
 /* The last tracked frame's residuals against the keyframe it was aligned with, for an outlier
  * overlay (the paper's Figure 20; planarvo plot outliers draws one). Per keyframe pixel of pyramid
  * `level` (0 = full resolution; every pixel of the level, whatever subsampling tracking used),

@@ -105,7 +105,7 @@ class SimOptions(ctypes.Structure):
 class TrackerOptions(ctypes.Structure):
     _fields_ = [("struct_size", c_size_t), ("levels", c_int32), ("finest_level", c_int32),
                 ("max_iterations", c_int32), ("keyframe_overlap", c_double), ("estimate_brightness", c_int32),
-                ("level0_subsample", c_int32)]
+                ("level0_subsample", c_int32), ("flat_field", c_char_p)]
 
 
 class TrackResult(ctypes.Structure):
@@ -257,6 +257,7 @@ _SIGNATURES = {
     "planarvo_tracker_destroy": (None, [c_void_p]),
     "planarvo_tracker_track": (S, [c_void_p, P(Image), c_double, P(TrackResult)]),
     "planarvo_tracker_reset": (S, [c_void_p]),
+    "planarvo_tracker_save_flat_field": (S, [c_void_p, c_char_p]),
     "planarvo_tracker_residuals": (S, [c_void_p, c_int32, P(ctypes.c_float), P(ctypes.c_float), P(ctypes.c_float),
                                        c_size_t, P(c_int32), P(c_int32), P(c_double)]),
     "planarvo_evaluate_motions": (S, [P(SE2), P(SE2), P(c_double), P(c_int32), c_size_t, c_double,

@@ -16,7 +16,7 @@ from ._frame import _image
 from ._handle import _Handle
 from ._native import lib
 from ._se2 import SE2
-from ._util import _c_options, _require
+from ._util import PathLike, _c_options, _path, _require
 
 
 class TrackStatus(enum.IntEnum):
@@ -36,10 +36,17 @@ class TrackerOptions:
     keyframe_overlap: Optional[float] = None
     estimate_brightness: Optional[bool] = None
     level0_subsample: Optional[int] = None
+    # A known flat field (an image file: the camera's relative brightness per distorted pixel,
+    # brightest 1, 8- or 16-bit grey, the camera's size) instead of learning the light fixed to
+    # the camera; None learns. Tracker.save_flat_field writes one.
+    flat_field: Optional[PathLike] = None
 
 
 def _tracker_options(options: Optional[TrackerOptions]) -> N.TrackerOptions:
-    return _c_options(N.TrackerOptions, "planarvo_tracker_options_init", options)
+    c = _c_options(N.TrackerOptions, "planarvo_tracker_options_init", options, skip=("flat_field",))
+    if options is not None and options.flat_field is not None:
+        c.flat_field = _path(options.flat_field)  # the structure keeps the bytes alive
+    return c
 
 
 @dataclass
@@ -133,6 +140,14 @@ class Tracker(_Handle):
         _check(lib.planarvo_tracker_residuals(self._h(), int(level), ptr[0], ptr[1], ptr[2], arrays[0].size,
                                               ctypes.byref(w), ctypes.byref(h), ctypes.byref(k)))
         return Residuals(int(level), arrays[0], arrays[1], arrays[2], k.value)
+
+    def save_flat_field(self, path: PathLike) -> None:
+        """Writes the photometric model in use (learnt, or the flat field given) as a 16-bit
+        flat-field PNG that TrackerOptions.flat_field reads back
+        (planarvo_tracker_save_flat_field). Raises Error with status FAILED when none has been
+        learnt yet (the model stays the identity until frames in motion show light fixed to the
+        camera), IO when the file cannot be written."""
+        _check(lib.planarvo_tracker_save_flat_field(self._h(), _path(path)))
 
     def reset(self) -> None:
         """Forgets the keyframe and the pose: the next frame is FIRST again."""

@@ -117,3 +117,88 @@ def test_reset(context, tracked):
         r = tracker.track(frames[2][1], frames[2][0])
         assert r.status == planarvo.TrackStatus.OK
         np.testing.assert_allclose(r.pose.as_array(), r.motion.as_array())
+
+
+def test_flat_field(context, tracked, tmp_path):
+    """A known flat field (a 16-bit PNG written here with numpy's values) is saved back unchanged
+    away from the border (within 1e-3); nothing learnt is FAILED; a file of another size is INVALID_INPUT."""
+    info = tracked[0]
+    w, h = info.camera.width, info.camera.height
+    y, x = np.mgrid[0:h, 0:w]
+    gain = np.rint(60000.0 / (1.0 + ((x - 0.3 * w) ** 2 + (y - 0.6 * h) ** 2) / 250.0 ** 2)).astype(np.uint16)
+    known, saved, bad = tmp_path / "known.png", tmp_path / "saved.png", tmp_path / "bad.png"
+    _write_png16(known, gain)
+    _write_png16(bad, gain[:-1])
+    with planarvo.Tracker(context, info.camera, info.extrinsics_gt) as tracker:
+        with pytest.raises(planarvo.Error) as e:
+            tracker.save_flat_field(saved)
+        assert e.value.status == planarvo.Status.FAILED and "learnt" in str(e.value)
+    with pytest.raises(planarvo.Error) as e:
+        planarvo.Tracker(context, info.camera, info.extrinsics_gt, planarvo.TrackerOptions(flat_field=bad))
+    assert e.value.status == planarvo.Status.INVALID_INPUT and str(bad) in str(e.value)
+    with planarvo.Tracker(context, info.camera, info.extrinsics_gt,
+                          planarvo.TrackerOptions(flat_field=str(known))) as tracker:
+        tracker.save_flat_field(saved)
+    back = _read_png16(saved)
+    assert back.shape == (h, w)
+    # Exact to 16 bits and two bilinear samplings where the model has a value; the border columns
+    # without an undistorted source (barrel distortion) take the nearest value.
+    np.testing.assert_allclose(back[30:-30, 30:-30] / 65535.0, gain[30:-30, 30:-30] / 60000.0, rtol=0, atol=1e-3)
+    np.testing.assert_allclose(back[10:-10, 10:-10] / 65535.0, gain[10:-10, 10:-10] / 60000.0, rtol=0, atol=0.02)
+
+
+def _write_png16(path, a):
+    """A 16-bit grey PNG from numpy alone (zlib, no image library)."""
+    import struct
+    import zlib
+    raw = b"".join(b"\x00" + row.astype(">u2").tobytes() for row in a)
+
+    def chunk(kind, data):
+        return struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data) & 0xFFFFFFFF)
+    ihdr = struct.pack(">IIBBBBB", a.shape[1], a.shape[0], 16, 0, 0, 0, 0)
+    path.write_bytes(b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", ihdr) + chunk(b"IDAT", zlib.compress(raw)) +
+                     chunk(b"IEND", b""))
+
+
+def _read_png16(path):
+    """A 16-bit grey PNG's pixels (any filter type), from numpy and zlib alone."""
+    import struct
+    import zlib
+    data = path.read_bytes()
+    pos, idat, w, h = 8, b"", 0, 0
+    while pos < len(data):
+        n, kind = struct.unpack(">I4s", data[pos:pos + 8])
+        body = data[pos + 8:pos + 8 + n]
+        if kind == b"IHDR":
+            w, h, depth, colour = struct.unpack(">IIBB", body[:10])
+            assert depth == 16 and colour == 0, (depth, colour)
+        elif kind == b"IDAT":
+            idat += body
+        pos += 12 + n
+    raw = zlib.decompress(idat)
+    stride, bpp = 2 * w, 2
+    out = np.zeros((h, stride), dtype=np.int64)
+    prev = np.zeros(stride, dtype=np.int64)
+    for r in range(h):
+        f = raw[r * (stride + 1)]
+        line = np.frombuffer(raw, dtype=np.uint8, count=stride, offset=r * (stride + 1) + 1).astype(np.int64)
+        cur = np.zeros(stride, dtype=np.int64)
+        for i in range(stride):
+            a = cur[i - bpp] if i >= bpp else 0
+            b = prev[i]
+            c = prev[i - bpp] if i >= bpp else 0
+            if f == 0:
+                p = 0
+            elif f == 1:
+                p = a
+            elif f == 2:
+                p = b
+            elif f == 3:
+                p = (a + b) // 2
+            else:
+                pa, pb, pc = abs(b - c), abs(a - c), abs(a + b - 2 * c)
+                p = a if pa <= pb and pa <= pc else (b if pb <= pc else c)
+            cur[i] = (line[i] + p) & 0xFF
+        out[r] = cur
+        prev = cur
+    return (out[:, 0::2] * 256 + out[:, 1::2]).astype(np.uint16)

@@ -21,6 +21,7 @@ using planarvo::capi::require;
 
 struct planarvo_tracker {
   std::unique_ptr<planarvo::track::Tracker> tracker;
+  planarvo::CameraModel camera;  // the distorted camera, for saving the flat field
   cv::Mat grey;  // conversion buffer for colour and float frames
 };
 
@@ -98,6 +99,9 @@ planarvo::track::TrackerOptions tracker_options_from_c(const planarvo_tracker_op
         o.select_blocks[static_cast<size_t>(o.finest_level)] = b >= 2 ? b : 0;
       }
     }
+    if (options->struct_size >= offsetof(planarvo_tracker_options, flat_field) + sizeof(const char*) &&
+        options->flat_field)
+      o.flat_field = options->flat_field;
   }
   return o;
 }
@@ -136,6 +140,7 @@ PLANARVO_API planarvo_status planarvo_tracker_create(planarvo_context* context, 
     require(extrinsics->z > 0, "planarvo_tracker_create: extrinsics.z (the camera height) must be positive");
     const planarvo::track::TrackerOptions o = planarvo::capi::tracker_options_from_c(options);
     auto t = std::make_unique<planarvo_tracker>();
+    t->camera = cam;
     t->tracker = std::make_unique<planarvo::track::Tracker>(*context->runtime, cam,
                                                             planarvo::capi::to_cpp(*extrinsics), o);
     *tracker = t.release();
@@ -185,6 +190,20 @@ PLANARVO_API planarvo_status planarvo_tracker_reset(planarvo_tracker* tracker) {
   return guard([&] {
     require(tracker != nullptr, "planarvo_tracker_reset: tracker is NULL");
     tracker->tracker->reset();
+  });
+}
+
+PLANARVO_API planarvo_status planarvo_tracker_save_flat_field(planarvo_tracker* tracker, const char* path) {
+  return guard([&] {
+    require(tracker != nullptr && path != nullptr && path[0] != '\0',
+            "planarvo_tracker_save_flat_field: tracker and path are required");
+    const planarvo::PhotometricFit* fit = tracker->tracker->photometric_model();
+    if (!fit)
+      throw planarvo::Error(planarvo::ErrorCode::Failed,
+                            "planarvo_tracker_save_flat_field: no photometric model has been learnt yet (it stays the "
+                            "identity until enough frames in motion show light fixed to the camera, or the "
+                            "photometric model is off); " + std::string(path) + " is not written");
+    planarvo::write_flat_field(path, planarvo::fill_flat_field(planarvo::flat_field_to_distorted(*fit, tracker->camera)));
   });
 }
 

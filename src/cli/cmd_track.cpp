@@ -210,6 +210,16 @@ TrackRun track_dataset(planarvo_context* ctx, planarvo_dataset* ds, const planar
     check(planarvo_write_tum(outputs.trajectory.c_str(), stamps.data(), k.pose.data(), k.t.size()));
   }
   if (!outputs.motions.empty()) check(planarvo_motion_pairs_save(outputs.motions.c_str(), pairs.data(), pairs.size()));
+  if (!outputs.flat_field.empty()) {
+    const planarvo_status s = planarvo_tracker_save_flat_field(tracker.get(), outputs.flat_field.c_str());
+    if (s == PLANARVO_ERROR_FAILED) {
+      const std::string warning = std::string("planarvo track: warning: ") + planarvo_last_error();
+      if (progress) progress->warn(warning);
+      else std::fprintf(stderr, "%s\n", warning.c_str());
+    } else {
+      check(s);
+    }
+  }
   account_lost(k, &run);
   evaluate(k, &run);
   return run;
@@ -277,6 +287,11 @@ int cmd_track(int argc, char** argv) {
                               "counted in the summary) instead of an error", ""},
       {"max-lost", "PERCENT", "exit 1 (after writing every output) when more than this share of the frames was "
                               "lost", "5"},
+      {"flat-field", "FILE", "a known flat field instead of learning the light fixed to the camera: the camera's "
+                             "relative brightness per (distorted) pixel, brightest = 1, an 8- or 16-bit grey image "
+                             "of the camera's size (as DSO's vignette.png; --save-flat-field writes one)", ""},
+      {"save-flat-field", "FILE", "after tracking, write the photometric model in use (learnt, or --flat-field's) as "
+                                  "a 16-bit flat-field PNG for --flat-field (a warning when none was learnt)", ""},
       {"quiet", "", "no progress bar", ""},
       {"help", "", "show this help", ""}};
   for (auto& b : bag_options()) specs.push_back(b);
@@ -294,13 +309,15 @@ int cmd_track(int argc, char** argv) {
   args.expect_positionals(1, "DATASET, the data set folder or a bag");
   const std::string dir = args.positionals()[0];
   // The options first: a usage error is reported before any file is read.
-  args.expect_output_files({"output", "stats", "motions-out"});
+  args.expect_output_files({"output", "stats", "motions-out", "save-flat-field"});
   planarvo_tracker_options o;
   planarvo_tracker_options_init(&o);
   o.levels = args.get_int_in("levels", o.levels, 1, 8);
   if (args.has("finest-level")) o.finest_level = args.get_int_in("finest-level", 0, 0, o.levels - 1);
   o.max_iterations = args.get_int_in("max-iterations", 0, 1, 1000);
   o.level0_subsample = args.get_int_in("level0-subsample", 0, 1, 8);
+  const std::string flat_field = args.get("flat-field");  // outlives o
+  o.flat_field = flat_field.empty() ? nullptr : flat_field.c_str();
   const std::optional<planarvo_region> roi = parse_roi(args);  // before any file is read
   const double max_lost = args.get_double("max-lost", 5.0);
   if (!(max_lost >= 0.0 && max_lost <= 100.0))
@@ -310,7 +327,7 @@ int cmd_track(int argc, char** argv) {
   Progress progress(!args.has("quiet"));
   DatasetPtr ds = open_dataset(dir, args, false, &progress, args.has("skip-bad-frames"));
   apply_roi(roi, ds.get());
-  const TrackRun run = track_dataset(ctx.get(), ds.get(), e, o, {args.get("output"), args.get("stats"), args.get("motions-out"), args.has("skip-bad-frames")}, &progress);
+  const TrackRun run = track_dataset(ctx.get(), ds.get(), e, o, {args.get("output"), args.get("stats"), args.get("motions-out"), args.has("skip-bad-frames"), args.get("save-flat-field")}, &progress);
   progress.finish();
   std::printf("tracked %s on %s\n", dir.c_str(), device_name(ctx.get()).c_str());
   print_track_run(run);

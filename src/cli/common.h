@@ -103,6 +103,9 @@ struct TrackOutputs {
   // row in the statistics, no pose; the next frame is tracked against the last good one. When
   // false it is an error (exit 2, naming the frame).
   bool skip_bad_frames = false;
+  // The photometric model (the light fixed to the camera) as a flat-field PNG after tracking,
+  // "" for none; a warning, not an error, when none was learnt.
+  std::string flat_field;
 };
 TrackRun track_dataset(planarvo_context* ctx, planarvo_dataset* ds, const planarvo_extrinsics& extrinsics,
                        const planarvo_tracker_options& options, const TrackOutputs& outputs, Progress* progress);

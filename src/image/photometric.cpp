@@ -4,12 +4,15 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <string>
 #include <vector>
 
+#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "core/error.h"
+#include "core/output_file.h"
 #include "image/pipeline.h"
 #include "ocl/runtime.h"
 
@@ -196,6 +199,124 @@ PhotometricFit flat_field_photometric(const cv::Mat& gain, const cv::Mat& valid,
   }
   f.unusable = n_valid > 0 ? static_cast<double>(n_unusable) / static_cast<double>(n_valid) : 0.0;
   return f;
+}
+
+cv::Mat read_flat_field(const std::string& path, int width, int height) {
+  const cv::Mat img = cv::imread(path, cv::IMREAD_GRAYSCALE | cv::IMREAD_ANYDEPTH);
+  if (img.empty()) throw_invalid_input("flat field " + path + ": cannot be read as an image");
+  if (img.cols != width || img.rows != height)
+    throw_invalid_input("flat field " + path + ": the image is " + std::to_string(img.cols) + "x" +
+                        std::to_string(img.rows) + ", the camera " + std::to_string(width) + "x" +
+                        std::to_string(height));
+  double unit = 1.0;
+  switch (img.depth()) {
+    case CV_8U: unit = 255.0; break;
+    case CV_16U: unit = 65535.0; break;
+    case CV_32F:
+    case CV_64F: unit = 1.0; break;
+    default:
+      throw_invalid_input("flat field " + path + ": not an 8-bit, 16-bit or float grey image");
+  }
+  cv::Mat gain;
+  img.convertTo(gain, CV_32F, 1.0 / unit);
+  for (int y = 0; y < gain.rows; ++y) {
+    const float* g = gain.ptr<float>(y);
+    for (int x = 0; x < gain.cols; ++x)
+      if (!(std::isfinite(g[x]) && g[x] > 0.0f))
+        throw_invalid_input("flat field " + path + ": pixel (" + std::to_string(x) + ", " + std::to_string(y) +
+                            ") is " + (std::isfinite(g[x]) ? std::to_string(g[x]) : std::string("not finite")) +
+                            "; a flat field is positive everywhere");
+  }
+  double top = 0.0;
+  cv::minMaxLoc(gain, nullptr, &top);
+  return gain / top;
+}
+
+cv::Mat flat_field_to_undistorted(const cv::Mat& gain_distorted, const UndistortMap& map) {
+  if (gain_distorted.type() != CV_32FC1)
+    throw_invalid_argument("flat_field_to_undistorted: the gain must be CV_32FC1");
+  return remap_bilinear(gain_distorted, map);
+}
+
+cv::Mat flat_field_to_distorted(const PhotometricFit& fit, const CameraModel& camera) {
+  const UndistortMap map = compute_undistort_map(camera);
+  if (fit.scale.type() != CV_32FC1 || fit.scale.cols != camera.width || fit.scale.rows != camera.height)
+    throw_invalid_argument("flat_field_to_distorted: the model must be CV_32FC1 of the camera's " +
+                           std::to_string(camera.width) + "x" + std::to_string(camera.height));
+  const int w = camera.width, h = camera.height;
+  // The gain per undistorted pixel, 0 where it has no value.
+  cv::Mat g(h, w, CV_32FC1, cv::Scalar(0.0f));
+  for (int y = 0; y < h; ++y) {
+    const float* sc = fit.scale.ptr<float>(y);
+    float* o = g.ptr<float>(y);
+    for (int x = 0; x < w; ++x)
+      if (map.valid[static_cast<size_t>(y) * static_cast<size_t>(w) + static_cast<size_t>(x)] && sc[x] > 0.0f)
+        o[x] = 1.0f / sc[x];
+  }
+  cv::Mat out(h, w, CV_32FC1, cv::Scalar(0.0f));
+  double top = 0.0;
+  for (int v = 0; v < h; ++v) {
+    float* o = out.ptr<float>(v);
+    for (int u = 0; u < w; ++u) {
+      const Eigen::Vector2d n = camera.unproject(Eigen::Vector2d(u, v));
+      const double px = camera.fx * n.x() + camera.cx, py = camera.fy * n.y() + camera.cy;
+      if (!(px >= 0 && py >= 0 && px <= w - 1 && py <= h - 1)) continue;
+      const int x0 = std::min(static_cast<int>(px), w - 2), y0 = std::min(static_cast<int>(py), h - 2);
+      const double ax = px - x0, ay = py - y0;
+      const float a = g.at<float>(y0, x0), b = g.at<float>(y0, x0 + 1);
+      const float c = g.at<float>(y0 + 1, x0), d = g.at<float>(y0 + 1, x0 + 1);
+      if (!(a > 0 && b > 0 && c > 0 && d > 0)) continue;
+      const double s = (1 - ay) * ((1 - ax) * a + ax * b) + ay * ((1 - ax) * c + ax * d);
+      o[u] = static_cast<float>(s);
+      top = std::max(top, s);
+    }
+  }
+  if (top > 0) out /= top;
+  return out;
+}
+
+cv::Mat fill_flat_field(const cv::Mat& gain) {
+  if (gain.type() != CV_32FC1) throw_invalid_argument("fill_flat_field: the gain must be CV_32FC1");
+  cv::Mat holes(gain.size(), CV_8UC1);
+  for (int y = 0; y < gain.rows; ++y)
+    for (int x = 0; x < gain.cols; ++x) holes.at<uint8_t>(y, x) = gain.at<float>(y, x) > 0.0f ? 0 : 255;
+  if (cv::countNonZero(holes) == 0) return gain.clone();
+  if (cv::countNonZero(holes) == static_cast<int>(gain.total()))
+    throw Error(ErrorCode::Failed, "the flat field has no pixel with a value");
+  // Each pixel labelled with its nearest zero of `holes` (a pixel with a value).
+  cv::Mat dist, labels;
+  cv::distanceTransform(holes, dist, labels, cv::DIST_L2, cv::DIST_MASK_5, cv::DIST_LABEL_PIXEL);
+  double max_label = 0;
+  cv::minMaxLoc(labels, nullptr, &max_label);
+  std::vector<float> value(static_cast<size_t>(max_label) + 1, 0.0f);
+  for (int y = 0; y < gain.rows; ++y)
+    for (int x = 0; x < gain.cols; ++x)
+      if (!holes.at<uint8_t>(y, x)) value[static_cast<size_t>(labels.at<int>(y, x))] = gain.at<float>(y, x);
+  cv::Mat out = gain.clone();
+  for (int y = 0; y < gain.rows; ++y)
+    for (int x = 0; x < gain.cols; ++x)
+      if (holes.at<uint8_t>(y, x)) out.at<float>(y, x) = value[static_cast<size_t>(labels.at<int>(y, x))];
+  return out;
+}
+
+void write_flat_field(const std::string& path, const cv::Mat& gain) {
+  if (gain.type() != CV_32FC1 || gain.empty())
+    throw_invalid_argument("write_flat_field: the gain must be a non-empty CV_32FC1 image");
+  cv::Mat u16(gain.size(), CV_16UC1);
+  for (int y = 0; y < gain.rows; ++y)
+    for (int x = 0; x < gain.cols; ++x) {
+      const float g = gain.at<float>(y, x);
+      const double v = std::isfinite(g) ? std::clamp(static_cast<double>(g), 0.0, 1.0) : 0.0;
+      long q = std::lround(v * 65535.0);
+      if (v > 0 && q == 0) q = 1;
+      u16.at<uint16_t>(y, x) = static_cast<uint16_t>(q);
+    }
+  std::vector<uchar> png;
+  if (!cv::imencode(".png", u16, png)) throw Error(ErrorCode::Io, "flat field " + path + ": PNG encoding failed");
+  OutputFile out(path);
+  if (std::fwrite(png.data(), 1, png.size(), out.stream()) != png.size())
+    throw Error(ErrorCode::Io, "flat field " + path + ": writing failed");
+  out.commit();
 }
 
 cv::Mat photometric_reference(const cv::Mat& raw, const PhotometricFit& fit, double saturation) {

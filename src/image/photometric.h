@@ -19,6 +19,9 @@
 #include <CL/opencl.hpp>
 #include <opencv2/core.hpp>
 
+#include "image/camera.h"
+#include "image/undistort.h"
+
 namespace planarvo {
 
 namespace ocl {
@@ -85,6 +88,33 @@ PhotometricFit fit_photometric(const cv::Mat& mean, const cv::Mat& square, const
 // value.
 PhotometricFit flat_field_photometric(const cv::Mat& gain, const cv::Mat& valid,
                                       const PhotometricOptions& options);
+
+// Known and saved flat fields (README.md, "Known and saved flat fields"). A flat-field file is
+// the camera's relative brightness per pixel of the distorted camera image, brightest 1 (DSO's
+// vignette.png): any 8- or 16-bit grey image OpenCV reads (8-bit divided by 255, 16-bit by
+// 65535, float as it is), then divided by its maximum.
+//
+// read_flat_field: CV_32FC1 of width x height in camera (distorted) pixels, maximum 1. Throws
+// InvalidInput naming the file when it cannot be read as an image, is not width x height (both
+// sizes named), or has a zero, negative or non-finite pixel (the pixel named).
+cv::Mat read_flat_field(const std::string& path, int width, int height);
+// The gain in the undistorted image: gain_distorted (CV_32FC1, the camera's size) sampled
+// bilinearly at the map's source coordinates where the map is valid, 0 elsewhere (remap_bilinear).
+cv::Mat flat_field_to_undistorted(const cv::Mat& gain_distorted, const UndistortMap& map);
+// The inverse, for saving a model: per distorted camera pixel, the model's gain 1 / scale
+// sampled bilinearly at the pixel's undistorted position (CameraModel::unproject, then K),
+// normalised to maximum 1; 0 where the model has no value (scale 0, or the undistortion no
+// source, at any of the four neighbours). CV_32FC1 of the camera's size. InvalidArgument when the
+// model is not the camera's size.
+cv::Mat flat_field_to_distorted(const PhotometricFit& fit, const CameraModel& camera);
+// Each zero pixel of a gain image takes the value of the nearest non-zero pixel, so that a
+// saved model (which has no value in a saturated spot, or where the undistorted image has no
+// source) reads back as a flat field, which has no zeros. Failed when every pixel is zero.
+cv::Mat fill_flat_field(const cv::Mat& gain);
+// Writes a gain image (CV_32FC1, values 0..1) as a 16-bit grey PNG, value * 65535 rounded (a
+// positive value at least 1), complete or not at all (core/output_file.h). Io naming the file
+// when it cannot be written; InvalidArgument for another type.
+void write_flat_field(const std::string& path, const cv::Mat& gain);
 
 // Plain C++ reference of the `photometric` kernel (kernels/undistort.cl): raw level-0 intensity
 // (kInvalidIntensity where not valid) -> corrected.

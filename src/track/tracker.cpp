@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <optional>
 
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
@@ -108,6 +109,8 @@ struct Tracker::Impl {
   // The camera-frame path: the pipeline and two pyramids, one the keyframe's (aliased by
   // `keyframe`), the other filled with each live frame.
   std::unique_ptr<ImagePipeline> pipeline;
+  // The model from TrackerOptions::flat_field, read when the tracker is made (none: learnt).
+  std::optional<PhotometricFit> known_photometric;
   Pyramid slots[2];
   int live_slot = 0;
   bool keyframe_is_slot = false;
@@ -139,7 +142,28 @@ struct Tracker::Impl {
 
   Impl(ocl::Runtime& r, const CameraModel& c, const Extrinsics& e, const TrackerOptions& o)
       : rt(r), camera(validated(c, e, o)), ext(e), opt(o), aligner(r, c.K(), o, false), selector(r) {
+    // The flat field is read now, so that a bad file fails at once rather than at the first frame.
+    if (!opt.flat_field.empty() && opt.photometric.enabled) {
+      const UndistortMap map = compute_undistort_map(camera);
+      const cv::Mat valid = cv::Mat(map.height, map.width, CV_8UC1, const_cast<uint8_t*>(map.valid.data())).clone();
+      known_photometric = flat_field_photometric(
+          flat_field_to_undistorted(read_flat_field(opt.flat_field, camera.width, camera.height), map), valid,
+          opt.photometric);
+    }
     reset();
+  }
+
+  // The model in use when it is not the identity: the known one, or a learnt one.
+  const PhotometricFit* photometric_model() const {
+    if (known_photometric) return &*known_photometric;
+    const PhotometricModel* m = pipeline ? pipeline->photometric() : nullptr;
+    if (!m) return nullptr;
+    const PhotometricFit& f = m->fit();
+    if (f.frames == 0) return nullptr;
+    for (int y = 0; y < f.scale.rows; ++y)
+      for (int x = 0; x < f.scale.cols; ++x)
+        if (f.scale.at<float>(y, x) != 1.0f || f.offset.at<float>(y, x) != 0.0f) return &f;
+    return nullptr;  // fitted, but the statistics found no light fixed to the camera
   }
 
   void reset() {
@@ -469,6 +493,7 @@ struct Tracker::Impl {
       po.prefilter = opt.prefilter;
       po.photometric = opt.photometric;
       pipeline = std::make_unique<ImagePipeline>(rt, camera, opt.levels, po);
+      if (known_photometric && pipeline->photometric()) pipeline->photometric()->set(*known_photometric);
     }
     pipeline->process(gray, width, height, stride, slots[live_slot]);
     // Waiting here costs one synchronisation (the first pass would wait anyway) and splits
@@ -653,5 +678,6 @@ void Tracker::reset() { impl_->reset(); }
 ResidualImage Tracker::residuals(int level) { return impl_->residuals(level); }
 const SE2& Tracker::pose() const { return impl_->pose; }
 const TrackerOptions& Tracker::options() const { return impl_->opt; }
+const PhotometricFit* Tracker::photometric_model() const { return impl_->photometric_model(); }
 
 }  // namespace planarvo::track

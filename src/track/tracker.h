@@ -7,6 +7,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <memory>
+#include <string>
 
 #include <Eigen/Core>
 
@@ -95,6 +96,12 @@ struct TrackerOptions : AlignerOptions {
   // the frames aligned with it are always corrected alike).
   PhotometricOptions photometric;
   double learn_motion_px = 8.0;
+  // A known flat field instead of learning (image/photometric.h, read_flat_field: the camera's
+  // relative brightness per distorted pixel, brightest 1, an 8- or 16-bit grey image file): read
+  // and checked when the Tracker is made (InvalidInput naming the file), taken to the undistorted
+  // image and used as the model from the first frame, without learning. Empty: learnt. Unused when
+  // photometric.enabled is false.
+  std::string flat_field;
 
   static WarpReduceOptions default_kernel_options();
 };
@@ -193,6 +200,12 @@ class Tracker {
   // The accumulated robot pose relative to the first frame (product of the motions).
   const SE2& pose() const;
   const TrackerOptions& options() const;
+  // The photometric model in use (its scale and offset per undistorted pixel), for saving it
+  // (flat_field_to_distorted, write_flat_field): the known flat field's, or the learnt one; null
+  // while it is the identity (no frame yet, photometric off, or not yet learnt: the model stays
+  // the identity until the statistics or the alignments show light fixed to the camera). Valid
+  // until the next call to track().
+  const PhotometricFit* photometric_model() const;
 
  private:
   struct Impl;

@@ -195,6 +195,11 @@ PLANARVO_API planarvo_status planarvo_tracker_reset(planarvo_tracker* tracker) {
   return fn ? fn(tracker) : PLANARVO_ERROR_INTERNAL;
 }
 
+PLANARVO_API planarvo_status planarvo_tracker_save_flat_field(planarvo_tracker* tracker, const char* path) {
+  PLANARVO_FORWARD(planarvo_tracker_save_flat_field);
+  return fn ? fn(tracker, path) : PLANARVO_ERROR_INTERNAL;
+}
+
 PLANARVO_API planarvo_status planarvo_tracker_residuals(planarvo_tracker* tracker, int32_t level, float* residual, float* weight, float* intensity, size_t capacity, int32_t* width, int32_t* height, double* threshold) {
   PLANARVO_FORWARD(planarvo_tracker_residuals);
   return fn ? fn(tracker, level, residual, weight, intensity, capacity, width, height, threshold) : PLANARVO_ERROR_INTERNAL;
