@@ -27,13 +27,16 @@ constexpr int kOwnVarianceFrames = 30;
 constexpr double kMaxRelativeSpread = 2.0;
 
 // The q-quantile (0..1) of m's values where mask is non-zero (0 when none).
+// The maps it is used on are box-smoothed, so on large images every 4th row and column says the
+// same (a sixteenth of the work of a refit's sorting).
 double masked_quantile(const cv::Mat& m, const cv::Mat& mask, double q) {
+  const int step = m.total() > 100000 ? 4 : 1;
   std::vector<float> v;
-  v.reserve(m.total());
-  for (int r = 0; r < m.rows; ++r) {
+  v.reserve(m.total() / static_cast<size_t>(step * step) + 1);
+  for (int r = 0; r < m.rows; r += step) {
     const float* a = m.ptr<float>(r);
     const uint8_t* k = mask.ptr<uint8_t>(r);
-    for (int c = 0; c < m.cols; ++c)
+    for (int c = 0; c < m.cols; c += step)
       if (k[c]) v.push_back(a[c]);
   }
   if (v.empty()) return 0.0;
