@@ -321,6 +321,13 @@ struct ImagePipeline::Impl {
     }
     if (prefilter) kernels.smooth(raw, w(0), h(0), intensity[0]);
   }
+  // Undistortion (with the photometric correction), pyramid and gradients of the frame in
+  // `source` into `out`.
+  void stages(const cl::Buffer& source, Pyramid& out) {
+    undistort(source);
+    pyramid();
+    gradients(out);
+  }
   void pyramid() {
     for (int l = 1; l < levels; ++l)
       kernels.downsample(intensity[static_cast<size_t>(l - 1)], w(l - 1), h(l - 1),
@@ -383,9 +390,7 @@ void ImagePipeline::process(const uint8_t* gray, int width, int height, size_t s
   try {
     m.upload(gray, stride);
     m.has_frame = true;
-    m.undistort();
-    m.pyramid();
-    m.gradients(out);
+    m.stages(m.frame, out);
   } catch (const cl::Error& e) {
     throw_opencl("processing a frame", e);
   }
@@ -414,9 +419,7 @@ void ImagePipeline::reprocess(Pyramid& out) {
   if (!m.has_frame) throw_invalid_argument("image pipeline: reprocess before any frame");
   m.ensure(out);
   try {
-    m.undistort();
-    m.pyramid();
-    m.gradients(out);
+    m.stages(m.frame, out);
   } catch (const cl::Error& e) {
     throw_opencl("reprocessing a frame", e);
   }
@@ -440,9 +443,7 @@ void ImagePipeline::reprocess_kept(Pyramid& out) {
   if (!m.has_kept) throw_invalid_argument("image pipeline: reprocess_kept before keep");
   m.ensure(out);
   try {
-    m.undistort(m.kept);
-    m.pyramid();
-    m.gradients(out);
+    m.stages(m.kept, out);
   } catch (const cl::Error& e) {
     throw_opencl("reprocessing the kept frame", e);
   }

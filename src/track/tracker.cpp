@@ -462,6 +462,21 @@ struct Tracker::Impl {
     }
   }
 
+  // The frame aligned once more from `from` after an attempt that gave `before`: on success
+  // *again is judged (finish) and counts both attempts' passes and times.
+  bool align_again(const Pyramid& live, const Estimate& from, const FrameResult& before, FrameResult* again,
+                   Estimate* est) {
+    *again = before;
+    const char* reason = "";
+    if (!align(live, from, est, again, &reason)) return false;
+    finish(again, *est);
+    for (size_t l = 0; l < before.iterations.size(); ++l) {
+      again->iterations[l] += before.iterations[l];
+      again->level_ms[l] += before.level_ms[l];
+    }
+    return true;
+  }
+
   // A frame misaligned with its keyframe by the light fixed to the camera: the model learns from
   // it at once and, when a model can be made, the keyframe and the frame are corrected with it
   // so that the frame can be aligned again. False when nothing changed.
@@ -603,33 +618,19 @@ struct Tracker::Impl {
     if (ok) finish(&res, est);
     if ((!ok || res.status == Status::Lost) && reason != kAlignNoLiveTexture &&
         !(predicted.x == 0 && predicted.y == 0 && predicted.theta == 0)) {
-      FrameResult retry = res;
-      const char* reason2 = "";
+      FrameResult retry;
       Estimate est2;
-      if (align(live, prev, &est2, &retry, &reason2)) {
-        finish(&retry, est2);
-        if (retry.status != Status::Lost) {
-          for (size_t l = 0; l < res.iterations.size(); ++l) {
-            retry.iterations[l] += res.iterations[l];
-            retry.level_ms[l] += res.level_ms[l];
-          }
-          res = retry;
-          est = est2;
-          ok = true;
-        }
+      if (align_again(live, prev, res, &retry, &est2) && retry.status != Status::Lost) {
+        res = retry;
+        est = est2;
+        ok = true;
       }
     }
     // Held by the light fixed to the camera: once more with the photometric model made now.
     if (ok && res.status == Status::Lost && res.reason == kMisaligned && correct_again(live)) {
-      FrameResult again = res;
-      const char* reason3 = "";
+      FrameResult again;
       Estimate est3;
-      if (align(live, init, &est3, &again, &reason3)) {
-        finish(&again, est3);
-        for (size_t l = 0; l < res.iterations.size(); ++l) {
-          again.iterations[l] += res.iterations[l];
-          again.level_ms[l] += res.level_ms[l];
-        }
+      if (align_again(live, init, res, &again, &est3)) {
         res = again;
         est = est3;
       }
