@@ -161,6 +161,7 @@ PipelineKernels::PipelineKernels(ocl::Runtime& runtime, const ImagePipelineOptio
     cl::Device& dev = runtime.device();
     cl::Program& undistort = runtime.program("undistort", undistort_opts);
     undistort_ = make_kernel(undistort, "undistort", dev, undistort_wg_);
+    undistort_rolling_ = make_kernel(undistort, "undistort_rolling", dev, undistort_wg_);
     photometric_ = make_kernel(undistort, "photometric", dev, undistort_wg_);
     photometric_learn_ = make_kernel(undistort, "photometric_learn", dev, undistort_wg_);
     cl::Program& pyramid = runtime.program("pyramid", pyramid_opts);
@@ -203,6 +204,18 @@ void PipelineKernels::undistort(const cl::Buffer& frame, const cl::Buffer& index
   undistort_.setArg(4, static_cast<cl_int>(height));
   undistort_.setArg(5, dst);
   launch(runtime_.queue(), undistort_, undistort_wg_, width, height);
+}
+
+void PipelineKernels::undistort_rolling(const cl::Buffer& frame, const cl::Buffer& map, const cl::Buffer& rows,
+                                        int width, int height, const cl_float4& roi, const cl::Buffer& dst) {
+  undistort_rolling_.setArg(0, frame);
+  undistort_rolling_.setArg(1, map);
+  undistort_rolling_.setArg(2, rows);
+  undistort_rolling_.setArg(3, static_cast<cl_int>(width));
+  undistort_rolling_.setArg(4, static_cast<cl_int>(height));
+  undistort_rolling_.setArg(5, roi);
+  undistort_rolling_.setArg(6, dst);
+  launch(runtime_.queue(), undistort_rolling_, undistort_wg_, width, height);
 }
 
 void PipelineKernels::downsample(const cl::Buffer& src, int src_width, int src_height,
@@ -272,6 +285,15 @@ struct ImagePipeline::Impl {
   bool has_frame = false;             // a frame is in `frame` (reprocess)
   cl::Buffer kept;                    // a copy of `frame` (keep, reprocess_kept)
   bool has_kept = false;
+  // The rolling shutter: the map as (x, y) pairs (made on the first row warp that is not the
+  // identity), and the current and the kept frame's row warps (a buffer each, when not identity).
+  cl::Buffer map_xy;
+  cl_float4 roi{};
+  struct Rows {
+    RowWarp warp;
+    cl::Buffer buffer;
+    bool identity = true;
+  } row_warp, kept_row_warp;
   Impl(ocl::Runtime& r, const ImagePipelineOptions& o) : rt(r), kernels(r, o), prefilter(o.prefilter) {}
 
   int w(int l) const { return level_size(camera.width, l); }
@@ -309,22 +331,47 @@ struct ImagePipeline::Impl {
     }
   }
 
-  void undistort() { undistort(frame); }
-  void undistort(const cl::Buffer& source) {
+  void set_rows(Rows& r, const RowWarp& warp) {
+    if (warp.height != camera.height || warp.h.size() != static_cast<size_t>(warp.height) * 9)
+      throw_invalid_argument("image pipeline: the row warp has " + std::to_string(warp.height) +
+                             " rows, the camera's images " + std::to_string(camera.height));
+    r.warp = warp;
+    r.identity = warp.identity();
+    if (r.identity) return;
+    cl::Context& ctx = rt.context();
+    if (!map_xy()) {
+      std::vector<float> xy(2 * map.map_x.size());
+      for (size_t i = 0; i < map.map_x.size(); ++i) {
+        xy[2 * i] = map.map_x[i];
+        xy[2 * i + 1] = map.map_y[i];
+      }
+      map_xy = cl::Buffer(ctx, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, xy.size() * sizeof(float), xy.data());
+      const PixelRegion reg = camera.region();
+      roi = {{static_cast<float>(reg.x), static_cast<float>(reg.y), static_cast<float>(reg.x + reg.width - 1),
+              static_cast<float>(reg.y + reg.height - 1)}};
+    }
+    if (!r.buffer()) r.buffer = cl::Buffer(ctx, CL_MEM_READ_WRITE, warp.h.size() * sizeof(float));
+    // Blocking: the next call may change r.warp before a non-blocking write had read it.
+    rt.queue().enqueueWriteBuffer(r.buffer, CL_TRUE, 0, warp.h.size() * sizeof(float), r.warp.h.data());
+  }
+
+  void undistort() { undistort(frame, row_warp); }
+  void undistort(const cl::Buffer& source, const Rows& r) {
     const cl::Buffer& level0 = prefilter ? raw : intensity[0];
-    if (photometric) {
-      kernels.undistort(source, map_index, map_weights, w(0), h(0), uncorrected);
+    const cl::Buffer& undistorted = photometric ? uncorrected : level0;
+    if (r.identity)
+      kernels.undistort(source, map_index, map_weights, w(0), h(0), undistorted);
+    else
+      kernels.undistort_rolling(source, map_xy, r.buffer, w(0), h(0), roi, undistorted);
+    if (photometric)
       kernels.photometric(uncorrected, photometric->model(),
                           static_cast<float>(photometric->options().saturation), w(0), h(0), level0);
-    } else {
-      kernels.undistort(source, map_index, map_weights, w(0), h(0), level0);
-    }
     if (prefilter) kernels.smooth(raw, w(0), h(0), intensity[0]);
   }
-  // Undistortion (with the photometric correction), pyramid and gradients of the frame in
-  // `source` into `out`.
-  void stages(const cl::Buffer& source, Pyramid& out) {
-    undistort(source);
+  // Undistortion (with the rolling shutter's row warp r and the photometric correction), pyramid
+  // and gradients of the frame in `source` into `out`.
+  void stages(const cl::Buffer& source, const Rows& r, Pyramid& out) {
+    undistort(source, r);
     pyramid();
     gradients(out);
   }
@@ -349,6 +396,7 @@ ImagePipeline::ImagePipeline(ocl::Runtime& runtime, const CameraModel& camera, i
   m.camera = camera;
   m.levels = levels;
   m.map = std::move(map);
+  m.row_warp.warp = m.kept_row_warp.warp = identity_row_warp(camera.height);
   PipelineKernels::DeviceMap dm = PipelineKernels::device_map(m.map);
   // Zeroed, so that the bytes after the frame that the kernel reads (with weight 0) are defined.
   std::vector<uint8_t> zeros(PipelineKernels::frame_buffer_size(camera.width, camera.height), 0);
@@ -390,7 +438,7 @@ void ImagePipeline::process(const uint8_t* gray, int width, int height, size_t s
   try {
     m.upload(gray, stride);
     m.has_frame = true;
-    m.stages(m.frame, out);
+    m.stages(m.frame, m.row_warp, out);
   } catch (const cl::Error& e) {
     throw_opencl("processing a frame", e);
   }
@@ -419,7 +467,7 @@ void ImagePipeline::reprocess(Pyramid& out) {
   if (!m.has_frame) throw_invalid_argument("image pipeline: reprocess before any frame");
   m.ensure(out);
   try {
-    m.stages(m.frame, out);
+    m.stages(m.frame, m.row_warp, out);
   } catch (const cl::Error& e) {
     throw_opencl("reprocessing a frame", e);
   }
@@ -433,6 +481,13 @@ void ImagePipeline::keep() {
     if (!m.has_kept) m.kept = cl::Buffer(m.rt.context(), CL_MEM_READ_WRITE, bytes);
     m.rt.queue().enqueueCopyBuffer(m.frame, m.kept, 0, 0, bytes);
     m.has_kept = true;
+    m.kept_row_warp.warp = m.row_warp.warp;
+    m.kept_row_warp.identity = m.row_warp.identity;
+    if (!m.row_warp.identity) {
+      const size_t rb = m.row_warp.warp.h.size() * sizeof(float);
+      if (!m.kept_row_warp.buffer()) m.kept_row_warp.buffer = cl::Buffer(m.rt.context(), CL_MEM_READ_WRITE, rb);
+      m.rt.queue().enqueueCopyBuffer(m.row_warp.buffer, m.kept_row_warp.buffer, 0, 0, rb);
+    }
   } catch (const cl::Error& e) {
     throw_opencl("keeping a frame", e);
   }
@@ -443,9 +498,25 @@ void ImagePipeline::reprocess_kept(Pyramid& out) {
   if (!m.has_kept) throw_invalid_argument("image pipeline: reprocess_kept before keep");
   m.ensure(out);
   try {
-    m.stages(m.kept, out);
+    m.stages(m.kept, m.kept_row_warp, out);
   } catch (const cl::Error& e) {
     throw_opencl("reprocessing the kept frame", e);
+  }
+}
+
+void ImagePipeline::set_row_warp(const RowWarp& warp) {
+  try {
+    impl_->set_rows(impl_->row_warp, warp);
+  } catch (const cl::Error& e) {
+    throw_opencl("setting the row warp", e);
+  }
+}
+
+void ImagePipeline::set_kept_row_warp(const RowWarp& warp) {
+  try {
+    impl_->set_rows(impl_->kept_row_warp, warp);
+  } catch (const cl::Error& e) {
+    throw_opencl("setting the kept frame's row warp", e);
   }
 }
 

@@ -15,6 +15,7 @@
 #include "image/camera.h"
 #include "image/photometric.h"
 #include "image/pyramid.h"
+#include "image/rolling_shutter.h"
 #include "image/undistort.h"
 
 namespace planarvo {
@@ -137,6 +138,11 @@ class PipelineKernels {
   // intensity image.
   void undistort(const cl::Buffer& frame, const cl::Buffer& index, const cl::Buffer& weights,
                  int width, int height, const cl::Buffer& dst);
+  // The rolling-shutter undistortion (rolling_shutter.h): frame as undistort's; map: width *
+  // height float2, the UndistortMap's (map_x, map_y) interleaved; rows: RowWarp::h; roi: the
+  // region of interest's (min x, min y, max x, max y).
+  void undistort_rolling(const cl::Buffer& frame, const cl::Buffer& map, const cl::Buffer& rows, int width,
+                         int height, const cl_float4& roi, const cl::Buffer& dst);
   // The photometric correction: raw -> dst (intensity images of width x height, not the same
   // buffer), model PhotometricModel's planes.
   void photometric(const cl::Buffer& raw, const cl::Buffer& model, float saturation, int width,
@@ -154,7 +160,7 @@ class PipelineKernels {
 
  private:
   ocl::Runtime& runtime_;
-  cl::Kernel undistort_, photometric_, photometric_learn_, smooth_, downsample_, gradient_;
+  cl::Kernel undistort_, undistort_rolling_, photometric_, photometric_learn_, smooth_, downsample_, gradient_;
   size_t undistort_wg_[2] = {1, 1}, pyramid_wg_[2] = {1, 1};
 };
 
@@ -200,6 +206,14 @@ class ImagePipeline {
   // learning's frame (learn()) to the kept one until the next process or reprocess.
   // InvalidArgument when nothing was kept.
   void reprocess_kept(Pyramid& out);
+  // The rolling shutter (rolling_shutter.h): the row warp with which the last frame (and the
+  // frames processed after it until the next call) is undistorted, to the global-shutter image at
+  // its stamp. The identity (the default) is the plain undistortion, bit for bit. Its caller
+  // knows the robot's velocity (rolling_shutter_warp); after a better estimate, set it again and
+  // reprocess(). InvalidArgument when its height is not the camera's.
+  void set_row_warp(const RowWarp& warp);
+  // The same for the kept frame (reprocess_kept); keep() keeps the last frame's with it.
+  void set_kept_row_warp(const RowWarp& warp);
   // The photometric model, or null when it is off.
   PhotometricModel* photometric();
 

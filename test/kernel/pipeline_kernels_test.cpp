@@ -20,6 +20,7 @@
 #include <gtest/gtest.h>
 
 #include "image/pipeline.h"
+#include "image/rolling_shutter.h"
 #include "ocl/runtime.h"
 
 namespace planarvo {
@@ -142,6 +143,88 @@ TEST(PipelineKernels, UndistortMatchesReference) {
         EXPECT_LT(map.valid_count(), n) << what << ": the test wants pixels without a source";
       }
     }
+}
+
+// The rolling-shutter undistortion against undistort_rolling_reference. Its source coordinate is
+// computed in float (a homography with OpenCL's 2.5-ulp division, then the map interpolated and
+// extrapolated beyond the image's edge, three times), so a contracted multiply-add or a division's
+// last bits move it by up to about 1e-3 px, and a coordinate that close to the region's edge may
+// change validity. On a smooth random image (up to about 20 grey levels per pixel) tolerance 0.05
+// grey levels, and at most 1 in 10^4 pixels of another validity; a wrong row, tap or weight errs
+// by grey levels. With the identity warp it is undistort_reference exactly (the coordinates of
+// the plain undistortion).
+TEST(PipelineKernels, UndistortRollingMatchesReference) {
+  ocl::Runtime rt;
+  PipelineKernels kernels(rt);
+  const double dist[][2] = {{-0.12, 0.03}, {0.2, 0.05}, {0.0, 0.0}};
+  const int sizes[][2] = {{643, 479}, {97, 61}, {20, 13}};
+  Extrinsics e;
+  e.z = 0.3;
+  e.pitch = 0.2;
+  e.roll = -0.05;
+  uint32_t seed = 71;
+  for (const auto& s : sizes)
+    for (const auto& d : dist)
+      for (int moving = 0; moving < 2; ++moving) {
+        const std::string what = std::to_string(s[0]) + "x" + std::to_string(s[1]) + " k1=" + std::to_string(d[0]) +
+                                 (moving ? " moving" : " at rest");
+        CameraModel cam = distorted_camera(s[0], s[1], d[0], d[1]);
+        cam.rolling_shutter_readout = 0.03;
+        const UndistortMap map = compute_undistort_map(cam);
+        // Fast enough to shift the last row by tens of pixels at 643 px.
+        const RowWarp warp = rolling_shutter_warp(cam, e, moving ? Eigen::Vector3d(1.5, -0.3, 1.2) : Eigen::Vector3d::Zero());
+        ASSERT_EQ(warp.identity(), !moving) << what;
+        // Smooth random texture (a few grey levels per pixel), so that a sample's difference
+        // measures its coordinate's.
+        cv::Mat noise(s[1], s[0], CV_32FC1), gray;
+        cv::RNG(seed++).fill(noise, cv::RNG::UNIFORM, 0.0, 255.0);
+        cv::GaussianBlur(noise, noise, cv::Size(0, 0), 2.0);
+        cv::normalize(noise, noise, 0, 255, cv::NORM_MINMAX);
+        noise.convertTo(gray, CV_8UC1);
+        const size_t n = gray.total();
+        cv::Mat bytes(1, static_cast<int>(PipelineKernels::frame_buffer_size(s[0], s[1])), CV_8UC1);
+        cv::RNG(seed++).fill(bytes, cv::RNG::UNIFORM, 0, 256);
+        std::copy(gray.datastart, gray.dataend, bytes.data);
+        std::vector<float> xy(2 * n);
+        for (size_t i = 0; i < n; ++i) {
+          xy[2 * i] = map.map_x[i];
+          xy[2 * i + 1] = map.map_y[i];
+        }
+        const PixelRegion r = cam.region();
+        const cl_float4 roi = {{static_cast<float>(r.x), static_cast<float>(r.y), static_cast<float>(r.x + r.width - 1),
+                                static_cast<float>(r.y + r.height - 1)}};
+        const cl::Buffer frame = upload(rt, bytes.data, bytes.total()),
+                         mapb = upload(rt, xy.data(), xy.size() * sizeof(float)),
+                         rows = upload(rt, warp.h.data(), warp.h.size() * sizeof(float));
+        const cl::Buffer dst = poisoned(rt, n);
+        kernels.undistort_rolling(frame, mapb, rows, s[0], s[1], roi, dst);
+        const std::vector<float> k = download(rt, dst, n);
+        const cv::Mat ref = undistort_rolling_reference(gray, cam, map, warp);
+        if (!moving) {
+          // At rest: the plain undistortion, exactly (reference and kernel).
+          EXPECT_EQ(cv::norm(ref, undistort_reference(gray, map), cv::NORM_INF), 0.0) << what;
+          expect_intensity_matches(k, ref, what);
+          continue;
+        }
+        size_t unwritten = 0, validity = 0, off = 0, valid = 0, overrun = 0;
+        double worst = 0.0;
+        for (size_t i = 0; i < n; ++i) {
+          const float want = ref.at<float>(static_cast<int>(i / s[0]), static_cast<int>(i % s[0])), got = k[i];
+          if (got == kPoison) ++unwritten;
+          else if ((want == kInvalidIntensity) != (got == kInvalidIntensity)) ++validity;
+          else if (want != kInvalidIntensity) {
+            ++valid;
+            worst = std::max(worst, std::abs(static_cast<double>(got) - want));
+            off += !(std::abs(static_cast<double>(got) - want) <= 0.05);
+          }
+        }
+        for (size_t i = n; i < k.size(); ++i) overrun += k[i] != kPoison;
+        EXPECT_EQ(unwritten, 0u) << what;
+        EXPECT_EQ(overrun, 0u) << what;
+        EXPECT_LE(validity, n / 10000) << what;
+        EXPECT_EQ(off, 0u) << what << ": worst difference " << worst;
+        EXPECT_GT(valid, n / 3) << what;
+      }
 }
 
 TEST(PipelineKernels, DownsampleMatchesReference) {
