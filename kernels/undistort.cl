@@ -130,75 +130,47 @@ void photometric_learn(__global const float* raw, __global float* stats, const f
 
 // Undistortion of a rolling-shutter camera's frame (src/image/rolling_shutter.h; plain C++
 // reference: undistort_rolling_reference): the undistorted image a global shutter would have
-// taken at the frame's stamp. Per output pixel p, with s(r) the map bilinearly interpolated at
-// q = H_r p (rows' homographies interpolated linearly) and f(r) = s(r).y clamped to
-// [0, height - 1]: r0 = the map's source row at p, r1 = f(r0), r2 = f(r1), and the frame is
-// sampled bilinearly at s(aitken(r0, r1, r2)) when that lies inside the region of interest,
-// PV_INVALID otherwise.
+// taken at the frame's stamp. Per output pixel p = (u, v): the source coordinate is the map's
+// plus the rolling shutter's displacement, interpolated bilinearly from a grid of nodes every
+// `step` pixels (cells clamped to the grid); the frame is sampled there bilinearly when it lies
+// inside the region of interest, PV_INVALID otherwise.
 //
 //   src      the 8-bit frame (as `undistort`'s)
 //   map      per output pixel its source coordinate (x, y) under a global shutter
-//   rows     height homographies of 9 floats, row-major
+//   grid     nodes_x x nodes_y displacements (dx, dy), row-major
+//   inv_step 1 / the grid's step
 //   roi      (min x, min y, max x, max y) of the source coordinates that may be sampled
 //   dst      width x height floats
-// Each work-item makes 8 consecutive pixels of a row (the launch shape of `undistort`), one at
-// a time: the gathers dominate.
-
-inline float2 pv_map_at(__global const float2* map, const float2 q, const int width, const int height) {
-  const float fx = isnan(q.x) ? 0.0f : floor(q.x), fy = isnan(q.y) ? 0.0f : floor(q.y);
-  const int x0 = clamp((int)clamp(fx, -1.0f, (float)width), 0, width - 2);
-  const int y0 = clamp((int)clamp(fy, -1.0f, (float)height), 0, height - 2);
-  const float ax = q.x - (float)x0, ay = q.y - (float)y0;
-  const int i00 = y0 * width + x0, i10 = i00 + width;
-  // a + t (b - a): beyond the image's edge t is large, and this form keeps the rounding of the
-  // map's coordinates from being multiplied by it.
-  const float2 m00 = map[i00], m10 = map[i10];
-  const float2 top = m00 + ax * (map[i00 + 1] - m00);
-  const float2 bottom = m10 + ax * (map[i10 + 1] - m10);
-  return top + ay * (bottom - top);
-}
-
-// s(r) for output pixel (u, v).
-inline float2 pv_rolling_source(__global const float2* map, __global const float* rows, const float r,
-                                const float u, const float v, const int width, const int height) {
-  const int i = min((int)r, max(height - 2, 0));
-  const float f = height > 1 ? r - (float)i : 0.0f;
-  __global const float* a = rows + 9 * i;
-  __global const float* b = height > 1 ? a + 9 : a;
-  const float m0 = a[0] + f * (b[0] - a[0]), m1 = a[1] + f * (b[1] - a[1]), m2 = a[2] + f * (b[2] - a[2]);
-  const float m3 = a[3] + f * (b[3] - a[3]), m4 = a[4] + f * (b[4] - a[4]), m5 = a[5] + f * (b[5] - a[5]);
-  const float m6 = a[6] + f * (b[6] - a[6]), m7 = a[7] + f * (b[7] - a[7]), m8 = a[8] + f * (b[8] - a[8]);
-  const float z = m6 * u + m7 * v + m8;
-  return pv_map_at(map, (float2)((m0 * u + m1 * v + m2) / z, (m3 * u + m4 * v + m5) / z), width, height);
-}
-
+// Each work-item makes 8 consecutive pixels of a row (the launch shape of `undistort`).
 __kernel __attribute__((reqd_work_group_size(UNDISTORT_WG_X, UNDISTORT_WG_Y, 1)))
-void undistort_rolling(__global const uchar* src, __global const float2* map, __global const float* rows,
-                       const int width, const int height, const float4 roi, __global float* dst) {
+void undistort_rolling(__global const uchar* src, __global const float2* map, __global const float2* grid,
+                       const int nodes_x, const int nodes_y, const float inv_step, const int width,
+                       const int height, const float4 roi, __global float* dst) {
   const int x = (int)get_global_id(0) * 8;
   const int y = (int)get_global_id(1);
   if (x >= width || y >= height) return;
   const int end = min(x + 8, width);
-  const float last_row = (float)(height - 1), fv = (float)y;
+  const float gy = (float)y * inv_step;
+  const int j = min((int)gy, nodes_y - 2);
+  const float ay = gy - (float)j;
   for (int u = x; u < end; ++u) {
     const int p = y * width + u;
-    const float fu = (float)u;
-    const float r0 = clamp(map[p].y, 0.0f, last_row);
-    const float r1 = clamp(pv_rolling_source(map, rows, r0, fu, fv, width, height).y, 0.0f, last_row);
-    const float r2 = clamp(pv_rolling_source(map, rows, r1, fu, fv, width, height).y, 0.0f, last_row);
-    // Aitken's extrapolation (rolling_shutter.h, aitken()).
-    const float d1 = r1 - r0, d2 = r2 - r1, den = d2 - d1;
-    const float r = fabs(d2) < 0.9f * fabs(d1) && fabs(den) > 1e-4f ? clamp(r2 - d2 * d2 / den, 0.0f, last_row) : r2;
-    const float2 s = pv_rolling_source(map, rows, r, fu, fv, width, height);
+    const float gx = (float)u * inv_step;
+    const int i = min((int)gx, nodes_x - 2);
+    const float ax = gx - (float)i;
+    const int n00 = j * nodes_x + i, n10 = n00 + nodes_x;
+    const float2 top = grid[n00] + ax * (grid[n00 + 1] - grid[n00]);
+    const float2 bottom = grid[n10] + ax * (grid[n10 + 1] - grid[n10]);
+    const float2 s = map[p] + (top + ay * (bottom - top));
     if (!(s.x >= roi.x && s.x <= roi.z && s.y >= roi.y && s.y <= roi.w)) {
       dst[p] = PV_INVALID;
       continue;
     }
     const int x0 = (int)s.x, y0 = (int)s.y;
     const int x1 = min(x0 + 1, width - 1), y1 = min(y0 + 1, height - 1);
-    const float ax = s.x - (float)x0, ay = s.y - (float)y0;
-    const float top = (1.0f - ax) * (float)src[y0 * width + x0] + ax * (float)src[y0 * width + x1];
-    const float bottom = (1.0f - ax) * (float)src[y1 * width + x0] + ax * (float)src[y1 * width + x1];
-    dst[p] = (1.0f - ay) * top + ay * bottom;
+    const float bx = s.x - (float)x0, by = s.y - (float)y0;
+    const float t = (1.0f - bx) * (float)src[y0 * width + x0] + bx * (float)src[y0 * width + x1];
+    const float b = (1.0f - bx) * (float)src[y1 * width + x0] + bx * (float)src[y1 * width + x1];
+    dst[p] = (1.0f - by) * t + by * b;
   }
 }

@@ -96,6 +96,13 @@ PLANARVO_API planarvo_status planarvo_dataset_info_get(const planarvo_dataset* d
  * roi NULL or all zero: the whole image. PLANARVO_ERROR_INVALID_INPUT, changing nothing, when it
  * does not lie inside the image or is smaller than 16 pixels on a side. */
 PLANARVO_API planarvo_status planarvo_dataset_set_roi(planarvo_dataset* dataset, const planarvo_region* roi);
+/* Replaces the data set camera's rolling-shutter readout (camera.yaml's rolling_shutter_readout:
+ * seconds from the first row's read to the last's; 0 = a global shutter) for everything that reads
+ * the data set from now on. source names where the value came from in the error message (NULL:
+ * "the readout time"). PLANARVO_ERROR_INVALID_INPUT, changing nothing, when it is negative, not
+ * finite or longer than the frames' median interval. */
+PLANARVO_API planarvo_status planarvo_dataset_set_readout(planarvo_dataset* dataset, double seconds,
+                                                          const char* source);
 PLANARVO_API planarvo_status planarvo_dataset_frame_data(const planarvo_dataset* dataset,
                                                          int64_t index, planarvo_frame_data* data);
 /* Decodes frame index as 8-bit grey. *image points into memory owned by the data set, valid until

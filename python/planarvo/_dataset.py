@@ -109,6 +109,12 @@ class Dataset(_Handle):
         """Replaces the camera's region of interest (x, y, width, height); None: the whole image."""
         _check(lib.planarvo_dataset_set_roi(self._h(), None if roi is None else ctypes.byref(N.Region(*roi))))
 
+    def set_readout(self, seconds: float) -> None:
+        """Replaces the camera's rolling-shutter readout: seconds from the first row's read to the
+        last's (0: a global shutter), as camera.yaml's rolling_shutter_readout. Raises when it is
+        negative, not finite or longer than the frames' interval."""
+        _check(lib.planarvo_dataset_set_readout(self._h(), float(seconds), b"readout"))
+
     def frame_data(self, index: int) -> FrameData:
         d = N.FrameData()
         _check(lib.planarvo_dataset_frame_data(self._h(), index, ctypes.byref(d)))

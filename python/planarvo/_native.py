@@ -234,6 +234,7 @@ _SIGNATURES = {
     "planarvo_bag_topics": (S, [c_char_p, c_char_p, c_size_t, P(c_size_t)]),
     "planarvo_dataset_info_get": (S, [c_void_p, P(DatasetInfo)]),
     "planarvo_dataset_set_roi": (S, [c_void_p, P(Region)]),
+    "planarvo_dataset_set_readout": (S, [c_void_p, ctypes.c_double, ctypes.c_char_p]),
     "planarvo_dataset_frame_data": (S, [c_void_p, c_int64, P(FrameData)]),
     "planarvo_dataset_frame": (S, [c_void_p, c_int64, P(Image)]),
     "planarvo_write_tum": (S, [c_char_p, P(c_double), P(SE2), c_size_t]),

@@ -88,6 +88,14 @@ PLANARVO_API planarvo_status planarvo_dataset_set_roi(planarvo_dataset* dataset,
   });
 }
 
+PLANARVO_API planarvo_status planarvo_dataset_set_readout(planarvo_dataset* dataset, double seconds,
+                                                          const char* source) {
+  return guard([&] {
+    require(dataset != nullptr, "planarvo_dataset_set_readout: dataset is NULL");
+    dataset->dataset->set_rolling_shutter_readout(seconds, source ? source : "the readout time");
+  });
+}
+
 PLANARVO_API planarvo_status planarvo_dataset_info_get(const planarvo_dataset* dataset, planarvo_dataset_info* info) {
   return guard([&] {
     require(dataset != nullptr && info != nullptr, "planarvo_dataset_info_get: NULL argument");

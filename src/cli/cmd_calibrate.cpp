@@ -76,11 +76,13 @@ int cmd_calibrate_dataset(const Args& args, const planarvo_calibration_options& 
   }
   args.expect_output_files({"output"});
   const std::optional<planarvo_region> roi = parse_roi(args);  // before any file is read
+  const std::optional<double> readout = parse_readout(args);
   const std::string out = args.get("output");
   ContextPtr ctx = make_context(args);
   Progress progress(!args.has("quiet"));
   DatasetPtr ds = open_dataset(dir, args, false, &progress);
   apply_roi(roi, ds.get());
+  apply_readout(readout, ds.get());
   planarvo_dataset_info info{};
   info.struct_size = sizeof info;
   check(planarvo_dataset_info_get(ds.get(), &info));

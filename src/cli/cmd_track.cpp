@@ -283,6 +283,7 @@ int cmd_track(int argc, char** argv) {
        "3 with the automatic finest level, else 1"},
       {"video", "FILE", "a video file standing in for images/ and frames.txt", ""},
       roi_option("camera.yaml's region_of_interest, else the whole image"),
+      readout_option(),
       {"skip-bad-frames", "", "a missing or undecodable image is a gap (a warning, a \"skipped\" statistics row, "
                               "counted in the summary) instead of an error", ""},
       {"max-lost", "PERCENT", "exit 1 (after writing every output) when more than this share of the frames was "
@@ -319,6 +320,7 @@ int cmd_track(int argc, char** argv) {
   const std::string flat_field = args.get("flat-field");  // outlives o
   o.flat_field = flat_field.empty() ? nullptr : flat_field.c_str();
   const std::optional<planarvo_region> roi = parse_roi(args);  // before any file is read
+  const std::optional<double> readout = parse_readout(args);
   const double max_lost = args.get_double("max-lost", 5.0);
   if (!(max_lost >= 0.0 && max_lost <= 100.0))
     throw UsageError("--max-lost must be a percentage within 0..100, not " + args.get("max-lost"));
@@ -327,6 +329,7 @@ int cmd_track(int argc, char** argv) {
   Progress progress(!args.has("quiet"));
   DatasetPtr ds = open_dataset(dir, args, false, &progress, args.has("skip-bad-frames"));
   apply_roi(roi, ds.get());
+  apply_readout(readout, ds.get());
   const TrackRun run = track_dataset(ctx.get(), ds.get(), e, o, {args.get("output"), args.get("stats"), args.get("motions-out"), args.has("skip-bad-frames"), args.get("save-flat-field")}, &progress);
   progress.finish();
   std::printf("tracked %s on %s\n", dir.c_str(), device_name(ctx.get()).c_str());

@@ -86,6 +86,23 @@ void apply_roi(const std::optional<planarvo_region>& roi, planarvo_dataset* data
   if (roi) check(planarvo_dataset_set_roi(dataset, &*roi));
 }
 
+OptionSpec readout_option() {
+  return {"readout-time", "SECONDS", "rolling shutter: seconds from the first row's read to the last's (0: a global "
+                                     "shutter); overrides the camera file's rolling_shutter_readout", "camera.yaml's, else 0"};
+}
+
+std::optional<double> parse_readout(const Args& args) {
+  if (!args.has("readout-time")) return std::nullopt;
+  const double v = args.get_double("readout-time", 0.0);
+  if (!std::isfinite(v) || v < 0)
+    throw UsageError("--readout-time needs a finite number of seconds >= 0, got \"" + args.get("readout-time") + "\"");
+  return v;
+}
+
+void apply_readout(const std::optional<double>& readout, planarvo_dataset* dataset) {
+  if (readout) check(planarvo_dataset_set_readout(dataset, *readout, "--readout-time"));
+}
+
 namespace {
 
 // Opens path with the source options in o and the ones every data set takes.

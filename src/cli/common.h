@@ -63,6 +63,13 @@ OptionSpec roi_option(const char* fallback);
 std::optional<planarvo_region> parse_roi(const Args& args);
 // Applies a parsed --roi, when given, to an open data set's camera.
 void apply_roi(const std::optional<planarvo_region>& roi, planarvo_dataset* dataset);
+// --readout-time SECONDS: the camera's rolling-shutter readout, overriding camera.yaml's
+// rolling_shutter_readout (0: a global shutter).
+OptionSpec readout_option();
+// The value when given: UsageError unless a finite number >= 0 (the data set checks it against
+// the frame interval in apply_readout, naming the option).
+std::optional<double> parse_readout(const Args& args);
+void apply_readout(const std::optional<double>& readout, planarvo_dataset* dataset);
 
 // allow_missing: a missing image is found when its frame is read, not at open (--skip-bad-frames).
 // The options that read a ROS 1 bag or MCAP file given as DATASET: topics, camera, timing.

@@ -206,16 +206,19 @@ void PipelineKernels::undistort(const cl::Buffer& frame, const cl::Buffer& index
   launch(runtime_.queue(), undistort_, undistort_wg_, width, height);
 }
 
-void PipelineKernels::undistort_rolling(const cl::Buffer& frame, const cl::Buffer& map, const cl::Buffer& rows,
-                                        int width, int height, const cl_float4& roi, const cl::Buffer& dst) {
+void PipelineKernels::undistort_rolling(const cl::Buffer& frame, const cl::Buffer& map, const cl::Buffer& grid,
+                                        const RowWarp& warp, const cl_float4& roi, const cl::Buffer& dst) {
   undistort_rolling_.setArg(0, frame);
   undistort_rolling_.setArg(1, map);
-  undistort_rolling_.setArg(2, rows);
-  undistort_rolling_.setArg(3, static_cast<cl_int>(width));
-  undistort_rolling_.setArg(4, static_cast<cl_int>(height));
-  undistort_rolling_.setArg(5, roi);
-  undistort_rolling_.setArg(6, dst);
-  launch(runtime_.queue(), undistort_rolling_, undistort_wg_, width, height);
+  undistort_rolling_.setArg(2, grid);
+  undistort_rolling_.setArg(3, static_cast<cl_int>(warp.nodes_x));
+  undistort_rolling_.setArg(4, static_cast<cl_int>(warp.nodes_y));
+  undistort_rolling_.setArg(5, 1.0f / static_cast<float>(warp.step));
+  undistort_rolling_.setArg(6, static_cast<cl_int>(warp.width));
+  undistort_rolling_.setArg(7, static_cast<cl_int>(warp.height));
+  undistort_rolling_.setArg(8, roi);
+  undistort_rolling_.setArg(9, dst);
+  launch(runtime_.queue(), undistort_rolling_, undistort_wg_, warp.width, warp.height);
 }
 
 void PipelineKernels::downsample(const cl::Buffer& src, int src_width, int src_height,
@@ -332,9 +335,10 @@ struct ImagePipeline::Impl {
   }
 
   void set_rows(Rows& r, const RowWarp& warp) {
-    if (warp.height != camera.height || warp.h.size() != static_cast<size_t>(warp.height) * 9)
-      throw_invalid_argument("image pipeline: the row warp has " + std::to_string(warp.height) +
-                             " rows, the camera's images " + std::to_string(camera.height));
+    if (warp.width != camera.width || warp.height != camera.height || warp.nodes_x < 2 || warp.nodes_y < 2 ||
+        warp.delta.size() != 2 * static_cast<size_t>(warp.nodes_x) * static_cast<size_t>(warp.nodes_y))
+      throw_invalid_argument("image pipeline: the row warp is for " + size_text(warp.width, warp.height) +
+                             " images, the camera's are " + size_text(camera.width, camera.height));
     r.warp = warp;
     r.identity = warp.identity();
     if (r.identity) return;
@@ -350,9 +354,10 @@ struct ImagePipeline::Impl {
       roi = {{static_cast<float>(reg.x), static_cast<float>(reg.y), static_cast<float>(reg.x + reg.width - 1),
               static_cast<float>(reg.y + reg.height - 1)}};
     }
-    if (!r.buffer()) r.buffer = cl::Buffer(ctx, CL_MEM_READ_WRITE, warp.h.size() * sizeof(float));
+    const size_t bytes = warp.delta.size() * sizeof(float);
+    if (!r.buffer() || r.buffer.getInfo<CL_MEM_SIZE>() != bytes) r.buffer = cl::Buffer(ctx, CL_MEM_READ_WRITE, bytes);
     // Blocking: the next call may change r.warp before a non-blocking write had read it.
-    rt.queue().enqueueWriteBuffer(r.buffer, CL_TRUE, 0, warp.h.size() * sizeof(float), r.warp.h.data());
+    rt.queue().enqueueWriteBuffer(r.buffer, CL_TRUE, 0, bytes, r.warp.delta.data());
   }
 
   void undistort() { undistort(frame, row_warp); }
@@ -362,7 +367,7 @@ struct ImagePipeline::Impl {
     if (r.identity)
       kernels.undistort(source, map_index, map_weights, w(0), h(0), undistorted);
     else
-      kernels.undistort_rolling(source, map_xy, r.buffer, w(0), h(0), roi, undistorted);
+      kernels.undistort_rolling(source, map_xy, r.buffer, r.warp, roi, undistorted);
     if (photometric)
       kernels.photometric(uncorrected, photometric->model(),
                           static_cast<float>(photometric->options().saturation), w(0), h(0), level0);
@@ -396,7 +401,7 @@ ImagePipeline::ImagePipeline(ocl::Runtime& runtime, const CameraModel& camera, i
   m.camera = camera;
   m.levels = levels;
   m.map = std::move(map);
-  m.row_warp.warp = m.kept_row_warp.warp = identity_row_warp(camera.height);
+  m.row_warp.warp = m.kept_row_warp.warp = identity_row_warp(camera.width, camera.height);
   PipelineKernels::DeviceMap dm = PipelineKernels::device_map(m.map);
   // Zeroed, so that the bytes after the frame that the kernel reads (with weight 0) are defined.
   std::vector<uint8_t> zeros(PipelineKernels::frame_buffer_size(camera.width, camera.height), 0);
@@ -484,8 +489,9 @@ void ImagePipeline::keep() {
     m.kept_row_warp.warp = m.row_warp.warp;
     m.kept_row_warp.identity = m.row_warp.identity;
     if (!m.row_warp.identity) {
-      const size_t rb = m.row_warp.warp.h.size() * sizeof(float);
-      if (!m.kept_row_warp.buffer()) m.kept_row_warp.buffer = cl::Buffer(m.rt.context(), CL_MEM_READ_WRITE, rb);
+      const size_t rb = m.row_warp.warp.delta.size() * sizeof(float);
+      if (!m.kept_row_warp.buffer() || m.kept_row_warp.buffer.getInfo<CL_MEM_SIZE>() != rb)
+        m.kept_row_warp.buffer = cl::Buffer(m.rt.context(), CL_MEM_READ_WRITE, rb);
       m.rt.queue().enqueueCopyBuffer(m.row_warp.buffer, m.kept_row_warp.buffer, 0, 0, rb);
     }
   } catch (const cl::Error& e) {

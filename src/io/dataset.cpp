@@ -12,6 +12,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <deque>
 #include <filesystem>
 #include <tuple>
@@ -35,6 +36,28 @@ using detail::BagSource;
 using detail::to_grey_checked;
 
 namespace {
+
+// A readout longer than the frame interval would read a row of the next frame before this one's
+// last: no camera does that, and it is what a readout given in milliseconds looks like.
+void check_readout(double readout, const std::vector<FrameEntry>& frames, const std::string& where) {
+  char got[64];
+  std::snprintf(got, sizeof got, "%g", readout);
+  if (!std::isfinite(readout) || readout < 0)
+    throw_invalid_input(where + ": the rolling shutter readout must be a finite number of seconds >= 0, not " + got);
+  std::vector<double> dt;
+  for (size_t i = 1; i < frames.size(); ++i)
+    if (frames[i].t > frames[i - 1].t) dt.push_back(frames[i].t - frames[i - 1].t);
+  if (dt.empty()) return;
+  std::nth_element(dt.begin(), dt.begin() + static_cast<std::ptrdiff_t>(dt.size() / 2), dt.end());
+  const double period = dt[dt.size() / 2];
+  if (readout > period) {
+    char msg[160];
+    std::snprintf(msg, sizeof msg, "%s s is longer than the frames' interval, %g s (the median; seconds, not "
+                  "milliseconds)", got, period);
+    throw_invalid_input(where + ": the rolling shutter readout " + msg);
+  }
+}
+
 
 constexpr size_t kVideoCacheSize = 4;
 
@@ -305,6 +328,7 @@ Dataset::Dataset(const std::string& directory, DatasetOptions options) : impl_(s
     for (double t : d.video->times()) d.frames.push_back({t, std::string(), 0});
   }
   const int64_t n = static_cast<int64_t>(d.frames.size());
+  check_readout(d.camera.rolling_shutter_readout, d.frames, (d.dir / "camera.yaml").string());
 
   d.has_odometry = read_optional(
       d.dir / "odometry.txt", d.odometry, read_tum,
@@ -346,6 +370,8 @@ void Dataset::open_bag(const std::string& file, const DatasetOptions& options) {
                                       [&](double f, const char* stage) { progress.report(f, stage); });
   d.camera = d.bag->camera();
   d.frames = d.bag->frames();
+  check_readout(d.camera.rolling_shutter_readout, d.frames,
+                options.bag.camera_yaml.empty() ? file + ": the camera" : options.bag.camera_yaml);
   d.odometry = d.bag->odometry();
   d.groundtruth = d.bag->groundtruth();
   const int64_t n = static_cast<int64_t>(d.frames.size());
@@ -373,6 +399,11 @@ void Dataset::check_index(int64_t i, const char* what) const {
 
 const std::string& Dataset::directory() const { return impl_->directory; }
 const CameraModel& Dataset::camera() const { return impl_->camera; }
+
+void Dataset::set_rolling_shutter_readout(double seconds, const std::string& where) {
+  check_readout(seconds, impl_->frames, where);
+  impl_->camera.rolling_shutter_readout = seconds;
+}
 
 void Dataset::set_region_of_interest(const PixelRegion& roi) {
   CameraModel c = impl_->camera;

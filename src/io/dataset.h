@@ -66,6 +66,9 @@ class Dataset {
   // Replaces the camera's region of interest (camera.yaml's region_of_interest; empty: the whole
   // image). Throws InvalidInput, changing nothing, when it is not inside the image.
   void set_region_of_interest(const PixelRegion& roi);
+  // Replaces the camera's rolling_shutter_readout (seconds). InvalidInput naming `where` when it
+  // is negative, not finite or longer than the frames' median interval (check_readout).
+  void set_rolling_shutter_readout(double seconds, const std::string& where);
   bool is_video() const;
   bool is_bag() const;
   // A bag's first frame's stamp in integer nanoseconds; timestamps are seconds after it. 0 for

@@ -12,6 +12,7 @@
 #include "core/extrinsics.h"
 #include "image/pipeline.h"
 #include "ocl/runtime.h"
+#include "track/readout_twist.h"
 #include "track/warp_model.h"
 
 namespace planarvo::track {
@@ -67,6 +68,8 @@ CameraModel validated(const CameraModel& c, const Extrinsics& e, const TrackerOp
     if (b < 0 || b > 16) throw_invalid_argument("TrackerOptions::select_blocks must be 0..16");
   if (o.auto_finer_block < 0 || o.auto_finer_block > 16)
     throw_invalid_argument("TrackerOptions::auto_finer_block must be 0..16");
+  if (!(o.rolling_shutter_tolerance_px > 0.0))
+    throw_invalid_argument("TrackerOptions::rolling_shutter_tolerance_px must be positive");
   if (!(o.keyframe_scale_change > 0.0))
     throw_invalid_argument("TrackerOptions::keyframe_scale_change must be positive");
   if (!(o.covariance_step_fraction >= 0.0))
@@ -119,11 +122,21 @@ struct Tracker::Impl {
   bool light_holds = false;  // this frame was misaligned (held by the light fixed to the camera?)
   bool keyframe_kept = false;  // the keyframe's camera frame is kept in the pipeline
   bool learnt_this_frame = false;
+  // The rolling shutter: the twist the live frame in the pipeline was undistorted with, and
+  // whether the keyframe's was measured (not predicted).
+  Eigen::Vector3d live_twist = Eigen::Vector3d::Zero();
+  bool keyframe_twist_measured = false;
   Estimate prev;        // the previous frame relative to the keyframe
   // Covariance of prev.T less the part the next frame shares with it ((1 - 2 rho) C; zero when
   // the previous frame is the keyframe, lost_covariance() after a Lost frame).
   Eigen::Matrix3d prev_covariance = Eigen::Matrix3d::Zero();
   Eigen::Vector3d velocity = Eigen::Vector3d::Zero();  // se(2) per second
+  // The rolling shutter: the twist over the readout (readout_twist.h), the twist the previous
+  // frame (prev) was undistorted with, and the live frame's c.
+  ReadoutTwist readout_twist{0.0};
+  Eigen::Vector3d prev_twist = Eigen::Vector3d::Zero();
+  Eigen::Vector3d live_c = Eigen::Vector3d::Zero();
+  bool has_live_c = false;
   double last_t = 0.0, nominal_dt = 0.0, since_good = 0.0;
   bool has_t = false;
   std::array<double, kMaxLevels> sigma{};  // the robust scale per level, from frame to frame
@@ -142,6 +155,7 @@ struct Tracker::Impl {
 
   Impl(ocl::Runtime& r, const CameraModel& c, const Extrinsics& e, const TrackerOptions& o)
       : rt(r), camera(validated(c, e, o)), ext(e), opt(o), aligner(r, c.K(), o, false), selector(r) {
+    readout_twist = ReadoutTwist(camera.rolling_shutter_readout);
     // The flat field is read now, so that a bad file fails at once rather than at the first frame.
     if (!opt.flat_field.empty() && opt.photometric.enabled) {
       const UndistortMap map = compute_undistort_map(camera);
@@ -174,6 +188,8 @@ struct Tracker::Impl {
     prev = Estimate();
     prev_covariance.setZero();
     velocity.setZero();
+    readout_twist.reset();
+    prev_twist = live_twist = Eigen::Vector3d::Zero();
     has_t = false;
     nominal_dt = 0.0;
     since_good = 0.0;
@@ -182,8 +198,10 @@ struct Tracker::Impl {
 
   // Coarse-to-fine alignment with the keyframe from `init` (the aligner, one pair). Returns false
   // with *reason when the frame cannot be tracked; fills result's per-level fields.
+  // refine: from an estimate already close (the same frame aligned a moment ago), the levels from
+  // half resolution down only (the match is judged at half resolution).
   bool align(const Pyramid& live, const Estimate& init, Estimate* out, FrameResult* res,
-             const char** reason) {
+             const char** reason, bool refine = false) {
     AlignmentPair& pair = pairs[0];
     pair.reference = &keyframe;
     pair.live = &live;
@@ -194,6 +212,7 @@ struct Tracker::Impl {
     pair.sigma = sigma;
     Extrinsics e = ext;
     AlignmentLevels levels = aligner.levels(keyframe, live);
+    if (refine) levels.coarsest = std::max(levels.finest, std::min(1, levels.coarsest));
     report = aligner.align(pairs, &e, levels);
     res->iterations = report.passes;
     res->level_ms = report.level_ms;
@@ -364,8 +383,8 @@ struct Tracker::Impl {
         pipeline->reprocess(keyframe);
       }
       // Its frame stays on the device, so that a model made at a later frame can correct the
-      // keyframe again (correct_again).
-      if (photometric) {
+      // keyframe again (correct_again), or a measured twist undistort it again (unroll_again).
+      if (photometric || rolling()) {
         pipeline->keep();
         keyframe_kept = true;
       }
@@ -397,6 +416,47 @@ struct Tracker::Impl {
   }
 
   // The keyframe's subsampled pixels per level (AlignmentLevels::select_block).
+  bool rolling() const { return camera.rolling_shutter_readout > 0.0; }
+
+  // How far apart two twists put the image of the last row's read: the rolling shutter's
+  // tolerance measure (level-0 pixels).
+  double shutter_shift(const Eigen::Vector3d& a, const Eigen::Vector3d& b) const {
+    const double r = camera.rolling_shutter_readout;
+    return max_pixel_displacement(camera.K(), ext, SE2::exp(a * r), SE2::exp(b * r), camera.width, camera.height);
+  }
+
+  // The live frame (in the pipeline) undistorted again with the twist its alignment measured,
+  // and the keyframe too when its twist was not measured, then aligned once more; twice at most,
+  // while the twist moves the image by more than the tolerance. dt: the frame interval.
+  void unroll_again(const Pyramid& live, double t, double dt, FrameResult* res, Estimate* est) {
+    if (!rolling() || !(dt > 0.0) || &live != &slots[live_slot] || !keyframe_kept) return;
+    for (int round = 0;; ++round) {
+      const Eigen::Vector3d v = (prev.T.inverse() * est->T).log() / dt;
+      const Eigen::Vector3d twist = readout_twist.measure(t, dt, v, live_twist, prev_twist, &live_c);
+      has_live_c = twist.allFinite();
+      if (!has_live_c || round == 2) return;
+      const bool keyframe_too = !keyframe_twist_measured;
+      if (!keyframe_too && shutter_shift(live_twist, twist) <= opt.rolling_shutter_tolerance_px) return;
+      if (keyframe_too) {
+        // The keyframe was the previous frame (the first, or one after a Lost frame): this
+        // frame's twist is the best measure of its own.
+        pipeline->set_kept_row_warp(rolling_shutter_warp(camera, ext, twist));
+        pipeline->reprocess_kept(keyframe);
+        select_keyframe_pixels();
+        keyframe_twist_measured = true;
+        prev_twist = twist;
+      }
+      live_twist = twist;
+      pipeline->set_row_warp(rolling_shutter_warp(camera, ext, twist));
+      pipeline->reprocess(slots[live_slot]);
+      FrameResult again;
+      Estimate e;
+      if (!align_again(live, *est, *res, &again, &e, true)) return;
+      *res = again;
+      *est = e;
+    }
+  }
+
   void select_keyframe_pixels() {
     const AlignmentLevels levels = aligner.levels(keyframe, keyframe);
     for (int l = 0; l < keyframe.num_levels() && l < kMaxLevels; ++l) {
@@ -465,10 +525,10 @@ struct Tracker::Impl {
   // The frame aligned once more from `from` after an attempt that gave `before`: on success
   // *again is judged (finish) and counts both attempts' passes and times.
   bool align_again(const Pyramid& live, const Estimate& from, const FrameResult& before, FrameResult* again,
-                   Estimate* est) {
+                   Estimate* est, bool refine = false) {
     *again = before;
     const char* reason = "";
-    if (!align(live, from, est, again, &reason)) return false;
+    if (!align(live, from, est, again, &reason, refine)) return false;
     finish(again, *est);
     for (size_t l = 0; l < before.iterations.size(); ++l) {
       again->iterations[l] += before.iterations[l];
@@ -510,6 +570,11 @@ struct Tracker::Impl {
       pipeline = std::make_unique<ImagePipeline>(rt, camera, opt.levels, po);
       if (known_photometric && pipeline->photometric()) pipeline->photometric()->set(*known_photometric);
     }
+    if (rolling()) {
+      // Undistorted with the constant-velocity prediction's twist (track() measures it).
+      live_twist = has_keyframe ? readout_twist.predict(t) : Eigen::Vector3d::Zero();
+      pipeline->set_row_warp(rolling_shutter_warp(camera, ext, live_twist));
+    }
     pipeline->process(gray, width, height, stride, slots[live_slot]);
     // Waiting here costs one synchronisation (the first pass would wait anyway) and splits
     // the frame's time between the pipeline and the tracker.
@@ -534,6 +599,7 @@ struct Tracker::Impl {
 
   FrameResult track(const Pyramid& live, double t) {
     const auto t0 = std::chrono::steady_clock::now();
+    has_live_c = false;
     forget_alignment(kNotAligned);
     FrameResult res;
     res.motion.covariance = lost_covariance();
@@ -573,13 +639,18 @@ struct Tracker::Impl {
       pose = pose * predicted;
       if (can_be_keyframe) {
         make_keyframe(live);
+        keyframe_twist_measured = false;
+        prev_twist = live_twist;
         res.keyframe = true;
       } else {
         // The next motion is from this predicted pose: as uncertain as this one.
         prev.T = prev.T * predicted;
         prev_covariance = lost_covariance();
       }
-      if (since_good > opt.max_gap_seconds) velocity.setZero();
+      if (since_good > opt.max_gap_seconds) {
+        velocity.setZero();
+        readout_twist.reset();
+      }
       return done(res);
     };
 
@@ -602,6 +673,8 @@ struct Tracker::Impl {
         return done(res);
       }
       make_keyframe(live);
+      keyframe_twist_measured = false;
+      prev_twist = live_twist;
       res.status = Status::First;
       res.keyframe = true;
       since_good = 0.0;
@@ -635,6 +708,7 @@ struct Tracker::Impl {
         est = est3;
       }
     }
+    if (ok && res.status != Status::Lost) unroll_again(live, t, dt, &res, &est);
     if (ok) remember(live, est);  // before a new keyframe replaces the one aligned with
     else missing = reason;
     if (!ok) return lost(reason, reason != kAlignNoLiveTexture);
@@ -653,9 +727,12 @@ struct Tracker::Impl {
     if (!res.motion.covariance.allFinite()) res.motion.covariance = lost_covariance();
     pose = pose * res.motion.value;
     if (dt > 0.0) velocity = res.motion.value.log() / dt;
+    if (has_live_c) readout_twist.commit(last_t, dt, live_c);
+    prev_twist = live_twist;
     since_good = 0.0;
     if (res.overlap < opt.keyframe_overlap || scale_change(est.T) > opt.keyframe_scale_change) {
       make_keyframe(live);
+      keyframe_twist_measured = true;
       res.keyframe = true;
     } else {
       prev = est;

@@ -103,6 +103,16 @@ struct TrackerOptions : AlignerOptions {
   // photometric.enabled is false.
   std::string flat_field;
 
+  // A rolling shutter (CameraModel::rolling_shutter_readout > 0), camera-frame path: each frame
+  // is undistorted to the global shutter's image at its stamp (image/rolling_shutter.h) with
+  // the robot's twist, first the constant-velocity prediction's, then the one its alignment
+  // measured (the motion from the previous frame over the interval): when the two move the
+  // image (by its last row's read) by more than rolling_shutter_tolerance_px, the frame is
+  // undistorted again and aligned once more (twice at most). A keyframe undistorted without a
+  // measured twist (the first frame, one after a Lost frame) is undistorted again with the next
+  // frame's. Pyramids given to track(Pyramid) are taken as they are.
+  double rolling_shutter_tolerance_px = 0.05;
+
   static WarpReduceOptions default_kernel_options();
 };
 

@@ -145,19 +145,18 @@ TEST(PipelineKernels, UndistortMatchesReference) {
     }
 }
 
-// The rolling-shutter undistortion against undistort_rolling_reference. Its source coordinate is
-// computed in float (a homography with OpenCL's 2.5-ulp division, then the map interpolated and
-// extrapolated beyond the image's edge, three times), so a contracted multiply-add or a division's
-// last bits move it by up to about 1e-3 px, and a coordinate that close to the region's edge may
-// change validity. On a smooth random image (up to about 20 grey levels per pixel) tolerance 0.05
-// grey levels, and at most 1 in 10^4 pixels of another validity; a wrong row, tap or weight errs
-// by grey levels. With the identity warp it is undistort_reference exactly (the coordinates of
-// the plain undistortion).
+// The rolling-shutter undistortion against undistort_rolling_reference: the same float
+// operations (the grid's interpolation, the map's coordinate plus it, the bilinear sample), so a
+// contracted multiply-add moves a coordinate by an ulp or so (1e-5 px at 600 px): on a smooth
+// random image (up to about 20 grey levels per pixel) tolerance 0.01 grey levels, and at most 1
+// in 10^4 pixels of another validity (a coordinate within an ulp of the region's edge); a wrong
+// node, tap or weight errs by grey levels. With the identity warp it is undistort_reference
+// exactly (the coordinates of the plain undistortion).
 TEST(PipelineKernels, UndistortRollingMatchesReference) {
   ocl::Runtime rt;
   PipelineKernels kernels(rt);
   const double dist[][2] = {{-0.12, 0.03}, {0.2, 0.05}, {0.0, 0.0}};
-  const int sizes[][2] = {{643, 479}, {97, 61}, {20, 13}};
+  const int sizes[][2] = {{643, 479}, {97, 61}, {20, 13}, {1, 1}};
   Extrinsics e;
   e.z = 0.3;
   e.pitch = 0.2;
@@ -173,9 +172,10 @@ TEST(PipelineKernels, UndistortRollingMatchesReference) {
         const UndistortMap map = compute_undistort_map(cam);
         // Fast enough to shift the last row by tens of pixels at 643 px.
         const RowWarp warp = rolling_shutter_warp(cam, e, moving ? Eigen::Vector3d(1.5, -0.3, 1.2) : Eigen::Vector3d::Zero());
-        ASSERT_EQ(warp.identity(), !moving) << what;
-        // Smooth random texture (a few grey levels per pixel), so that a sample's difference
-        // measures its coordinate's.
+        if (s[0] > 1) {
+          ASSERT_EQ(warp.identity(), !moving) << what;
+        }
+        // Smooth random texture, so that a sample's difference measures its coordinate's.
         cv::Mat noise(s[1], s[0], CV_32FC1), gray;
         cv::RNG(seed++).fill(noise, cv::RNG::UNIFORM, 0.0, 255.0);
         cv::GaussianBlur(noise, noise, cv::Size(0, 0), 2.0);
@@ -195,9 +195,9 @@ TEST(PipelineKernels, UndistortRollingMatchesReference) {
                                 static_cast<float>(r.y + r.height - 1)}};
         const cl::Buffer frame = upload(rt, bytes.data, bytes.total()),
                          mapb = upload(rt, xy.data(), xy.size() * sizeof(float)),
-                         rows = upload(rt, warp.h.data(), warp.h.size() * sizeof(float));
+                         grid = upload(rt, warp.delta.data(), warp.delta.size() * sizeof(float));
         const cl::Buffer dst = poisoned(rt, n);
-        kernels.undistort_rolling(frame, mapb, rows, s[0], s[1], roi, dst);
+        kernels.undistort_rolling(frame, mapb, grid, warp, roi, dst);
         const std::vector<float> k = download(rt, dst, n);
         const cv::Mat ref = undistort_rolling_reference(gray, cam, map, warp);
         if (!moving) {
@@ -215,7 +215,7 @@ TEST(PipelineKernels, UndistortRollingMatchesReference) {
           else if (want != kInvalidIntensity) {
             ++valid;
             worst = std::max(worst, std::abs(static_cast<double>(got) - want));
-            off += !(std::abs(static_cast<double>(got) - want) <= 0.05);
+            off += !(std::abs(static_cast<double>(got) - want) <= 0.01);
           }
         }
         for (size_t i = n; i < k.size(); ++i) overrun += k[i] != kPoison;
@@ -223,7 +223,9 @@ TEST(PipelineKernels, UndistortRollingMatchesReference) {
         EXPECT_EQ(overrun, 0u) << what;
         EXPECT_LE(validity, n / 10000) << what;
         EXPECT_EQ(off, 0u) << what << ": worst difference " << worst;
-        EXPECT_GT(valid, n / 3) << what;
+        if (n > 100) {
+          EXPECT_GT(valid, n / 3) << what;
+        }
       }
 }
 

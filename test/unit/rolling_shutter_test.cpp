@@ -5,6 +5,7 @@
 // rounding and bilinear resampling; undistorted without it, it is sheared by tens of pixels.
 // Then the ImagePipeline's plumbing: the row warp set before process(), again before reprocess(),
 // and the kept frame's own warp, against undistort_rolling_reference.
+#include <algorithm>
 #include <cmath>
 #include <string>
 #include <vector>
@@ -13,6 +14,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "core/error.h"
+#include "core/se2.h"
 #include "image/pipeline.h"
 #include "image/rolling_shutter.h"
 #include "ocl/runtime.h"
@@ -96,6 +98,54 @@ TEST(RollingShutter, UndistortedFrameIsTheGlobalShuttersAtTheStamp) {
   }
 }
 
+// The grid's interpolated displacement against the per-pixel solution (rolling_shutter_source),
+// and that solution against its own definition: the sensor row it lands on is the row whose
+// pose sees the pixel there (distort(H_r p) with H_r computed afresh from that row's time).
+TEST(RollingShutter, GridMatchesThePerPixelSolution) {
+  CameraModel cam = sim::default_camera(640, 480);
+  cam.rolling_shutter_readout = 0.03;
+  const UndistortMap map = compute_undistort_map(cam);
+  for (int config = 1; config <= 3; ++config) {
+    const Extrinsics e = sim::paper_configuration(config);
+    const Eigen::Vector3d twist(1.5, 0.2, 1.2);
+    const RowWarp warp = rolling_shutter_warp(cam, e, twist);
+    cv::RNG rng(config);
+    double worst = 0.0, worst_fixed = 0.0, largest = 0.0;
+    Eigen::Vector2d worst_at(0, 0);
+    for (int k = 0; k < 400; ++k) {
+      const int u = rng.uniform(0, cam.width), v = rng.uniform(0, cam.height);
+      const Eigen::Vector2d exact = rolling_shutter_source(cam, e, twist, u, v);
+      // Where the frame has a source (elsewhere the solution's row is clamped to the sensor).
+      if (!(exact.x() >= 0 && exact.x() <= cam.width - 1 && exact.y() >= 0 && exact.y() <= cam.height - 1)) continue;
+      // The grid, interpolated as the reference does (in double here).
+      const double gx = static_cast<double>(u) / warp.step, gy = static_cast<double>(v) / warp.step;
+      const int i = std::min(static_cast<int>(gx), warp.nodes_x - 2), j = std::min(static_cast<int>(gy), warp.nodes_y - 2);
+      const double ax = gx - i, ay = gy - j;
+      Eigen::Vector2d d;
+      for (int c = 0; c < 2; ++c) {
+        auto g = [&](int a, int b) { return warp.delta[2 * (static_cast<size_t>(b) * warp.nodes_x + a) + c]; };
+        d[c] = (1 - ay) * ((1 - ax) * g(i, j) + ax * g(i + 1, j)) + ay * ((1 - ax) * g(i, j + 1) + ax * g(i + 1, j + 1));
+      }
+      const size_t p = static_cast<size_t>(v) * cam.width + u;
+      const Eigen::Vector2d grid(map.map_x[p] + d.x(), map.map_y[p] + d.y());
+      if ((grid - exact).norm() > worst) worst_at = Eigen::Vector2d(u, v);
+      worst = std::max(worst, (grid - exact).norm());
+      largest = std::max(largest, (exact - Eigen::Vector2d(map.map_x[p], map.map_y[p])).norm());
+      // The fixed point: the row's own pose, from scratch.
+      const double tau = std::clamp(exact.y(), 0.0, cam.height - 1.0) / (cam.height - 1) * cam.rolling_shutter_readout;
+      Eigen::Matrix3d H = ground_homography(cam.K(), e, SE2::exp(tau * twist).matrix3d());
+      const Eigen::Vector3d q = H * Eigen::Vector3d(u, v, 1.0);
+      const Eigen::Vector2d dn = cam.distort(Eigen::Vector2d((q.x() / q.z() - cam.cx) / cam.fx, (q.y() / q.z() - cam.cy) / cam.fy));
+      worst_fixed = std::max(worst_fixed, (Eigen::Vector2d(cam.fx * dn.x() + cam.cx, cam.fy * dn.y() + cam.cy) - exact).norm());
+    }
+    EXPECT_GT(largest, 20.0) << "configuration " << config << ": the test wants a real shear";
+    // The grid's interpolation (rolling_shutter.h): the field's curvature over 16 px.
+    EXPECT_LT(worst, 0.06) << "configuration " << config << " worst at " << worst_at.transpose();
+    // 65 row homographies interpolated linearly, and the fixed point to 1e-5 rows.
+    EXPECT_LT(worst_fixed, 5e-3) << "configuration " << config;
+  }
+}
+
 TEST(RollingShutter, PipelineUsesEachFramesRowWarp) {
   ocl::Runtime rt;
   CameraModel cam = sim::default_camera(160, 120);
@@ -145,10 +195,10 @@ TEST(RollingShutter, PipelineUsesEachFramesRowWarp) {
   pipeline.set_kept_row_warp(wb);
   pipeline.reprocess_kept(out);
   expect_matches(level0(out), undistort_rolling_reference(a, cam, map, wb), "the kept frame with a new warp");
-  pipeline.set_row_warp(identity_row_warp(cam.height));
+  pipeline.set_row_warp(identity_row_warp(cam.width, cam.height));
   pipeline.reprocess(out);
   expect_matches(level0(out), undistort_reference(b, map), "the identity is the plain undistortion");
-  EXPECT_THROW(pipeline.set_row_warp(identity_row_warp(cam.height + 1)), Error);
+  EXPECT_THROW(pipeline.set_row_warp(identity_row_warp(cam.width, cam.height + 1)), Error);
 }
 
 }  // namespace

@@ -120,6 +120,12 @@ PLANARVO_API planarvo_status planarvo_dataset_set_roi(planarvo_dataset* dataset,
   return fn ? fn(dataset, roi) : PLANARVO_ERROR_INTERNAL;
 }
 
+PLANARVO_API planarvo_status planarvo_dataset_set_readout(planarvo_dataset* dataset, double seconds,
+                                                          const char* source) {
+  PLANARVO_FORWARD(planarvo_dataset_set_readout);
+  return fn ? fn(dataset, seconds, source) : PLANARVO_ERROR_INTERNAL;
+}
+
 PLANARVO_API planarvo_status planarvo_dataset_frame_data(const planarvo_dataset* dataset, int64_t index, planarvo_frame_data* data) {
   PLANARVO_FORWARD(planarvo_dataset_frame_data);
   return fn ? fn(dataset, index, data) : PLANARVO_ERROR_INTERNAL;

@@ -1,0 +1,33 @@
+#include "track/readout_twist.h"
+
+namespace planarvo::track {
+
+Eigen::Vector3d ReadoutTwist::extrapolate(double at, const Eigen::Vector3d* c, double tc) const {
+  // The newest two of (c_[1], c_[0], c).
+  const Eigen::Vector3d* b = c ? c : (n_ >= 1 ? &c_[0] : nullptr);
+  const double tb = c ? tc : t_[0];
+  const Eigen::Vector3d* a = c ? (n_ >= 1 ? &c_[0] : nullptr) : (n_ >= 2 ? &c_[1] : nullptr);
+  const double ta = c ? t_[0] : t_[1];
+  if (!b) return Eigen::Vector3d::Zero();
+  if (!a || !(tb - ta > 1e-6)) return *b;
+  return *b + (*b - *a) * ((at - tb) / (tb - ta));
+}
+
+Eigen::Vector3d ReadoutTwist::predict(double t) const { return extrapolate(t + 0.5 * readout_, nullptr, 0.0); }
+
+Eigen::Vector3d ReadoutTwist::measure(double t, double dt, const Eigen::Vector3d& v, const Eigen::Vector3d& own,
+                                      const Eigen::Vector3d& before, Eigen::Vector3d* c) const {
+  const double k = readout_ / (2.0 * dt);
+  *c = v + k * (own - before);
+  return extrapolate(t + 0.5 * readout_, c, t - 0.5 * dt + 0.5 * readout_);
+}
+
+void ReadoutTwist::commit(double t, double dt, const Eigen::Vector3d& c) {
+  c_[1] = c_[0];
+  t_[1] = t_[0];
+  c_[0] = c;
+  t_[0] = t - 0.5 * dt + 0.5 * readout_;
+  if (n_ < 2) ++n_;
+}
+
+}  // namespace planarvo::track
