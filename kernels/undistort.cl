@@ -136,41 +136,65 @@ void photometric_learn(__global const float* raw, __global float* stats, const f
 // inside the region of interest, PV_INVALID otherwise.
 //
 //   src      the 8-bit frame (as `undistort`'s)
-//   map      per output pixel its source coordinate (x, y) under a global shutter
+//   map      per output pixel its source coordinate (x, y) under a global shutter, then 8
+//            pairs of padding
 //   grid     nodes_x x nodes_y displacements (dx, dy), row-major
 //   inv_step 1 / the grid's step
 //   roi      (min x, min y, max x, max y) of the source coordinates that may be sampled
 //   dst      width x height floats
-// Each work-item makes 8 consecutive pixels of a row (the launch shape of `undistort`).
+// Each work-item makes 8 consecutive pixels of a row with float8 arithmetic (as `undistort`).
 __kernel __attribute__((reqd_work_group_size(UNDISTORT_WG_X, UNDISTORT_WG_Y, 1)))
-void undistort_rolling(__global const uchar* src, __global const float2* map, __global const float2* grid,
+void undistort_rolling(__global const uchar* src, __global const float* map, __global const float2* grid,
                        const int nodes_x, const int nodes_y, const float inv_step, const int width,
                        const int height, const float4 roi, __global float* dst) {
   const int x = (int)get_global_id(0) * 8;
   const int y = (int)get_global_id(1);
   if (x >= width || y >= height) return;
-  const int end = min(x + 8, width);
   const float gy = (float)y * inv_step;
   const int j = min((int)gy, nodes_y - 2);
   const float ay = gy - (float)j;
-  for (int u = x; u < end; ++u) {
-    const int p = y * width + u;
-    const float gx = (float)u * inv_step;
-    const int i = min((int)gx, nodes_x - 2);
-    const float ax = gx - (float)i;
-    const int n00 = j * nodes_x + i, n10 = n00 + nodes_x;
-    const float2 top = grid[n00] + ax * (grid[n00 + 1] - grid[n00]);
-    const float2 bottom = grid[n10] + ax * (grid[n10 + 1] - grid[n10]);
-    const float2 s = map[p] + (top + ay * (bottom - top));
-    if (!(s.x >= roi.x && s.x <= roi.z && s.y >= roi.y && s.y <= roi.w)) {
-      dst[p] = PV_INVALID;
-      continue;
-    }
-    const int x0 = (int)s.x, y0 = (int)s.y;
-    const int x1 = min(x0 + 1, width - 1), y1 = min(y0 + 1, height - 1);
-    const float bx = s.x - (float)x0, by = s.y - (float)y0;
-    const float t = (1.0f - bx) * (float)src[y0 * width + x0] + bx * (float)src[y0 * width + x1];
-    const float b = (1.0f - bx) * (float)src[y1 * width + x0] + bx * (float)src[y1 * width + x1];
-    dst[p] = (1.0f - by) * t + by * b;
+  // The eight pixels' grid cells and weights (lanes past the row's end are computed, not stored).
+  const float8 gx = convert_float8((int8)(x) + (int8)(0, 1, 2, 3, 4, 5, 6, 7)) * inv_step;
+  const int8 i = min(convert_int8(gx), (int8)(nodes_x - 2));
+  const float8 ax = gx - convert_float8(i);
+  const int8 n00 = (int8)(j * nodes_x) + i;
+  float8 g00x, g00y, g01x, g01y, g10x, g10y, g11x, g11y;
+#define UR_GRID(k)                                                                   \
+  {                                                                                  \
+    const float2 a = grid[n00.s##k], b = grid[n00.s##k + 1];                          \
+    const float2 c = grid[n00.s##k + nodes_x], d = grid[n00.s##k + nodes_x + 1];      \
+    g00x.s##k = a.x; g00y.s##k = a.y; g01x.s##k = b.x; g01y.s##k = b.y;               \
+    g10x.s##k = c.x; g10y.s##k = c.y; g11x.s##k = d.x; g11y.s##k = d.y;               \
   }
+  UR_GRID(0) UR_GRID(1) UR_GRID(2) UR_GRID(3) UR_GRID(4) UR_GRID(5) UR_GRID(6) UR_GRID(7)
+#undef UR_GRID
+  const float8 tx = g00x + ax * (g01x - g00x), bx = g10x + ax * (g11x - g10x);
+  const float8 ty = g00y + ax * (g01y - g00y), by = g10y + ax * (g11y - g10y);
+  // The map's eight (x, y) pairs (the last work-item of a row may read into the next row: the
+  // map is padded by 8 pairs).
+  const float16 m = vload16(0, map + 2 * (y * width + x));
+  const float8 sx = m.even + (tx + ay * (bx - tx));
+  const float8 sy = m.odd + (ty + ay * (by - ty));
+  const int8 valid = (sx >= (float8)(roi.x)) & (sx <= (float8)(roi.z)) & (sy >= (float8)(roi.y)) & (sy <= (float8)(roi.w));
+  // Invalid lanes sample pixel (0, 0), and are then overwritten.
+  const int8 x0 = select((int8)(0), convert_int8(sx), valid), y0 = select((int8)(0), convert_int8(sy), valid);
+  const int8 x1 = min(x0 + 1, (int8)(width - 1)), y1 = min(y0 + 1, (int8)(height - 1));
+  const float8 fx = select((float8)(0.0f), sx - convert_float8(x0), valid);
+  const float8 fy = select((float8)(0.0f), sy - convert_float8(y0), valid);
+  const int8 r0 = y0 * width, r1 = y1 * width;
+  float8 p00, p01, p10, p11;
+#define UR_GATHER(k)                       \
+  p00.s##k = src[r0.s##k + x0.s##k];       \
+  p01.s##k = src[r0.s##k + x1.s##k];       \
+  p10.s##k = src[r1.s##k + x0.s##k];       \
+  p11.s##k = src[r1.s##k + x1.s##k];
+  UR_GATHER(0) UR_GATHER(1) UR_GATHER(2) UR_GATHER(3) UR_GATHER(4) UR_GATHER(5) UR_GATHER(6) UR_GATHER(7)
+#undef UR_GATHER
+  const float8 top = (1.0f - fx) * p00 + fx * p01;
+  const float8 bottom = (1.0f - fx) * p10 + fx * p11;
+  const float8 value = select((float8)(PV_INVALID), (1.0f - fy) * top + fy * bottom, valid);
+  if (x + 8 <= width)
+    vstore8(value, 0, dst + y * width + x);
+  else
+    pv_store_head(value, dst + y * width + x, width - x);
 }

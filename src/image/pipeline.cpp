@@ -344,7 +344,8 @@ struct ImagePipeline::Impl {
     if (r.identity) return;
     cl::Context& ctx = rt.context();
     if (!map_xy()) {
-      std::vector<float> xy(2 * map.map_x.size());
+      // Padded by 8 pairs outside any image (the last work-item of the last row reads them).
+      std::vector<float> xy(2 * (map.map_x.size() + 8), -1e6f);
       for (size_t i = 0; i < map.map_x.size(); ++i) {
         xy[2 * i] = map.map_x[i];
         xy[2 * i + 1] = map.map_y[i];

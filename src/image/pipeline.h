@@ -139,7 +139,8 @@ class PipelineKernels {
   void undistort(const cl::Buffer& frame, const cl::Buffer& index, const cl::Buffer& weights,
                  int width, int height, const cl::Buffer& dst);
   // The rolling-shutter undistortion (rolling_shutter.h): frame as undistort's; map: width *
-  // height float2, the UndistortMap's (map_x, map_y) interleaved; grid: RowWarp::delta of a warp
+  // height float2, the UndistortMap's (map_x, map_y) interleaved, then 8 pairs outside any image
+  // (-1e6); grid: RowWarp::delta of a warp
   // of this size; roi: the region of interest's (min x, min y, max x, max y).
   void undistort_rolling(const cl::Buffer& frame, const cl::Buffer& map, const cl::Buffer& grid,
                          const RowWarp& warp, const cl_float4& roi, const cl::Buffer& dst);

@@ -16,17 +16,18 @@ Eigen::Vector3d ReadoutTwist::extrapolate(double at, const Eigen::Vector3d* c, d
 Eigen::Vector3d ReadoutTwist::predict(double t) const { return extrapolate(t + 0.5 * readout_, nullptr, 0.0); }
 
 Eigen::Vector3d ReadoutTwist::measure(double t, double dt, const Eigen::Vector3d& v, const Eigen::Vector3d& own,
-                                      const Eigen::Vector3d& before, Eigen::Vector3d* c) const {
+                                      Eigen::Vector3d* c, double* tc) const {
   const double k = readout_ / (2.0 * dt);
-  *c = v + k * (own - before);
-  return extrapolate(t + 0.5 * readout_, c, t - 0.5 * dt + 0.5 * readout_);
+  *c = (v + k * own) / (1.0 + k);
+  *tc = ((t - 0.5 * dt) + k * (t + 0.5 * readout_)) / (1.0 + k);
+  return extrapolate(t + 0.5 * readout_, c, *tc);
 }
 
-void ReadoutTwist::commit(double t, double dt, const Eigen::Vector3d& c) {
+void ReadoutTwist::commit(const Eigen::Vector3d& c, double tc) {
   c_[1] = c_[0];
   t_[1] = t_[0];
   c_[0] = c;
-  t_[0] = t - 0.5 * dt + 0.5 * readout_;
+  t_[0] = tc;
   if (n_ < 2) ++n_;
 }
 

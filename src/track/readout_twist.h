@@ -1,19 +1,20 @@
 // The robot's twist over a rolling-shutter frame's readout, for undistorting the frame
 // (image/rolling_shutter.h), from the tracker's motions.
 //
-// The motion the tracker measures between two frames depends on the twists they were undistorted
-// with: a frame undistorted with a twist off by e is offset, on average over its rows, by about
-// e times half the readout (the alignment fits the mean of its rows' offsets), so the velocity
-// measured over the interval dt is
-//     v = v_true - k ((tw_k - xi_k) - (tw_{k-1} - xi_{k-1})),      k = readout / (2 dt),
-// tw the twists used, xi the true ones. Feeding v back as the next twist is a loop with gain -k
-// (-0.38 at a 25 ms readout and 30 Hz) that oscillates, and diverges once the twist is also
-// extrapolated. Instead the twists' part is taken out:
-//     c = v + k (tw_k - tw_{k-1}) = v_true + k (xi_k - xi_{k-1}),
-// which does not depend on the twists used; under smooth motion it is the velocity at
-// t_k - dt / 2 + readout / 2 (the interval's middle moved by k dt). The frame's twist, the
-// velocity at the middle of its readout (t_k + readout / 2), is c extrapolated linearly from the
-// previous frame's c. Constant velocity within a frame, as the model of rolling_shutter.h.
+// The pose the tracker measures for a frame depends on the twist it was undistorted with: a frame
+// undistorted with a twist tw where the robot's was xi looks, on average over its rows, like the
+// global shutter's image at pose P exp(-(readout / 2)(tw - xi)) (the alignment fits the mean of its
+// rows' offsets). The tracker takes that mean offset out of each frame's pose (so motions between
+// corrected poses are right to first order) and refines the twist:
+// measured from a corrected previous pose over the interval dt, the velocity is
+//     v = v_true - k (tw - xi),      k = readout / (2 dt),
+// so c = (v + k tw) / (1 + k) = (v_true + k xi) / (1 + k) does not depend on the twist used; under
+// smooth motion it is the velocity at t_c = ((t - dt / 2) + k (t + readout / 2)) / (1 + k), a
+// weighted mean of the interval's middle and the readout's. The frame's twist, the velocity at the
+// middle of its readout (t + readout / 2), is c extrapolated linearly from the previous frame's c.
+// (Feeding v back as the next twist instead is a loop with gain -k, -0.38 at a 25 ms readout and
+// 30 Hz, that oscillates, and diverges once the twist is also extrapolated.) Constant velocity
+// within a frame, as the model of rolling_shutter.h.
 #pragma once
 #include <Eigen/Core>
 
@@ -23,23 +24,25 @@ class ReadoutTwist {
  public:
   explicit ReadoutTwist(double readout) : readout_(readout) {}
 
+  double readout() const { return readout_; }
+
   // Nothing measured (the first frame, after a gap or a reset): the twist is zero.
   void reset() { n_ = 0; }
 
   // The twist for a frame stamped t, before it is aligned: the measured c's extrapolated.
   Eigen::Vector3d predict(double t) const;
 
-  // The twist of a frame stamped t from its measured velocity v over the interval dt before it,
-  // the twist it was undistorted with (own) and the one the frame it was measured from was
-  // (before). *c gets the frame's c, for commit().
+  // The twist of a frame stamped t from its velocity v measured over the interval dt before it
+  // (from the previous frame's corrected pose) and the twist it was undistorted with (own). *c
+  // and *tc get the frame's c and its time, for commit().
   Eigen::Vector3d measure(double t, double dt, const Eigen::Vector3d& v, const Eigen::Vector3d& own,
-                          const Eigen::Vector3d& before, Eigen::Vector3d* c) const;
+                          Eigen::Vector3d* c, double* tc) const;
 
   // The frame's c (from measure()) enters the model.
-  void commit(double t, double dt, const Eigen::Vector3d& c);
+  void commit(const Eigen::Vector3d& c, double tc);
 
  private:
-  // The velocity at time `at` from the last two c's (and an extra one, when given).
+  // The velocity at time `at` from the last two c's (or the last and an extra one, when given).
   Eigen::Vector3d extrapolate(double at, const Eigen::Vector3d* c, double tc) const;
 
   double readout_;

@@ -131,12 +131,13 @@ struct Tracker::Impl {
   // the previous frame is the keyframe, lost_covariance() after a Lost frame).
   Eigen::Matrix3d prev_covariance = Eigen::Matrix3d::Zero();
   Eigen::Vector3d velocity = Eigen::Vector3d::Zero();  // se(2) per second
-  // The rolling shutter: the twist over the readout (readout_twist.h), the twist the previous
-  // frame (prev) was undistorted with, and the live frame's c.
+  // The rolling shutter: the twist over the readout (readout_twist.h), the live frame's c (and its
+  // time) and the mean offset its remaining twist error puts in its pose.
   ReadoutTwist readout_twist{0.0};
-  Eigen::Vector3d prev_twist = Eigen::Vector3d::Zero();
   Eigen::Vector3d live_c = Eigen::Vector3d::Zero();
+  double live_tc = 0.0;
   bool has_live_c = false;
+  Eigen::Vector3d live_offset = Eigen::Vector3d::Zero();
   double last_t = 0.0, nominal_dt = 0.0, since_good = 0.0;
   bool has_t = false;
   std::array<double, kMaxLevels> sigma{};  // the robust scale per level, from frame to frame
@@ -189,7 +190,7 @@ struct Tracker::Impl {
     prev_covariance.setZero();
     velocity.setZero();
     readout_twist.reset();
-    prev_twist = live_twist = Eigen::Vector3d::Zero();
+    live_twist = live_offset = Eigen::Vector3d::Zero();
     has_t = false;
     nominal_dt = 0.0;
     since_good = 0.0;
@@ -383,7 +384,7 @@ struct Tracker::Impl {
         pipeline->reprocess(keyframe);
       }
       // Its frame stays on the device, so that a model made at a later frame can correct the
-      // keyframe again (correct_again), or a measured twist undistort it again (unroll_again).
+      // keyframe again (correct_again), or a measured twist undistort it again (take_out_shutter).
       if (photometric || rolling()) {
         pipeline->keep();
         keyframe_kept = true;
@@ -425,18 +426,24 @@ struct Tracker::Impl {
     return max_pixel_displacement(camera.K(), ext, SE2::exp(a * r), SE2::exp(b * r), camera.width, camera.height);
   }
 
-  // The live frame (in the pipeline) undistorted again with the twist its alignment measured,
-  // and the keyframe too when its twist was not measured, then aligned once more; twice at most,
-  // while the twist moves the image by more than the tolerance. dt: the frame interval.
-  void unroll_again(const Pyramid& live, double t, double dt, FrameResult* res, Estimate* est) {
-    if (!rolling() || !(dt > 0.0) || &live != &slots[live_slot] || !keyframe_kept) return;
+  // The rolling shutter's part of the live frame's alignment (readout_twist.h): the frame's
+  // twist from its alignment; when that moves the image by more than the tolerance from the twist
+  // the frame was undistorted with (or the keyframe's twist was not measured), the frame (and the
+  // keyframe) undistorted again with it and aligned once more, twice at most. Returns the mean
+  // offset the remaining twist error puts in the pose, to be taken out of est (after remember()).
+  SE2 take_out_shutter(const Pyramid& live, double t, double dt, FrameResult* res, Estimate* est) {
+    live_offset.setZero();
+    if (!rolling() || !(dt > 0.0) || &live != &slots[live_slot] || !keyframe_kept) return SE2();
     for (int round = 0;; ++round) {
       const Eigen::Vector3d v = (prev.T.inverse() * est->T).log() / dt;
-      const Eigen::Vector3d twist = readout_twist.measure(t, dt, v, live_twist, prev_twist, &live_c);
+      const Eigen::Vector3d twist = readout_twist.measure(t, dt, v, live_twist, &live_c, &live_tc);
       has_live_c = twist.allFinite();
-      if (!has_live_c || round == 2) return;
+      if (!has_live_c) return SE2();
       const bool keyframe_too = !keyframe_twist_measured;
-      if (!keyframe_too && shutter_shift(live_twist, twist) <= opt.rolling_shutter_tolerance_px) return;
+      if (round == 2 || (!keyframe_too && shutter_shift(live_twist, twist) <= opt.rolling_shutter_tolerance_px)) {
+        live_offset = 0.5 * camera.rolling_shutter_readout * (live_twist - twist);
+        return SE2::exp(live_offset);
+      }
       if (keyframe_too) {
         // The keyframe was the previous frame (the first, or one after a Lost frame): this
         // frame's twist is the best measure of its own.
@@ -444,14 +451,13 @@ struct Tracker::Impl {
         pipeline->reprocess_kept(keyframe);
         select_keyframe_pixels();
         keyframe_twist_measured = true;
-        prev_twist = twist;
       }
       live_twist = twist;
       pipeline->set_row_warp(rolling_shutter_warp(camera, ext, twist));
       pipeline->reprocess(slots[live_slot]);
       FrameResult again;
       Estimate e;
-      if (!align_again(live, *est, *res, &again, &e, true)) return;
+      if (!align_again(live, *est, *res, &again, &e, true)) return SE2();
       *res = again;
       *est = e;
     }
@@ -640,7 +646,6 @@ struct Tracker::Impl {
       if (can_be_keyframe) {
         make_keyframe(live);
         keyframe_twist_measured = false;
-        prev_twist = live_twist;
         res.keyframe = true;
       } else {
         // The next motion is from this predicted pose: as uncertain as this one.
@@ -674,7 +679,6 @@ struct Tracker::Impl {
       }
       make_keyframe(live);
       keyframe_twist_measured = false;
-      prev_twist = live_twist;
       res.status = Status::First;
       res.keyframe = true;
       since_good = 0.0;
@@ -708,9 +712,10 @@ struct Tracker::Impl {
         est = est3;
       }
     }
-    if (ok && res.status != Status::Lost) unroll_again(live, t, dt, &res, &est);
+    const SE2 shutter_offset = ok && res.status != Status::Lost ? take_out_shutter(live, t, dt, &res, &est) : SE2();
     if (ok) remember(live, est);  // before a new keyframe replaces the one aligned with
     else missing = reason;
+    est.T = est.T * shutter_offset;
     if (!ok) return lost(reason, reason != kAlignNoLiveTexture);
     if (res.status == Status::Lost) return lost(res.reason, true);
     if (time_problem && res.status == Status::Ok) {
@@ -727,12 +732,13 @@ struct Tracker::Impl {
     if (!res.motion.covariance.allFinite()) res.motion.covariance = lost_covariance();
     pose = pose * res.motion.value;
     if (dt > 0.0) velocity = res.motion.value.log() / dt;
-    if (has_live_c) readout_twist.commit(last_t, dt, live_c);
-    prev_twist = live_twist;
+    if (has_live_c) readout_twist.commit(live_c, live_tc);
     since_good = 0.0;
     if (res.overlap < opt.keyframe_overlap || scale_change(est.T) > opt.keyframe_scale_change) {
       make_keyframe(live);
       keyframe_twist_measured = true;
+      // Frames aligned with it carry its own shutter offset, which the motions from it must not.
+      prev.T = SE2::exp(live_offset);
       res.keyframe = true;
     } else {
       prev = est;

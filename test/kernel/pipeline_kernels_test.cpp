@@ -185,7 +185,7 @@ TEST(PipelineKernels, UndistortRollingMatchesReference) {
         cv::Mat bytes(1, static_cast<int>(PipelineKernels::frame_buffer_size(s[0], s[1])), CV_8UC1);
         cv::RNG(seed++).fill(bytes, cv::RNG::UNIFORM, 0, 256);
         std::copy(gray.datastart, gray.dataend, bytes.data);
-        std::vector<float> xy(2 * n);
+        std::vector<float> xy(2 * (n + 8), -1e6f);
         for (size_t i = 0; i < n; ++i) {
           xy[2 * i] = map.map_x[i];
           xy[2 * i + 1] = map.map_y[i];
