@@ -65,6 +65,12 @@ struct RollPitchEstimator::Impl {
 
   Pyramid spare;
   std::vector<Pyramid> keyframes;
+  // A rolling shutter: each keyframe's camera frame and stamp, to undistort it again once the
+  // joint alignment has measured the motion (unroll_keyframes).
+  std::vector<cv::Mat> keyframe_gray;
+  std::vector<double> keyframe_t;
+  cv::Mat current;  // the frame being added (not a copy)
+  double current_t = 0.0;
   std::vector<SE2> motions;  // between consecutive keyframes, from the tracker
   std::vector<int> keyframe_frames;
   SE2 since_keyframe;
@@ -114,6 +120,8 @@ struct RollPitchEstimator::Impl {
       return finish_frame(t0);
     }
     pipeline.process(gray, width, height, stride, spare);
+    current = cv::Mat(height, width, CV_8UC1, const_cast<uint8_t*>(gray), stride);
+    current_t = t;
     const FrameResult r = tracker.track(spare, t);
     if (r.status == FrameResult::Status::First) {
       start_map();
@@ -131,6 +139,7 @@ struct RollPitchEstimator::Impl {
     if (r.keyframe) {
       keyframes.push_back(std::move(spare));
       keyframe_frames.push_back(frames - 1);
+      keep_current();
       spare = Pyramid();
       motions.push_back(since_keyframe);
       since_keyframe = SE2();
@@ -154,11 +163,21 @@ struct RollPitchEstimator::Impl {
     keyframes.clear();
     motions.clear();
     keyframe_frames.clear();
+    keyframe_gray.clear();
+    keyframe_t.clear();
     keyframes.push_back(std::move(spare));
     keyframe_frames.push_back(frames - 1);
+    keep_current();
     spare = Pyramid();
     since_keyframe = SE2();
   }
+
+  void keep_current() {
+    if (!(camera.rolling_shutter_readout > 0.0)) return;
+    keyframe_gray.push_back(current.clone());
+    keyframe_t.push_back(current_t);
+  }
+
 
   bool finish_frame(Clock::time_point t0) {
     if (static_cast<int>(keyframes.size()) >= opt.max_keyframes) done = true;
@@ -219,6 +238,37 @@ struct RollPitchEstimator::Impl {
     run->dropped += static_cast<int>(run->pairs.size() - kept.size());
     run->pairs = std::move(kept);
     rounds(run, levels, opt.max_rounds);
+  }
+
+  // A rolling shutter: the keyframes were undistorted as a global shutter's (the tracker here runs
+  // at the initial orientation, whose motions are too rough for the row warp); with the joint
+  // alignment's orientation and keyframe-to-keyframe motions, each keyframe is undistorted again
+  // with the robot's twist at its readout's middle (the pairs' velocities, at the middles of their
+  // intervals, interpolated linearly and extrapolated at the ends), for the alignment to run again.
+  // False when there is nothing to do.
+  bool unroll_keyframes(const Run& run) {
+    const size_t K = keyframes.size();
+    if (!(camera.rolling_shutter_readout > 0.0) || keyframe_gray.size() != K || K < 2) return false;
+    std::vector<double> tv;
+    std::vector<Eigen::Vector3d> v;
+    for (const AlignmentPair& p : run.pairs) {
+      const size_t a = static_cast<size_t>(p.reference - keyframes.data()), b = static_cast<size_t>(p.live - keyframes.data());
+      if (a >= K || b >= K || !(keyframe_t[b] > keyframe_t[a])) continue;
+      tv.push_back(0.5 * (keyframe_t[a] + keyframe_t[b]));
+      v.push_back(p.motion.log() / (keyframe_t[b] - keyframe_t[a]));
+    }
+    if (v.empty()) return false;
+    for (size_t k = 0; k < K; ++k) {
+      const double at = keyframe_t[k] + 0.5 * camera.rolling_shutter_readout;
+      size_t i = 0;
+      while (i + 2 < v.size() && tv[i + 1] < at) ++i;
+      Eigen::Vector3d twist = v[i];
+      if (v.size() > 1 && tv[i + 1] > tv[i]) twist = v[i] + (v[i + 1] - v[i]) * ((at - tv[i]) / (tv[i + 1] - tv[i]));
+      pipeline.set_row_warp(rolling_shutter_warp(camera, run.ext, twist));
+      pipeline.process(keyframe_gray[k], keyframes[k]);
+    }
+    pipeline.set_row_warp(identity_row_warp(camera.width, camera.height));
+    return true;
   }
 
   Run start(double roll, double pitch) {
@@ -286,6 +336,13 @@ struct RollPitchEstimator::Impl {
         res.passes += found.passes;
         if (found.report.ok && (!best.report.ok || found.ratio < best.ratio)) best = std::move(found);
       }
+    }
+    // A rolling shutter: twice, the keyframes undistorted again with the motion just measured and
+    // the alignment run again from where it stopped.
+    for (int again = 0; again < 2 && best.report.ok && unroll_keyframes(best); ++again) {
+      rounds(&best, levels, opt.max_rounds);
+      res.rounds += best.rounds;
+      res.passes += best.passes;
     }
     res.align_ms = ms_since(t0);
     if (!best.report.ok) {
