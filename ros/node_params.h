@@ -25,6 +25,10 @@ struct NodeParams {
   // tracker's options point at it only where the tracker is made (tracker.flat_field stays NULL
   // here, so that a copy of NodeParams holds no pointer into another).
   std::string flat_field;
+  // ~readout_time: the camera's rolling-shutter readout in seconds (first row's read to the
+  // last's), overriding the camera's (~camera's rolling_shutter_readout; camera_info has none, so
+  // 0); -1 = the camera's.
+  double readout_time = -1;
   int queue_size = 100;    // ~queue_size: the image subscriber's roscpp queue
   int max_pending = 300;   // ~max_pending: frames waiting for the tracker before the oldest is dropped
   double drain_seconds = 10;  // ~drain_seconds: on shutdown, time to finish the frames still queued

@@ -174,8 +174,10 @@ class Node {
   };
 
   // The tracker and the calibrator, once the camera is known.
-  void start(const planarvo_camera& camera) {
+  void start(const planarvo_camera& given) {
     started_ = true;
+    planarvo_camera camera = given;
+    if (params_.readout_time >= 0) camera.rolling_shutter_readout = params_.readout_time;
     if (extrinsics_) create_tracker(camera, *extrinsics_);
     if (params_.calibrate) {
       std::lock_guard<std::mutex> lock(odometry_mutex_);

@@ -26,6 +26,14 @@ def test_rolling_shutter_readout_round_trip_and_simulated(context, tmp_path):
     assert planarvo.Camera.load(tmp_path / "rs" / "camera.yaml").rolling_shutter_readout == 0.02
     with pytest.raises(planarvo.Error):
         planarvo.simulate(context, tmp_path / "bad", planarvo.SimOptions(seconds=0.2, readout_time=-1.0))
+    # A data set's readout replaced for one run; refused when negative or longer than a frame.
+    ds = planarvo.Dataset(tmp_path / "rs")
+    ds.set_readout(0.01)
+    assert ds.info.camera.rolling_shutter_readout == 0.01
+    for bad in (-0.001, float("nan"), 0.5):
+        with pytest.raises(planarvo.Error):
+            ds.set_readout(bad)
+    assert ds.info.camera.rolling_shutter_readout == 0.01
 
 
 def test_extrinsics_round_trip_and_matrix(tmp_path):

@@ -59,6 +59,39 @@ TEST(CliShutter, ReadoutIsWrittenToCameraYamlAndPrintedByInfo) {
   EXPECT_THAT(r.output, ::testing::Not(HasSubstr("shutter")));
 }
 
+// track and calibrate take --readout-time for one run: a bad value is exit code 2 naming the
+// option; a camera.yaml whose readout is longer than the frame interval (a value in milliseconds)
+// is exit code 2 naming the file, for every command that opens the data set.
+TEST(CliShutter, ReadoutTimeOptionAndFileAreChecked) {
+  ScratchDir d;
+  const std::string out = (d / "ds").string();
+  ASSERT_EQ(run_cli("simulate --out " + out + kSmall + " --readout-time 0.02").exit_code, 0);
+  for (const char* cmd : {"track", "calibrate"})
+    for (const char* bad : {"-0.01", "nan", "0.2"}) {
+      SCOPED_TRACE(std::string(cmd) + " --readout-time " + bad);
+      const std::string ext = std::string(cmd) == "track" ? " --extrinsics " + out + "/extrinsics_gt.yaml" : "";
+      const auto r = run_cli(std::string(cmd) + " " + out + ext + " --quiet --readout-time " + bad);
+      EXPECT_EQ(r.exit_code, 2) << r.output;
+      EXPECT_THAT(r.output, HasSubstr("--readout-time"));
+    }
+  // Milliseconds written as seconds' number.
+  std::string camera = test::read_file(fs::path(out) / "camera.yaml");
+  const size_t at = camera.find("rolling_shutter_readout");
+  ASSERT_NE(at, std::string::npos);
+  camera = camera.substr(0, at) + "rolling_shutter_readout: 20\n";
+  {
+    std::ofstream f(fs::path(out) / "camera.yaml");
+    f << camera;
+  }
+  for (const char* cmd : {"info", "track"}) {
+    SCOPED_TRACE(cmd);
+    const auto r = run_cli(std::string(cmd) + " " + out + (std::string(cmd) == "track" ? " --extrinsics " + out + "/extrinsics_gt.yaml" : std::string()));
+    EXPECT_EQ(r.exit_code, 2) << r.output;
+    EXPECT_THAT(r.output, HasSubstr("camera.yaml"));
+    EXPECT_THAT(r.output, HasSubstr("longer than the frames' interval"));
+  }
+}
+
 TEST(CliShutter, NegativeReadoutInCameraYamlIsExitCodeTwoNamingTheFile) {
   ScratchDir d;
   const std::string out = (d / "ds").string();
