@@ -536,15 +536,22 @@ int bench_speed(int width, int height, double seconds, int rounds) {
   std::printf("device: %s\n", rt.device_info().device_name.c_str());
   const sim::Options so = Scene().options("asphalt_01.png", seconds, width, height, 1);
   const sim::Trajectory traj = sim::generate_trajectory(so);
-  const std::vector<cv::Mat> frames = bench::render_sequence(rt, so, traj);
+  const std::vector<cv::Mat> global_frames = bench::render_sequence(rt, so, traj);
+  // The same drive through a rolling shutter read out over 25 ms.
+  sim::Options rolling = so;
+  rolling.readout_time = rolling.camera.rolling_shutter_readout = 0.025;
+  const std::vector<cv::Mat> rolling_frames = bench::render_sequence(rt, rolling, traj);
   struct Config {
     const char* name;
     track::TrackerOptions opt;
+    int shutter = 0;  // 0: the global shutter's frames; 1: the rolling shutter's, told; 2: not told
   };
   std::vector<Config> configs;
   {
     track::TrackerOptions o;
     configs.push_back({"default (level 1, level 0 at 1/9)", o});
+    configs.push_back({"rolling shutter 25 ms", o, 1});
+    configs.push_back({"rolling 25 ms, not told", o, 2});
     o.photometric.enabled = false;
     configs.push_back({"default without the photometric model", o});
     o.photometric.enabled = true;
@@ -580,7 +587,8 @@ int bench_speed(int width, int height, double seconds, int rounds) {
   std::vector<Stats> stats(configs.size());
   for (int round = 0; round < rounds; ++round)
     for (size_t c = 0; c < configs.size(); ++c) {
-      track::Tracker tracker(rt, so.camera, so.extrinsics, configs[c].opt);
+      const std::vector<cv::Mat>& frames = configs[c].shutter ? rolling_frames : global_frames;
+      track::Tracker tracker(rt, configs[c].shutter == 1 ? rolling.camera : so.camera, so.extrinsics, configs[c].opt);
       for (size_t k = 0; k < frames.size(); ++k) {
         const double c0 = cpu_ms();
         const track::FrameResult r = tracker.track(frames[k].data, frames[k].cols, frames[k].rows, frames[k].step, traj.t[k]);
@@ -594,7 +602,7 @@ int bench_speed(int width, int height, double seconds, int rounds) {
       }
     }
   std::printf("%dx%d, %zu frames of asphalt_01 (mixed motion) x %d rounds, camera-frame API (upload, undistortion, "
-              "pyramid, tracking)\n", width, height, frames.size(), rounds);
+              "pyramid, tracking)\n", width, height, global_frames.size(), rounds);
   std::printf("%-26s %9s %9s %9s %9s %9s %8s %7s %7s %7s\n", "configuration", "med_frame", "mean_frame", "med_pipe",
               "med_track", "cpu/frame", "passes", "fps", "p99/md", "max/md");
   for (size_t c = 0; c < configs.size(); ++c) {
