@@ -132,7 +132,7 @@ void photometric_learn(__global const float* raw, __global float* stats, const f
 // reference: undistort_rolling_reference): the undistorted image a global shutter would have
 // taken at the frame's stamp. Per output pixel p = (u, v): the source coordinate is the map's
 // plus the rolling shutter's displacement, interpolated bilinearly from a grid of nodes every
-// `step` pixels (cells clamped to the grid); the frame is sampled there bilinearly when it lies
+// `step` pixels, 8 or more (cells clamped to the grid; between the node rows first); the frame is sampled there bilinearly when it lies
 // inside the region of interest, PV_INVALID otherwise.
 //
 //   src      the 8-bit frame (as `undistort`'s)
@@ -154,27 +154,24 @@ void undistort_rolling(__global const uchar* src, __global const float* map, __g
   const int j = min((int)gy, nodes_y - 2);
   const float ay = gy - (float)j;
   // The eight pixels' grid cells and weights (lanes past the row's end are computed, not stored).
+  // Eight pixels span at most two cells of a grid with a step of 8 or more, so the grid is read at
+  // three node columns from the first lane's, interpolated between the two rows first.
   const float8 gx = convert_float8((int8)(x) + (int8)(0, 1, 2, 3, 4, 5, 6, 7)) * inv_step;
   const int8 i = min(convert_int8(gx), (int8)(nodes_x - 2));
   const float8 ax = gx - convert_float8(i);
-  const int8 n00 = (int8)(j * nodes_x) + i;
-  float8 g00x, g00y, g01x, g01y, g10x, g10y, g11x, g11y;
-#define UR_GRID(k)                                                                   \
-  {                                                                                  \
-    const float2 a = grid[n00.s##k], b = grid[n00.s##k + 1];                          \
-    const float2 c = grid[n00.s##k + nodes_x], d = grid[n00.s##k + nodes_x + 1];      \
-    g00x.s##k = a.x; g00y.s##k = a.y; g01x.s##k = b.x; g01y.s##k = b.y;               \
-    g10x.s##k = c.x; g10y.s##k = c.y; g11x.s##k = d.x; g11y.s##k = d.y;               \
-  }
-  UR_GRID(0) UR_GRID(1) UR_GRID(2) UR_GRID(3) UR_GRID(4) UR_GRID(5) UR_GRID(6) UR_GRID(7)
-#undef UR_GRID
-  const float8 tx = g00x + ax * (g01x - g00x), bx = g10x + ax * (g11x - g10x);
-  const float8 ty = g00y + ax * (g01y - g00y), by = g10y + ax * (g11y - g10y);
+  const int i0 = i.s0, i2 = min(i0 + 2, nodes_x - 1);
+  const int g0 = j * nodes_x, g1 = g0 + nodes_x;
+  const float2 c0 = grid[g0 + i0] + ay * (grid[g1 + i0] - grid[g0 + i0]);
+  const float2 c1 = grid[g0 + i0 + 1] + ay * (grid[g1 + i0 + 1] - grid[g0 + i0 + 1]);
+  const float2 c2 = grid[g0 + i2] + ay * (grid[g1 + i2] - grid[g0 + i2]);
+  const int8 second = i > (int8)(i0);  // the lane lies in the next cell
+  const float8 lx = select((float8)(c0.x), (float8)(c1.x), second), rx = select((float8)(c1.x), (float8)(c2.x), second);
+  const float8 ly = select((float8)(c0.y), (float8)(c1.y), second), ry = select((float8)(c1.y), (float8)(c2.y), second);
   // The map's eight (x, y) pairs (the last work-item of a row may read into the next row: the
   // map is padded by 8 pairs).
   const float16 m = vload16(0, map + 2 * (y * width + x));
-  const float8 sx = m.even + (tx + ay * (bx - tx));
-  const float8 sy = m.odd + (ty + ay * (by - ty));
+  const float8 sx = m.even + (lx + ax * (rx - lx));
+  const float8 sy = m.odd + (ly + ax * (ry - ly));
   const int8 valid = (sx >= (float8)(roi.x)) & (sx <= (float8)(roi.z)) & (sy >= (float8)(roi.y)) & (sy <= (float8)(roi.w));
   // Invalid lanes sample pixel (0, 0), and are then overwritten.
   const int8 x0 = select((int8)(0), convert_int8(sx), valid), y0 = select((int8)(0), convert_int8(sy), valid);

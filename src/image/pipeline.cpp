@@ -336,6 +336,7 @@ struct ImagePipeline::Impl {
 
   void set_rows(Rows& r, const RowWarp& warp) {
     if (warp.width != camera.width || warp.height != camera.height || warp.nodes_x < 2 || warp.nodes_y < 2 ||
+        warp.step < 8 ||
         warp.delta.size() != 2 * static_cast<size_t>(warp.nodes_x) * static_cast<size_t>(warp.nodes_y))
       throw_invalid_argument("image pipeline: the row warp is for " + size_text(warp.width, warp.height) +
                              " images, the camera's are " + size_text(camera.width, camera.height));

@@ -112,8 +112,8 @@ bool RowWarp::identity() const {
 }
 
 RowWarp identity_row_warp(int width, int height, int step) {
-  if (width < 1 || height < 1 || step < 1)
-    throw_invalid_argument("identity_row_warp: the size and the step must be positive");
+  if (width < 1 || height < 1 || step < 8)
+    throw_invalid_argument("identity_row_warp: the size must be positive and the step at least 8");
   RowWarp w;
   w.width = width;
   w.height = height;
@@ -183,10 +183,10 @@ cv::Mat undistort_rolling_reference(const cv::Mat& gray, const CameraModel& came
       const size_t n00 = 2 * (static_cast<size_t>(j) * static_cast<size_t>(warp.nodes_x) + static_cast<size_t>(i));
       const size_t n10 = n00 + 2 * static_cast<size_t>(warp.nodes_x);
       float d[2];
-      for (int c = 0; c < 2; ++c) {
-        const float top = g[n00 + c] + ax * (g[n00 + 2 + c] - g[n00 + c]);
-        const float bottom = g[n10 + c] + ax * (g[n10 + 2 + c] - g[n10 + c]);
-        d[c] = top + ay * (bottom - top);
+      for (int c = 0; c < 2; ++c) {  // between the node rows first, as the kernel
+        const float left = g[n00 + c] + ay * (g[n10 + c] - g[n00 + c]);
+        const float right = g[n00 + 2 + c] + ay * (g[n10 + 2 + c] - g[n00 + 2 + c]);
+        d[c] = left + ax * (right - left);
       }
       const size_t p = static_cast<size_t>(v) * static_cast<size_t>(w) + static_cast<size_t>(u);
       const float sx = map.map_x[p] + d[0], sy = map.map_y[p] + d[1];

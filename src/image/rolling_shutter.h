@@ -41,7 +41,8 @@ inline constexpr int kRowWarpStep = 16;
 // The rolling shutter's displacement of each undistorted pixel's source coordinate, relative to
 // the global shutter's (UndistortMap), on a grid: node (i, j) at pixel (i * step, j * step),
 // i < nodes_x = (width - 1) / step + 2, j < nodes_y = (height - 1) / step + 2 (the last nodes
-// lie at or beyond the image's last pixel), (dx, dy) interleaved, row-major.
+// lie at or beyond the image's last pixel), (dx, dy) interleaved, row-major. The kernel needs
+// step >= 8 (eight pixels of a work-item span at most two cells).
 struct RowWarp {
   int width = 0, height = 0;  // the image's
   int step = kRowWarpStep;
@@ -52,7 +53,7 @@ struct RowWarp {
   bool identity() const;
 };
 
-// The identity for a width x height camera (InvalidArgument for sizes < 1 or step < 1).
+// The identity for a width x height camera (InvalidArgument for sizes < 1 or step < 8).
 RowWarp identity_row_warp(int width, int height, int step = kRowWarpStep);
 
 // The warp of `camera` (its K, distortion, size and rolling_shutter_readout) on the robot at
@@ -69,7 +70,8 @@ Eigen::Vector2d rolling_shutter_source(const CameraModel& camera, const Extrinsi
 
 // Plain C++ reference of the pipeline's rolling-shutter undistortion (kernel
 // `undistort_rolling`), in the kernel's float arithmetic: per output pixel p = (u, v), the warp's
-// displacement interpolated bilinearly at (u / step, v / step) (cells clamped to the grid) is
+// displacement interpolated bilinearly at (u / step, v / step) (cells clamped to the grid;
+// between the node rows first) is
 // added to the map's coordinate; gray is sampled there bilinearly as remap_bilinear samples (the
 // coordinate inside the camera's region of interest: x <= s.x <= x + width - 1, the same in y),
 // kInvalidIntensity (image/pipeline.h) where it is not. With the identity warp this is
