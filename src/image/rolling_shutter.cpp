@@ -93,7 +93,12 @@ Eigen::Vector2d solve_source(const CameraModel& c, const RowHomographies& H, con
   auto row = [&](const Eigen::Vector2d& s) { return std::isfinite(s.y()) ? std::clamp(s.y(), first, last) : 0.0; };
   double r = std::isfinite(start) ? std::clamp(start, first, last) : row(distorted_pixel(c, p));
   for (int it = 0; it < 8; ++it) {
-    const double r1 = row(source(r)), r2 = row(source(r1));
+    // A start this close (a neighbour's row, extrapolated) is taken as it is: the source found
+    // from it is within the contraction times 1e-4 rows of the fixed point's.
+    const Eigen::Vector2d s = source(r);
+    const double r1 = row(s);
+    if (std::abs(r1 - r) < 1e-4) return s;
+    const double r2 = row(source(r1));
     const double d1 = r1 - r, d2 = r2 - r1, den = d2 - d1;
     const double next = std::abs(d2) < 0.9 * std::abs(d1) && std::abs(den) > 1e-12 ? std::clamp(r2 - d2 * d2 / den, first, last) : r2;
     // Aitken's error is quadratic in the step's for a function this nearly linear: a step under
@@ -136,14 +141,16 @@ RowWarp rolling_shutter_warp(const CameraModel& camera, const Extrinsics& extrin
   RowWarp w = identity_row_warp(camera.width, camera.height, step);
   if (!(camera.rolling_shutter_readout > 0.0) || twist.isZero(0.0)) return w;
   const RowHomographies H(camera, extrinsics, twist);
-  // Each node starts from its left neighbour's row (the first of a row from the node above):
-  // the fixed point then converges in one Aitken step.
+  // Each node starts from its two left neighbours' rows extrapolated (the first two of a row
+  // from the node above): mostly one evaluation, else one Aitken step.
   double above = std::numeric_limits<double>::quiet_NaN();
   for (int j = 0; j < w.nodes_y; ++j) {
-    double left = above;
+    double left = above, before_left = std::numeric_limits<double>::quiet_NaN();
     for (int i = 0; i < w.nodes_x; ++i) {
       const Eigen::Vector2d p(i * step, j * step);
-      const Eigen::Vector2d s = solve_source(camera, H, p, left);
+      const double start = std::isfinite(before_left) ? 2.0 * left - before_left : left;
+      const Eigen::Vector2d s = solve_source(camera, H, p, start);
+      before_left = i > 0 ? left : std::numeric_limits<double>::quiet_NaN();
       left = s.y();
       if (i == 0) above = s.y();
       const Eigen::Vector2d d = s - distorted_pixel(camera, p);
