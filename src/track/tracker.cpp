@@ -416,7 +416,6 @@ struct Tracker::Impl {
     prev_covariance.setZero();
   }
 
-  // The keyframe's subsampled pixels per level (AlignmentLevels::select_block).
   bool rolling() const { return camera.rolling_shutter_readout > 0.0; }
 
   // How far apart two twists put the image of the last row's read: the rolling shutter's
@@ -463,6 +462,7 @@ struct Tracker::Impl {
     }
   }
 
+  // The keyframe's subsampled pixels per level (AlignmentLevels::select_block).
   void select_keyframe_pixels() {
     const AlignmentLevels levels = aligner.levels(keyframe, keyframe);
     for (int l = 0; l < keyframe.num_levels() && l < kMaxLevels; ++l) {
