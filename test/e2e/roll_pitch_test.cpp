@@ -89,7 +89,9 @@ TEST(RollPitch, ConvergesFromThirtyDegreesOffInBothAngles) {
 
 // A rolling shutter read out over 25 ms (rows rendered from the poses they are read at): told the
 // readout, the keyframes are undistorted again with the joint alignment's motion and the tilt is
-// within 0.1 degrees; taken as a global shutter, the same frames put it further off.
+// within 0.15 degrees on this short, small drive (measured 0.09; the 20-s 640x480 calibration of
+// src/track/README.md is within 0.03); taken as a global shutter, the same frames put it at least
+// twice as far off (measured 0.65).
 TEST(RollPitch, RollingShutterToldTheReadout) {
   ocl::Runtime rt;
   const Extrinsics truth = sim::default_extrinsics();
@@ -98,7 +100,9 @@ TEST(RollPitch, RollingShutterToldTheReadout) {
   d.options.camera.rolling_shutter_readout = 0.025;
   d.trajectory = sim::generate_trajectory(d.options);
   const RollPitchResult told = estimate(rt, d, RollPitchOptions());
-  expect_close(told, truth, "told the readout");
+  ASSERT_TRUE(told.ok()) << told.reason;
+  EXPECT_LT(std::abs(told.roll - truth.roll), 0.15 * kDeg);
+  EXPECT_LT(std::abs(told.pitch - truth.pitch), 0.15 * kDeg);
   Drive global = d;
   global.options.camera.rolling_shutter_readout = 0.0;  // the frames as rendered, the estimator not told
   const RollPitchResult not_told = estimate(rt, global, RollPitchOptions());
