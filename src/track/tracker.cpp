@@ -435,10 +435,22 @@ struct Tracker::Impl {
     if (!rolling() || !(dt > 0.0) || &live != &slots[live_slot] || !keyframe_kept) return SE2();
     for (int round = 0;; ++round) {
       const Eigen::Vector3d v = (prev.T.inverse() * est->T).log() / dt;
-      const Eigen::Vector3d twist = readout_twist.measure(t, dt, v, live_twist, &live_c, &live_tc);
+      const bool keyframe_too = !keyframe_twist_measured;
+      Eigen::Vector3d twist;
+      if (keyframe_too) {
+        // The keyframe was undistorted with the same twist as this frame (none measured yet), so
+        // their relative pose does not depend on it, and the velocity is the twist's measure.
+        // (readout_twist.measure's model holds once the keyframe's own twist is right: with it
+        // here, a robot that starts, or recovers, at speed undistorts the keyframe with 1/(1+k)
+        // of its twist and the frames stop matching.)
+        live_c = v;
+        live_tc = t - 0.5 * dt;
+        twist = v;
+      } else {
+        twist = readout_twist.measure(t, dt, v, live_twist, &live_c, &live_tc);
+      }
       has_live_c = twist.allFinite();
       if (!has_live_c) return SE2();
-      const bool keyframe_too = !keyframe_twist_measured;
       if (round == 2 || (!keyframe_too && shutter_shift(live_twist, twist) <= opt.rolling_shutter_tolerance_px)) {
         live_offset = 0.5 * camera.rolling_shutter_readout * (live_twist - twist);
         return SE2::exp(live_offset);
