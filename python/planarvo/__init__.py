@@ -16,7 +16,8 @@ from ._calibration import (CalibrationMethod, CalibrationOptions, CalibrationRes
                            compose_extrinsics)
 from ._camera import EXTRINSICS_NAMES, Camera, Extrinsics
 from ._camera_calibration import (CalibrationStatus, CameraCalibrationOptions, CameraCalibrationResult,
-                                  CameraCalibrator, RollPitch, RollPitchOptions, RollPitchResult, calibrate_dataset)
+                                  CameraCalibrator, ReadoutSource, RollPitch, RollPitchOptions, RollPitchResult,
+                                  calibrate_dataset)
 from ._context import Context, DeviceInfo, list_devices, version
 from ._dataset import Dataset, DatasetInfo, FrameData, bag_topics
 from ._errors import Error, Status
@@ -35,7 +36,7 @@ __version__ = _lib.planarvo_version_string().decode()
 __all__ = ["EXTRINSICS_NAMES", "CalibrationMethod", "CalibrationOptions", "CalibrationResult",
     "CalibrationStatus", "Camera", "CameraCalibrationOptions", "CameraCalibrationResult", "CameraCalibrator",
     "Context", "Dataset", "DatasetInfo", "DeviceInfo", "Error", "Extrinsics", "FrameData", "MotionAccuracy",
-    "Mosaic", "MosaicInfo", "MotionPair", "MotionProfile", "PosegraphInit", "Residuals", "RobustLoss", "RollPitch",
+    "Mosaic", "MosaicInfo", "MotionPair", "MotionProfile", "PosegraphInit", "ReadoutSource", "Residuals", "RobustLoss", "RollPitch",
     "RollPitchOptions",
     "RollPitchResult", "SE2", "SimOptions", "SolverSummary", "StatsWriter", "Status", "Tracker",
     "TrackerOptions", "TrackResult", "TrackStatus", "bag_topics", "calibrate", "calibrate_dataset", "compose_extrinsics",

@@ -99,7 +99,7 @@ class RollPitch(_Handle):
 class CameraCalibrationOptions:
     """planarvo_camera_calibration_options; None keeps the library's default. height: the camera
     height when known (held); initial: the extrinsics to start from; graph, tracker: the stages'
-    options."""
+    options; readout: where the rolling shutter's readout time comes from (ReadoutSource)."""
     method: Optional[CalibrationMethod] = None
     height: Optional[float] = None
     roll_pitch_frames: Optional[int] = None
@@ -107,6 +107,14 @@ class CameraCalibrationOptions:
     estimate_roll_pitch: Optional[bool] = None
     graph: Optional[CalibrationOptions] = None
     tracker: Optional[TrackerOptions] = None
+    readout: Optional["ReadoutSource"] = None
+
+
+class ReadoutSource(enum.IntEnum):
+    """planarvo_readout_source: where the calibration gets the rolling shutter's readout time."""
+    IF_UNKNOWN = 0  # estimated when the data set's camera file does not give it
+    CAMERA = 1      # the camera's as it is (0: a global shutter); the default
+    ESTIMATE = 2    # estimated from the drive
 
 
 @dataclass
@@ -132,6 +140,13 @@ class CameraCalibrationResult:
     seconds_tracking: float
     seconds_graph: float
     seconds_total: float
+    # The readout time (seconds) roll, pitch and tracking used; its estimate and standard
+    # deviation when one was made (readout_evaluations > 0), or why it failed (readout_reason).
+    readout: float = 0.0
+    readout_estimate: float = 0.0
+    readout_sigma: float = 0.0
+    readout_evaluations: int = 0
+    readout_reason: str = ""
 
     @property
     def sigmas(self) -> np.ndarray:
@@ -145,7 +160,8 @@ class CameraCalibrationResult:
                    tuple(bool(v) for v in r.observable), RollPitchResult._from_c(r.roll_pitch),
                    CalibrationResult._from_c(r.graph), r.frames, r.frames_ok, r.frames_degraded, r.frames_lost,
                    r.samples, r.tracking_median_ms, r.seconds_decode, r.seconds_roll_pitch, r.seconds_tracking,
-                   r.seconds_graph, r.seconds_total)
+                   r.seconds_graph, r.seconds_total, r.readout, r.readout_estimate, r.readout_sigma,
+                   r.readout_evaluations, r.readout_reason.decode(errors="replace"))
 
 
 class _CameraCalibrationC:

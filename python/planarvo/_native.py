@@ -175,7 +175,7 @@ class CameraCalibrationOptions(ctypes.Structure):
     _fields_ = [("struct_size", c_size_t), ("method", c_enum), ("height", c_double),
                 ("roll_pitch_frames", c_int32), ("has_initial", c_int32), ("initial", Extrinsics),
                 ("estimate_roll_pitch", c_int32), ("graph", P(CalibrationOptions)), ("tracker", P(TrackerOptions)),
-                ("progress", PROGRESS_FN), ("progress_user_data", c_void_p)]
+                ("progress", PROGRESS_FN), ("progress_user_data", c_void_p), ("readout", c_enum)]
 
 
 class CameraCalibrationResult(ctypes.Structure):
@@ -185,7 +185,9 @@ class CameraCalibrationResult(ctypes.Structure):
                 ("frames", c_int32), ("frames_ok", c_int32), ("frames_degraded", c_int32),
                 ("frames_lost", c_int32), ("samples", c_int32), ("tracking_median_ms", c_double),
                 ("seconds_decode", c_double), ("seconds_roll_pitch", c_double), ("seconds_tracking", c_double),
-                ("seconds_graph", c_double), ("seconds_total", c_double)]
+                ("seconds_graph", c_double), ("seconds_total", c_double), ("readout", c_double),
+                ("readout_estimate", c_double), ("readout_sigma", c_double), ("readout_evaluations", c_int32),
+                ("readout_frames", c_int32), ("readout_reason", ctypes.c_char * 256), ("seconds_readout", c_double)]
 
 
 class MosaicOptions(ctypes.Structure):

@@ -55,8 +55,10 @@ struct CameraCalibrator::Impl {
   ocl::Runtime& rt;
   CameraModel camera;
   PipelineOptions opt;
-  Stage stage = Stage::RollPitch;
+  bool estimating_readout = false;
+  Stage stage = Stage::RollPitch;  // frames are held (for roll and pitch, the readout time)
   std::unique_ptr<track::RollPitchEstimator> roll_pitch;
+  bool roll_pitch_complete = false;  // its map is complete: later held frames are not its
   std::vector<HeldFrame> held;
   std::unique_ptr<track::Tracker> tracker;
   MotionSampler sampler;
@@ -82,18 +84,20 @@ struct CameraCalibrator::Impl {
     return r;
   }
 
-  Impl(ocl::Runtime& r, const CameraModel& c, const PipelineOptions& o) : rt(r), camera(c), opt(validated(o)) {
+  Impl(ocl::Runtime& r, const CameraModel& c, const PipelineOptions& o)
+      : rt(r), camera(c), opt(validated(o)), estimating_readout(opt.readout == PipelineOptions::Readout::On) {
     if (opt.estimate_roll_pitch) {
       roll_pitch = std::make_unique<track::RollPitchEstimator>(rt, camera, roll_pitch_options(opt));
     } else {
       report.roll_pitch.status = track::RollPitchResult::Status::Ok;
       report.roll_pitch.roll = opt.initial->roll;
       report.roll_pitch.pitch = opt.initial->pitch;
-      start_tracking();
+      if (!estimating_readout) start_tracking();
     }
   }
 
   void start_tracking() {
+    report.readout_used = camera.rolling_shutter_readout;
     tracker = std::make_unique<track::Tracker>(rt, camera, camera_frame(report.roll_pitch.roll, report.roll_pitch.pitch),
                                                opt.tracker);
     stage = Stage::Tracking;
@@ -118,23 +122,70 @@ struct CameraCalibrator::Impl {
     }
   }
 
-  // Stage 1 ends: estimate, then track the frames held for it.
-  void end_roll_pitch() {
+  // Stage 1's estimate; false (and the pipeline stopped) when it failed.
+  bool estimate_roll_pitch() {
     const auto t0 = Clock::now();
     report.roll_pitch = roll_pitch->estimate();
-    roll_pitch.reset();  // its keyframe pyramids are no longer needed
     report.time.roll_pitch += seconds_since(t0);
-    if (!report.roll_pitch.ok()) {
-      stage = Stage::Stopped;
-      report.status = report.roll_pitch.status == track::RollPitchResult::Status::TooLittleTexture
-                          ? PipelineReport::Status::TooLittleTexture
-                      : report.roll_pitch.status == track::RollPitchResult::Status::TooLittleMotion
-                          ? PipelineReport::Status::TooLittleMotion
-                          : PipelineReport::Status::Failed;
-      report.reason = "roll and pitch: " + report.roll_pitch.reason;
-      held.clear();
-      return;
-    }
+    if (report.roll_pitch.ok()) return true;
+    stage = Stage::Stopped;
+    report.status = report.roll_pitch.status == track::RollPitchResult::Status::TooLittleTexture
+                        ? PipelineReport::Status::TooLittleTexture
+                    : report.roll_pitch.status == track::RollPitchResult::Status::TooLittleMotion
+                        ? PipelineReport::Status::TooLittleMotion
+                        : PipelineReport::Status::Failed;
+    report.reason = "roll and pitch: " + report.roll_pitch.reason;
+    held.clear();
+    roll_pitch.reset();
+    return false;
+  }
+
+  // The readout time from the held frames, tracked with the tilt known so far; when it finds a
+  // rolling shutter, stage 1 runs again through it.
+  bool estimate_readout() {
+    const auto t0 = Clock::now();
+    std::vector<cv::Mat> frames;
+    std::vector<double> stamps;
+    for (const HeldFrame& f : held)
+      if (f.gray.cols == camera.width && f.gray.rows == camera.height) {
+        frames.push_back(f.gray);
+        stamps.push_back(f.t);
+      }
+    ReadoutEstimateOptions ro = opt.readout_estimate;
+    ro.tracker = opt.tracker;
+    if (opt.progress) ro.progress = [this](double f) { return opt.progress(f, "readout time"); };
+    report.readout = calib::estimate_readout(rt, camera, camera_frame(report.roll_pitch.roll, report.roll_pitch.pitch),
+                                             frames, stamps, ro);
+    report.time.readout = seconds_since(t0);
+    if (!report.readout.ok) return true;  // the camera's readout stays; the report says why
+    const bool changed = report.readout.readout != camera.rolling_shutter_readout;
+    camera.rolling_shutter_readout = report.readout.readout;
+    if (!changed || !opt.estimate_roll_pitch) return true;
+    const auto t1 = Clock::now();
+    roll_pitch = std::make_unique<track::RollPitchEstimator>(rt, camera, roll_pitch_options(opt));
+    for (const HeldFrame& f : held)
+      if (roll_pitch->add_frame(f.gray.data, f.gray.cols, f.gray.rows, f.gray.step, f.t)) break;
+    report.time.roll_pitch += seconds_since(t1);
+    if (!estimate_roll_pitch()) return false;
+    // The tilt moved (a rolling shutter biases it): the readout once more from there.
+    const auto t2 = Clock::now();
+    ro.guess = report.readout.estimate;
+    const ReadoutEstimate again = calib::estimate_readout(
+        rt, camera, camera_frame(report.roll_pitch.roll, report.roll_pitch.pitch), frames, stamps, ro);
+    report.time.readout += seconds_since(t2);
+    if (!again.ok) return true;
+    const int evaluations = report.readout.evaluations + again.evaluations;
+    report.readout = again;
+    report.readout.evaluations = evaluations;
+    camera.rolling_shutter_readout = again.readout;
+    return true;
+  }
+
+  // The hold ends: roll and pitch, the readout time, then the held frames are tracked.
+  void end_hold() {
+    if (roll_pitch && !estimate_roll_pitch()) return;
+    if (estimating_readout && !estimate_readout()) return;
+    roll_pitch.reset();  // its keyframe pyramids are no longer needed
     start_tracking();
     for (const HeldFrame& f : held) track(f.gray.data, f.gray.cols, f.gray.rows, f.gray.step, f.t, f.odometry, f.direction);
     held.clear();
@@ -158,9 +209,11 @@ struct CameraCalibrator::Impl {
       f.odometry = odometry;
       f.direction = direction;
       held.push_back(std::move(f));
-      const bool complete = roll_pitch->add_frame(gray, width, height, stride, t);
+      if (roll_pitch && !roll_pitch_complete) roll_pitch_complete = roll_pitch->add_frame(gray, width, height, stride, t);
       report.time.roll_pitch += seconds_since(t0);
-      if (complete || static_cast<int>(held.size()) >= opt.max_buffered_frames) end_roll_pitch();
+      const int n = static_cast<int>(held.size());
+      const bool enough = (!roll_pitch || roll_pitch_complete) && (!estimating_readout || n >= opt.readout_frames);
+      if (enough || n >= opt.max_buffered_frames) end_hold();
       return;
     }
     track(gray, width, height, stride, t, odometry, direction);
@@ -201,7 +254,7 @@ struct CameraCalibrator::Impl {
 
   PipelineReport finish() {
     if (stage == Stage::Finished) throw_invalid_argument("calibration: finish() called twice");
-    if (stage == Stage::RollPitch) end_roll_pitch();
+    if (stage == Stage::RollPitch) end_hold();
     if (stage == Stage::Tracking) calibrate_graph();
     stage = Stage::Finished;
     if (!frame_ms.empty()) {
@@ -224,7 +277,7 @@ void CameraCalibrator::add_frame(const uint8_t* gray, int width, int height, siz
 PipelineReport CameraCalibrator::finish() { return impl_->finish(); }
 const char* CameraCalibrator::stage() const {
   switch (impl_->stage) {
-    case Impl::Stage::RollPitch: return "roll and pitch";
+    case Impl::Stage::RollPitch: return impl_->roll_pitch ? "roll and pitch" : "readout time";
     case Impl::Stage::Tracking: return "tracking";
     case Impl::Stage::Stopped: return "stopped";
     case Impl::Stage::Finished: return "finished";
@@ -239,7 +292,10 @@ PipelineReport calibrate_dataset(ocl::Runtime& runtime, io::Dataset& ds, const P
   if (options.graph.method == graph::CalibrationMethod::Nonholonomic && !ds.has_direction())
     throw_invalid_input(ds.directory() +
                         ": the nonholonomic method needs direction labels (direction.txt) for y and the branch");
-  CameraCalibrator calibrator(runtime, ds.camera(), options);
+  PipelineOptions o = options;
+  if (o.readout == PipelineOptions::Readout::IfUnknown)
+    o.readout = ds.readout_given() ? PipelineOptions::Readout::Off : PipelineOptions::Readout::On;
+  CameraCalibrator calibrator(runtime, ds.camera(), o);
   const int64_t n = ds.frame_count();
   double decode = 0.0;
   for (int64_t i = 0; i < n; ++i) {

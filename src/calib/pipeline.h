@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "calib/extrinsics_estimate.h"
+#include "calib/readout_estimate.h"
 #include "core/se2.h"
 #include "graph/calibration.h"
 #include "image/camera.h"
@@ -50,6 +51,18 @@ struct PipelineOptions {
   // start stage 3 (otherwise stage 1 starts looking straight down and stage 3 from its closed
   // form).
   std::optional<Extrinsics> initial;
+  // The rolling shutter's readout time (calib/readout_estimate.h). Off: the camera's
+  // rolling_shutter_readout as it is. On: estimated from the first readout_frames frames (held
+  // with stage 1's, so at most max_buffered_frames), after a first estimate of roll and pitch,
+  // and used from stage 1 on (stage 1 runs again through it). IfUnknown: calibrate_dataset
+  // estimates it when the data set's camera does not give it (io::Dataset::readout_given); a
+  // CameraCalibrator, which gets a camera and not a file, takes IfUnknown as Off. Off by
+  // default: a camera file without the key stays a global shutter unless the user asks, because
+  // a small global-shutter camera can read as a few ms (320x240: 2.7 +- 0.3; calib/README.md).
+  enum class Readout { Off, IfUnknown, On };
+  Readout readout = Readout::Off;
+  int readout_frames = 300;
+  ReadoutEstimateOptions readout_estimate;
   // Progress: fraction of the frames fed so far (calibrate_dataset; a stream's total is unknown)
   // and the stage; return false to cancel (Error(Cancelled)).
   std::function<bool(double fraction, const char* stage)> progress;
@@ -69,6 +82,10 @@ struct PipelineReport {
   std::string reason;  // "" when Ok: what failed, and what would fix it
   ExtrinsicsEstimate extrinsics;
   track::RollPitchResult roll_pitch;  // stage 1 (status Ok and empty when not estimated)
+  // The readout time's estimate (evaluations 0 when it was not estimated); the tracking used
+  // readout.readout when it is ok, the camera's otherwise.
+  ReadoutEstimate readout;
+  double readout_used = 0.0;  // the readout time stages 1 and 2 used, seconds
   graph::CalibrationResult graph;     // stage 3 (when it ran)
   std::vector<graph::MotionSample> samples;  // stage 2's output, stage 3's input
   struct Tracking {
@@ -79,6 +96,7 @@ struct PipelineReport {
   struct Timings {            // wall seconds per stage
     double decode = 0.0;      // reading and decoding images (calibrate_dataset)
     double roll_pitch = 0.0;  // stage 1: its tracker and the joint alignment
+    double readout = 0.0;     // the readout time's estimate
     double tracking = 0.0;    // stage 2
     double graph = 0.0;       // stage 3
     double total = 0.0;

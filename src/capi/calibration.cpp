@@ -60,6 +60,7 @@ constexpr size_t kRollPitchOptionsEnd = offsetof(planarvo_roll_pitch_options, se
 constexpr size_t kRollPitchResultEnd = offsetof(planarvo_roll_pitch_result, seconds) + sizeof(double);
 constexpr size_t kCameraOptionsEnd =
     offsetof(planarvo_camera_calibration_options, progress_user_data) + sizeof(void*);
+// Results this size and up receive the readout fields; older callers' structs end before them.
 constexpr size_t kCameraResultEnd = offsetof(planarvo_camera_calibration_result, seconds_total) + sizeof(double);
 
 planarvo::track::RollPitchOptions roll_pitch_options_from_c(const planarvo_roll_pitch_options* options) {
@@ -138,6 +139,12 @@ planarvo::calib::PipelineOptions pipeline_options_from_c(const planarvo_camera_c
   if (o.tracker) po.tracker = planarvo::capi::tracker_options_from_c(o.tracker);
   po.roll_pitch.max_frames = o.roll_pitch_frames;
   po.estimate_roll_pitch = o.estimate_roll_pitch != 0;
+  const int readout = planarvo::capi::enum_value(o.readout);
+  require(readout >= PLANARVO_READOUT_IF_UNKNOWN && readout <= PLANARVO_READOUT_ESTIMATE,
+          "planarvo_camera_calibration_options.readout is not a planarvo_readout_source");
+  po.readout = readout == PLANARVO_READOUT_CAMERA     ? planarvo::calib::PipelineOptions::Readout::Off
+               : readout == PLANARVO_READOUT_ESTIMATE ? planarvo::calib::PipelineOptions::Readout::On
+                                                      : planarvo::calib::PipelineOptions::Readout::IfUnknown;
   if (o.has_initial) {
     require(o.initial.z > 0 && std::isfinite(o.initial.x + o.initial.y + o.initial.z + o.initial.roll +
                                              o.initial.pitch + o.initial.yaw),
@@ -178,6 +185,13 @@ planarvo_camera_calibration_result report_to_c(const planarvo::calib::PipelineRe
   out.seconds_tracking = r.time.tracking;
   out.seconds_graph = r.time.graph;
   out.seconds_total = r.time.total;
+  out.readout = r.readout_used;
+  out.readout_estimate = r.readout.estimate;
+  out.readout_sigma = r.readout.sigma;
+  out.readout_evaluations = r.readout.evaluations;
+  out.readout_frames = r.readout.frames;
+  planarvo::capi::copy_string(out.readout_reason, sizeof out.readout_reason, r.readout.reason);
+  out.seconds_readout = r.time.readout;
   return out;
 }
 
@@ -256,6 +270,7 @@ PLANARVO_API void planarvo_camera_calibration_options_init(planarvo_camera_calib
   o->height = 0.0;
   o->roll_pitch_frames = 0;
   o->estimate_roll_pitch = 1;
+  o->readout = PLANARVO_READOUT_CAMERA;
 }
 
 PLANARVO_API planarvo_status planarvo_calibrate_dataset(planarvo_context* context, planarvo_dataset* dataset,

@@ -76,7 +76,9 @@ int cmd_calibrate_dataset(const Args& args, const planarvo_calibration_options& 
   }
   args.expect_output_files({"output"});
   const std::optional<planarvo_region> roi = parse_roi(args);  // before any file is read
-  const std::optional<double> readout = parse_readout(args);
+  const bool estimate_readout = args.get("readout-time", "") == "estimate";
+  const std::optional<double> readout = estimate_readout ? std::nullopt : parse_readout(args);
+  if (estimate_readout) o.readout = PLANARVO_READOUT_ESTIMATE;
   const std::string out = args.get("output");
   ContextPtr ctx = make_context(args);
   Progress progress(!args.has("quiet"));
@@ -108,6 +110,13 @@ int cmd_calibrate_dataset(const Args& args, const planarvo_calibration_options& 
     std::printf("graph calibration: %d iterations over all solves, %d gross errors gated, variance factor %.3g, "
                 "%.3f s\n",
                 r.graph.total_iterations, r.graph.outliers, r.graph.variance_factor, r.seconds_graph);
+  if (r.readout_evaluations > 0 && r.readout_reason[0] == 0)
+    std::printf("rolling shutter: readout %.2f ms +- %.2f estimated from %d frames (%d candidates), %.2f s; %s\n",
+                r.readout_estimate * 1e3, r.readout_sigma * 1e3, r.readout_frames, r.readout_evaluations,
+                r.seconds_readout, r.readout > 0 ? "used" : "within 2 sigma of 0: a global shutter");
+  else if (r.readout_evaluations > 0 || r.readout_reason[0] != 0)
+    std::printf("rolling shutter: the readout time could not be estimated (%s); %.2f ms used\n", r.readout_reason,
+                r.readout * 1e3);
   std::printf("time: %.2f s in all (%.2f s reading images)\n", r.seconds_total, r.seconds_decode);
   if (st == PLANARVO_OK || r.status == PLANARVO_CALIBRATION_UNOBSERVABLE) print_result(r);
   if (st == PLANARVO_ERROR_FAILED) {
@@ -123,7 +132,13 @@ int cmd_calibrate_dataset(const Args& args, const planarvo_calibration_options& 
                               ? "roll and pitch from images (sec. 5.1); x, y, z, yaw against wheel odometry (5.2.1)"
                               : "roll and pitch from images (sec. 5.1); x, yaw nonholonomic, y from direction labels "
                                 "(5.2.2), z given";
-    const std::string notes = "planarvo calibrate " + dir;
+    std::string notes = "planarvo calibrate " + dir;
+    if (r.readout_evaluations > 0 && r.readout_reason[0] == 0) {
+      char line[160];
+      std::snprintf(line, sizeof line, "; rolling_shutter_readout estimated %.6f s +- %.6f (%s)", r.readout_estimate,
+                    r.readout_sigma, r.readout > 0 ? "used" : "taken as 0, a global shutter");
+      notes += line;
+    }
     check(planarvo_extrinsics_save(out.c_str(), &r.extrinsics, r.covariance, estimated.c_str(), m.c_str(),
                                    notes.c_str()));
     std::printf("wrote %s\n", out.c_str());

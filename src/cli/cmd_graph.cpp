@@ -90,7 +90,9 @@ int cmd_calibrate(int argc, char** argv) {
       {"initial-extrinsics", "FILE", "DATASET: start from these extrinsics (YAML)", "looking straight down"},
       {"video", "FILE", "DATASET: a video file standing in for images/ and frames.txt", ""},
       roi_option("DATASET: camera.yaml's region_of_interest, else the whole image"),
-      readout_option(),
+      {"readout-time", "SECONDS|estimate", "DATASET: the rolling shutter's readout (first row's read to last row's; "
+                                          "0: a global shutter), overriding camera.yaml's; estimate: from the drive",
+       "camera.yaml's, else 0"},
       {"quiet", "", "no progress bar", ""},
       {"method", "KIND", "odometry | nonholonomic", "odometry"},
       {"fix-scale", "", "a metric sensor (e.g. a laser scan matcher): scale 1, z written as 0", ""},

@@ -243,6 +243,7 @@ struct Dataset::Impl {
   std::vector<FrameEntry> frames;
   std::string frames_file;
   bool has_odometry = false, has_groundtruth = false, has_direction = false;
+  bool readout_given = false;  // the camera file or set_rolling_shutter_readout gave it
   std::vector<StampedPose> odometry, groundtruth;
   std::vector<DirectionLabel> direction;
   std::optional<ExtrinsicsFile> extrinsics, extrinsics_gt;
@@ -304,7 +305,7 @@ Dataset::Dataset(const std::string& directory, DatasetOptions options) : impl_(s
     throw_invalid_input(directory + ": a data set directory, but topics, a camera file or receive times were given, "
                         "which apply to bags only");
 
-  d.camera = read_camera_yaml((d.dir / "camera.yaml").string());
+  d.camera = read_camera_yaml((d.dir / "camera.yaml").string(), &d.readout_given);
 
   // The text files first, so that a typo is reported before the long part.
   constexpr double kTextShare = 0.05;
@@ -369,6 +370,7 @@ void Dataset::open_bag(const std::string& file, const DatasetOptions& options) {
   d.bag = std::make_unique<BagSource>(file, options.bag, options.verify_images,
                                       [&](double f, const char* stage) { progress.report(f, stage); });
   d.camera = d.bag->camera();
+  d.readout_given = d.bag->readout_given();
   d.frames = d.bag->frames();
   check_readout(d.camera.rolling_shutter_readout, d.frames,
                 options.bag.camera_yaml.empty() ? file + ": the camera" : options.bag.camera_yaml);
@@ -403,6 +405,7 @@ const CameraModel& Dataset::camera() const { return impl_->camera; }
 void Dataset::set_rolling_shutter_readout(double seconds, const std::string& where) {
   check_readout(seconds, impl_->frames, where);
   impl_->camera.rolling_shutter_readout = seconds;
+  impl_->readout_given = true;
 }
 
 void Dataset::set_region_of_interest(const PixelRegion& roi) {
@@ -438,6 +441,7 @@ cv::Mat Dataset::frame(int64_t i) {
 }
 
 bool Dataset::has_odometry() const { return impl_->has_odometry; }
+bool Dataset::readout_given() const { return impl_->readout_given; }
 const std::vector<StampedPose>& Dataset::odometry() const { return impl_->odometry; }
 std::optional<SE2> Dataset::odometry_at(int64_t i) const {
   return interpolate_pose(impl_->odometry, timestamp(i));

@@ -69,6 +69,10 @@ class Dataset {
   // Replaces the camera's rolling_shutter_readout (seconds). InvalidInput naming `where` when it
   // is negative, not finite or longer than the frames' median interval (check_readout).
   void set_rolling_shutter_readout(double seconds, const std::string& where);
+  // The readout time was given: by the camera file's rolling_shutter_readout (0 included) or by
+  // set_rolling_shutter_readout. Otherwise the camera is taken as a global shutter, and
+  // `calibrate` estimates the readout (calib/pipeline.h, PipelineOptions::readout).
+  bool readout_given() const;
   bool is_video() const;
   bool is_bag() const;
   // A bag's first frame's stamp in integer nanoseconds; timestamps are seconds after it. 0 for

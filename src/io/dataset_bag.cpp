@@ -316,7 +316,7 @@ BagSource::BagSource(const std::string& path, const BagDatasetOptions& o, bool v
     camera_ = camera_from_info(*s.info, path + ": " + camera_source_);
   } else {
     camera_source_ = o.camera_yaml;
-    camera_ = read_camera_yaml(o.camera_yaml);
+    camera_ = read_camera_yaml(o.camera_yaml, &readout_given_);
   }
   // The first frame is decoded now, so that a size that disagrees with the camera is found at
   // open; every frame with verify.

@@ -49,6 +49,8 @@ class BagSource {
   const CameraModel& camera() const { return camera_; }
   // Camera description for messages: "the camera info on /camera/camera_info" or the yaml path.
   const std::string& camera_source() const { return camera_source_; }
+  // The camera file (--camera) gave rolling_shutter_readout; a CameraInfo never does.
+  bool readout_given() const { return readout_given_; }
   int64_t time_origin_ns() const { return origin_ns_; }
   // Frame times in seconds after the first, frame paths empty.
   const std::vector<FrameEntry>& frames() const { return frames_; }
@@ -64,6 +66,7 @@ class BagSource {
   std::unique_ptr<Impl> impl_;
   CameraModel camera_;
   std::string camera_source_;
+  bool readout_given_ = false;
   int64_t origin_ns_ = 0;
   std::vector<FrameEntry> frames_;
   std::vector<StampedPose> odometry_, groundtruth_;

@@ -405,7 +405,7 @@ cv::FileStorage memory_writer() {
 
 }  // namespace
 
-CameraModel read_camera_yaml(const std::string& path) {
+CameraModel read_camera_yaml(const std::string& path, bool* readout_given) {
   return with_parse_errors(path, [&] {
     cv::FileStorage fs;
     open_for_reading(fs, path);
@@ -458,8 +458,9 @@ CameraModel read_camera_yaml(const std::string& path) {
     }
     // planarvo's own, optional: absent is a global shutter. Range checked by validate().
     const cv::FileNode readout = fs["rolling_shutter_readout"];
-    if (!readout.empty() && !readout.isNone())
-      cam.rolling_shutter_readout = read_real(readout, path, "rolling_shutter_readout");
+    const bool given = !readout.empty() && !readout.isNone();
+    if (given) cam.rolling_shutter_readout = read_real(readout, path, "rolling_shutter_readout");
+    if (readout_given) *readout_given = given;
     cam.validate(path.c_str());
     return cam;
   });

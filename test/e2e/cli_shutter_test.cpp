@@ -34,6 +34,10 @@ TEST(CliShutter, BadReadoutOrExposureIsExitCodeTwoNamingTheOption) {
   refused("--exposure 0.05", "exposure_time");
   refused("--readout-time fast", "--readout-time");
   EXPECT_FALSE(fs::exists(d / "never" / "frames.txt"));
+  // calibrate takes "estimate" besides seconds, and nothing else.
+  const auto r = run_cli("calibrate " + (d / "none").string() + " --readout-time soon");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_THAT(r.output, HasSubstr("--readout-time"));
 }
 
 TEST(CliShutter, ReadoutIsWrittenToCameraYamlAndPrintedByInfo) {
