@@ -9,6 +9,9 @@
 #include <random>
 #include <system_error>
 
+#include <fcntl.h>
+#include <unistd.h>
+
 #include "core/error.h"
 
 namespace planarvo {
@@ -36,11 +39,32 @@ std::string unique_suffix() {
 
 }  // namespace
 
-OutputFile::OutputFile(std::string path, Temporary temporary) : path_(std::move(path)) {
-  temporary_ = write_directly(path_) ? path_
-               : path_ + kSuffix + (temporary == Temporary::Unique ? unique_suffix() : std::string());
-  file_ = std::fopen(temporary_.c_str(), "wb");
-  if (!file_) fail("cannot open for writing", errno);
+OutputFile::OutputFile(std::string path) : path_(std::move(path)) {
+  if (write_directly(path_)) {
+    temporary_ = path_;
+    file_ = std::fopen(temporary_.c_str(), "wb");
+    if (!file_) fail("cannot open for writing", errno);
+    return;
+  }
+  int err = EEXIST;
+  for (int attempt = 0; attempt < 16 && err == EEXIST; ++attempt) {
+    temporary_ = path_ + kSuffix + unique_suffix();
+    // Exclusive, and never through a link: a name someone else made is not ours to write.
+    const int fd = ::open(temporary_.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0666);
+    if (fd < 0) {
+      err = errno;
+      continue;
+    }
+    file_ = ::fdopen(fd, "wb");
+    if (!file_) {
+      err = errno;
+      ::close(fd);
+      std::remove(temporary_.c_str());
+      fail("cannot open for writing", err);
+    }
+    return;
+  }
+  fail("cannot create a temporary file beside it", err);
 }
 
 OutputFile::~OutputFile() { discard(); }

@@ -1,6 +1,7 @@
 // The per-frame statistics CSV (docs/formats.md, --stats FILE): one row per frame, written
-// and flushed as the frames are processed into FILE.partial, renamed onto FILE by close()
-// (core/output_file.h): FILE is complete or untouched; a crash leaves the rows in FILE.partial.
+// and flushed as the frames are processed into FILE.partial-<random>, renamed onto FILE by
+// close() (core/output_file.h): FILE is complete or untouched; a crash leaves the rows in the
+// temporary.
 #pragma once
 #include <string>
 
@@ -32,6 +33,7 @@ class StatsWriter {
   // removes its partial file and leaves FILE as it was.
   void close();
   const std::string& path() const { return out_.path(); }
+  const std::string& temporary_path() const { return out_.temporary_path(); }  // until close()
 
  private:
   detail::TextWriter out_;

@@ -58,12 +58,13 @@ class TextWriter {
 
   void write(std::string_view text);
   // Hands the written text to the operating system, so that a crash of this process loses none
-  // (it is then in the path's temporary, PATH.partial).
+  // (it is then in the path's temporary, PATH.partial-<random>: temporary_path()).
   void flush();
   // Completes the file: flushes, closes and renames it onto the path, reporting any failure.
   // The destructor, without close(), removes the temporary and leaves the path as it was.
   void close();
   const std::string& path() const { return file_.path(); }
+  const std::string& temporary_path() const { return file_.temporary_path(); }
 
  private:
   [[noreturn]] void fail(const char* what) const;

@@ -174,9 +174,10 @@ std::optional<std::vector<unsigned char>> read_file(const std::filesystem::path&
 
 bool write_file_atomically(const std::filesystem::path& path, const unsigned char* data,
                            size_t size) {
-  // Other threads and processes may write the same entry: each under a name of its own.
+  // Other threads and processes may write the same entry: each writes a temporary of its own
+  // (core/output_file.h).
   try {
-    OutputFile out(path.string(), OutputFile::Temporary::Unique);
+    OutputFile out(path.string());
     if (size > 0 && std::fwrite(data, 1, size, out.stream()) != size) return false;  // discarded
     out.commit();
     return true;

@@ -43,6 +43,15 @@ class ScratchDir {
   std::filesystem::path path_;
 };
 
+// The temporaries (core/output_file.h: PATH.partial-<random>) left beside path.
+inline int partial_files(const std::filesystem::path& path) {
+  int n = 0;
+  const std::string prefix = path.filename().string() + ".partial";
+  for (const auto& e : std::filesystem::directory_iterator(path.parent_path()))
+    n += e.path().filename().string().rfind(prefix, 0) == 0 ? 1 : 0;
+  return n;
+}
+
 struct CommandResult {
   int exit_code = -1;
   std::string output;  // stdout and stderr together

@@ -553,7 +553,8 @@ TEST(IoStats, HeaderRowsAndFlushedAsItGoes) {
   ScratchDir dir;
   const std::string path = (dir / "stats.csv").string();
   io::StatsWriter w(path);
-  const std::string partial = path + OutputFile::kSuffix;  // where the rows go until close()
+  const std::string partial = w.temporary_path();  // where the rows go until close()
+  EXPECT_EQ(partial.rfind(path + OutputFile::kSuffix + "-", 0), 0u) << partial;
   EXPECT_EQ(test::read_text(partial),
             "timestamp,vx,vy,omega,iterations,final_cost,inlier_fraction,ms,status\n");
   EXPECT_FALSE(std::filesystem::exists(path));
@@ -587,13 +588,15 @@ TEST(IoWriters, AFileIsCompleteOrUntouched) {
   ScratchDir dir;
   const std::string path = (dir / "stats.csv").string();
   test::write_text(path, "the user's earlier file\n");
+  std::string partial;
   {
     io::StatsWriter w(path);
     w.add(io::FrameStats{});
-    EXPECT_TRUE(std::filesystem::exists(path + OutputFile::kSuffix));
+    partial = w.temporary_path();
+    EXPECT_TRUE(std::filesystem::exists(partial));
   }
   EXPECT_EQ(test::read_text(path), "the user's earlier file\n");
-  EXPECT_FALSE(std::filesystem::exists(path + OutputFile::kSuffix));
+  EXPECT_FALSE(std::filesystem::exists(partial));
   {
     io::StatsWriter w(path);
     w.close();
@@ -602,7 +605,46 @@ TEST(IoWriters, AFileIsCompleteOrUntouched) {
   // The whole-file writers too: a complete write replaces, and nothing partial is left.
   io::write_tum(path, {{0.5, SE2(1, 2, 0.25)}});
   EXPECT_EQ(io::read_tum(path).size(), 1u);
-  EXPECT_FALSE(std::filesystem::exists(path + OutputFile::kSuffix));
+  EXPECT_EQ(std::distance(std::filesystem::directory_iterator(dir.path()), std::filesystem::directory_iterator()), 1)
+      << "only " << path << " is left";
+}
+
+// Two writers of one destination (two processes given the same --stats FILE): each writes a
+// temporary of its own, and the file is the last one committed, whole; the first's rows are not
+// spliced into it (issue 27: both wrote FILE.partial, and the second kept writing into the file
+// the first had renamed).
+TEST(IoWriters, TwoWritersOfOneFileLeaveOneWholeFile) {
+  ScratchDir dir;
+  const std::string path = (dir / "stats.csv").string();
+  io::StatsWriter a(path), b(path);
+  EXPECT_NE(a.temporary_path(), b.temporary_path());
+  io::FrameStats r;
+  r.status = "a";
+  a.add(r);
+  r.status = "b";
+  b.add(r);
+  a.close();
+  b.add(r);
+  b.close();
+  const std::string header = std::string(io::StatsWriter::kHeader) + "\n";
+  const std::string row_b = "0.000000000,0,0,0,0,0,0,0,b\n";
+  EXPECT_EQ(test::read_text(path), header + row_b + row_b);
+  EXPECT_EQ(std::distance(std::filesystem::directory_iterator(dir.path()), std::filesystem::directory_iterator()), 1);
+}
+
+// A symbolic link planted where the temporary used to be (PATH.partial) in a shared directory:
+// its target is not written, and the output is a regular file (issue 27: a root run overwrote
+// the link's target, and PATH became a link to it).
+TEST(IoWriters, ALinkAtTheTemporaryNameIsNotFollowed) {
+  ScratchDir dir;
+  const std::string path = (dir / "traj.txt").string();
+  const std::string target = (dir / "precious").string();
+  test::write_text(target, "keep me\n");
+  std::filesystem::create_symlink(target, path + OutputFile::kSuffix);
+  io::write_tum(path, {{0.5, SE2(1, 2, 0.25)}});
+  EXPECT_EQ(test::read_text(target), "keep me\n");
+  EXPECT_FALSE(std::filesystem::is_symlink(path));
+  EXPECT_EQ(io::read_tum(path).size(), 1u);
 }
 
 // A destination that is not a regular file (a device) is written directly: nothing to rename.
