@@ -44,6 +44,7 @@ Eigen::Matrix3d adjoint(const SE2& T) {
 // Reasons (compared by address).
 constexpr const char* kNoTexture = "no texture";
 constexpr const char* kMismatch = "images do not match";
+constexpr const char* kAfterLost = "the frame before was lost: the motion is from its predicted pose";
 constexpr const char* kMisaligned = "misaligned: the images match only where something fixed to the camera is";
 constexpr const char* kBrightness = "brightness changed too much";
 constexpr const char* kWrongSize = "frame size differs from the camera's";
@@ -126,6 +127,10 @@ struct Tracker::Impl {
   // whether the keyframe's was measured (not predicted).
   Eigen::Vector3d live_twist = Eigen::Vector3d::Zero();
   bool keyframe_twist_measured = false;
+  // Frames Lost in a row against the keyframe (keyframe hygiene: one failed frame never becomes
+  // the keyframe; the second in a row does, as the keyframe is then what no longer matches).
+  int lost_in_a_row = 0;
+  bool prev_predicted = false;  // prev.T is a Lost frame's predicted pose, not an alignment
   Estimate prev;        // the previous frame relative to the keyframe
   // Covariance of prev.T less the part the next frame shares with it ((1 - 2 rho) C; zero when
   // the previous frame is the keyframe, lost_covariance() after a Lost frame).
@@ -187,9 +192,11 @@ struct Tracker::Impl {
     pose = SE2();
     since_learnt = SE2();
     prev = Estimate();
+    prev_predicted = false;
     prev_covariance.setZero();
     velocity.setZero();
     readout_twist.reset();
+    lost_in_a_row = 0;
     live_twist = live_offset = Eigen::Vector3d::Zero();
     has_t = false;
     nominal_dt = 0.0;
@@ -413,10 +420,21 @@ struct Tracker::Impl {
     select_keyframe_pixels();
     has_keyframe = true;
     prev = Estimate();
+    prev_predicted = false;
     prev_covariance.setZero();
   }
 
   bool rolling() const { return camera.rolling_shutter_readout > 0.0; }
+
+  // The frame has texture of its own (at the coarsest level the alignment uses): it can be a
+  // keyframe.
+  bool has_own_texture(const Pyramid& live) {
+    int coarse = std::min(opt.levels, live.num_levels()) - 1;
+    while (coarse > 0 && (live.levels[static_cast<size_t>(coarse)].width < kMinLevelSide ||
+                          live.levels[static_cast<size_t>(coarse)].height < kMinLevelSide))
+      --coarse;
+    return aligner.texture(live, coarse) >= kMinSelfTexture;
+  }
 
   // How far apart two twists put the image of the last row's read: the rolling shutter's
   // tolerance measure (level-0 pixels).
@@ -649,13 +667,21 @@ struct Tracker::Impl {
       r.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
       return r;
     };
+    // A Lost frame. can_be_keyframe: it could replace the keyframe (its own texture allows). It
+    // does only when the frame before it failed too, the prediction has lapsed (a gap), or the
+    // light fixed to the camera held it: a single bad frame (a patch, a dropped half, a flash)
+    // must not become the reference of the good frames after it. Until then the next frame is
+    // aligned with the old keyframe.
     auto lost = [&](const char* why, bool can_be_keyframe) -> FrameResult {
       res.status = Status::Lost;
       res.reason = why;
       res.motion.value = predicted;
       res.motion.covariance = res.alignment_covariance = lost_covariance();
       pose = pose * predicted;
-      if (can_be_keyframe) {
+      ++lost_in_a_row;
+      // A frame misaligned by the light fixed to the camera is not a bad frame: the keyframe and
+      // the light's model are what failed, and a new keyframe takes a new model into use.
+      if (can_be_keyframe && (lost_in_a_row >= 2 || !predict || why == kMisaligned)) {
         make_keyframe(live);
         keyframe_twist_measured = false;
         res.keyframe = true;
@@ -663,6 +689,7 @@ struct Tracker::Impl {
         // The next motion is from this predicted pose: as uncertain as this one.
         prev.T = prev.T * predicted;
         prev_covariance = lost_covariance();
+        prev_predicted = true;
       }
       if (since_good > opt.max_gap_seconds) {
         velocity.setZero();
@@ -679,18 +706,14 @@ struct Tracker::Impl {
     if (!has_keyframe) {
       missing = nullptr;  // nothing to align with: not a failure of this frame's alignment
       // The frame's own texture decides whether it can be the keyframe.
-      int coarse = std::min(opt.levels, live.num_levels()) - 1;
-      while (coarse > 0 && (live.levels[static_cast<size_t>(coarse)].width < kMinLevelSide ||
-                            live.levels[static_cast<size_t>(coarse)].height < kMinLevelSide))
-        --coarse;
-      const double texture = aligner.texture(live, coarse);
-      if (!(texture >= kMinSelfTexture)) {
+      if (!has_own_texture(live)) {
         res.status = Status::Lost;
         res.reason = kNoTexture;
         return done(res);
       }
       make_keyframe(live);
       keyframe_twist_measured = false;
+      lost_in_a_row = 0;
       res.status = Status::First;
       res.keyframe = true;
       since_good = 0.0;
@@ -728,12 +751,21 @@ struct Tracker::Impl {
     if (ok) remember(live, est);  // before a new keyframe replaces the one aligned with
     else missing = reason;
     est.T = est.T * shutter_offset;
-    if (!ok) return lost(reason, reason != kAlignNoLiveTexture);
+    // "No texture in the live frame" compares it with the keyframe: a frame with texture of its
+    // own may still replace a keyframe whose texture the frames after it no longer show.
+    if (!ok) return lost(reason, reason != kAlignNoLiveTexture || has_own_texture(live));
     if (res.status == Status::Lost) return lost(res.reason, true);
     if (time_problem && res.status == Status::Ok) {
       res.status = Status::Degraded;
       res.reason = time_problem;
     }
+    // Its pose is right, but the motion from the frame before carries that frame's prediction
+    // error (the two motions together are right).
+    if (prev_predicted && res.status == Status::Ok) {
+      res.status = Status::Degraded;
+      res.reason = kAfterLost;
+    }
+    prev_predicted = false;
 
     // Frame-to-frame motion from the keyframe-relative estimates, and its covariance: with
     // prev.T = P exp(xi_p) and est.T = E exp(xi_e), the motion is m exp(xi_e - Ad(m^-1) xi_p);
@@ -746,6 +778,7 @@ struct Tracker::Impl {
     if (dt > 0.0) velocity = res.motion.value.log() / dt;
     if (has_live_c) readout_twist.commit(live_c, live_tc);
     since_good = 0.0;
+    lost_in_a_row = 0;
     if (res.overlap < opt.keyframe_overlap || scale_change(est.T) > opt.keyframe_scale_change) {
       make_keyframe(live);
       keyframe_twist_measured = true;
