@@ -2,7 +2,8 @@
 # Builds the libFuzzer targets (fuzz/, clang + ASan + UBSan) in build-fuzz/ and runs each one, or
 # the ones named, for a given time, starting from a copy of its seed corpus (fuzz/seeds/TARGET).
 # Prints a table: executions, corpus size and findings (crash, hang, out-of-memory and leak
-# artifacts, and sanitizer reports in the log). Exit status 1 when anything was found.
+# artifacts, and sanitizer reports in the log). Exit status 1 when anything was found, or when a
+# target was not built or executed nothing (it did not start).
 #
 #   scripts/fuzz.sh [-t SECONDS] [-j JOBS] [-b BUILD_DIR] [--no-build] [--report] [TARGET...]
 #
@@ -73,6 +74,11 @@ dict_for() {
 run_one() {
   local t=$1 dir="$build/fuzz-runs/$1"
   rm -rf "$dir"
+  if [ ! -x "$build/fuzz/fuzz_$t" ]; then
+    mkdir -p "$dir"
+    echo "not built: $build/fuzz/fuzz_$t" >"$dir/missing"
+    return
+  fi
   mkdir -p "$dir/corpus" "$dir/artifacts" "$dir/tmp"
   cp "$root/fuzz/seeds/$t/"* "$dir/corpus/"
   local dict args=()
@@ -108,7 +114,12 @@ printf '%-16s %8s %12s %9s %7s %7s %6s %5s %5s %10s\n' \
   target seconds executions exec/s corpus crashes hangs ooms leaks sanitizer
 for t in "${targets[@]}"; do
   dir="$build/fuzz-runs/$t"
-  [ -f "$dir/seconds" ] || { printf '%-16s (not run)\n' "$t"; continue; }
+  if [ -f "$dir/missing" ]; then
+    printf '%-16s NOT BUILT (%s)\n' "$t" "$build/fuzz/fuzz_$t"
+    found=1
+    continue
+  fi
+  [ -f "$dir/seconds" ] || { printf '%-16s (not run)\n' "$t"; found=1; continue; }
   secs=$(cat "$dir/seconds")
   execs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$dir/log.txt" | tail -1)
   # A run that died without libFuzzer's final statistics: its last status line "#N ...".
@@ -123,7 +134,12 @@ for t in "${targets[@]}"; do
   reports=$(grep -c -E 'ERROR: (Address|Leak|Undefined)Sanitizer|runtime error:|broken promise' "$dir/log.txt" || true)
   printf '%-16s %8s %12s %9s %7s %7s %6s %5s %5s %10s\n' \
     "$t" "$secs" "$execs" "$rate" "$corpus" "$crashes" "$hangs" "$ooms" "$leaks" "$reports"
-  if [ $((crashes + hangs + ooms + leaks + reports)) -gt 0 ]; then
+  # A target that ran nothing (it did not start, or died before its first input) found nothing
+  # only because it never looked.
+  if [ "$execs" -eq 0 ]; then
+    found=1
+    echo "  -> $t executed nothing: $dir/log.txt" >&2
+  elif [ $((crashes + hangs + ooms + leaks + reports)) -gt 0 ]; then
     found=1
     echo "  -> $dir/log.txt, $dir/artifacts/" >&2
   fi

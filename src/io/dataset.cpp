@@ -381,8 +381,10 @@ void Dataset::open_bag(const std::string& file, const DatasetOptions& options) {
                                       std::tuple{&d.groundtruth, &d.has_groundtruth, "--groundtruth-topic"}}) {
     *has = !samples->empty();
     if (!*has) continue;
+    // A lambda may not capture a structured binding before C++20 (clang 14 refuses it).
+    const std::vector<StampedPose>& poses = *samples;
     require_some_frame(
-        *samples, [&](int64_t i) { return interpolate_pose(*samples, d.frames[static_cast<size_t>(i)].t).has_value(); },
+        poses, [&](int64_t i) { return interpolate_pose(poses, d.frames[static_cast<size_t>(i)].t).has_value(); },
         n, d.directory + ": the " + option + " messages' times (s after the first frame)",
         "are both stamped on the same clock?");
   }
