@@ -2,6 +2,7 @@
 #include "ocl/manifest.h"
 
 #include <cctype>
+#include <cstdlib>
 
 #include "core/error.h"
 #include "ocl/program_cache.h"
@@ -54,9 +55,9 @@ std::vector<ManifestEntry> parse_manifest(const std::string& text, const std::st
     std::vector<std::string> f = split_tabs(line);
     // A hand-written line may end in a TAB that an editor kept.
     if (f.size() >= 6 && f.back().empty()) f.pop_back();
-    if (f.size() < 5 || f.size() > 7)
-      throw_invalid_input(where() + "expected 5 to 7 TAB-separated fields (program, options " +
-                          "hash, file, device, driver, options, for), found " +
+    if (f.size() < 5 || f.size() > 9 || f.size() == 8)
+      throw_invalid_input(where() + "expected 5 to 7, or 9, TAB-separated fields (program, options " +
+                          "hash, file, device, driver, options, for, size, sha256), found " +
                           std::to_string(f.size()) + " (are the fields separated by TABs?)");
     ManifestEntry e;
     e.program = f[0];
@@ -65,8 +66,22 @@ std::vector<ManifestEntry> parse_manifest(const std::string& text, const std::st
     e.device = f[3];
     e.driver = f[4];
     e.options = normalize_build_options(f.size() >= 6 ? f[5] : std::string());
-    e.uses = f.size() == 7 ? f[6] : std::string();
+    e.uses = f.size() >= 7 ? f[6] : std::string();
     e.line = line_no;
+    if (f.size() == 9) {
+      if (f[7] != "-") {
+        char* stop = nullptr;
+        const long long size = std::strtoll(f[7].c_str(), &stop, 10);
+        if (f[7].empty() || *stop != '\0' || size < 0)
+          throw_invalid_input(where() + "size \"" + f[7] + "\" is not a number of bytes (or -)");
+        e.size = size;
+      }
+      if (f[8] != "-") {
+        const bool hex = f[8].size() == 64 && f[8].find_first_not_of("0123456789abcdef") == std::string::npos;
+        if (!hex) throw_invalid_input(where() + "sha256 \"" + f[8] + "\" is not 64 lowercase hex digits (or -)");
+        e.sha256 = f[8];
+      }
+    }
     if (e.program.empty() || e.file.empty() || e.device.empty() || e.driver.empty())
       throw_invalid_input(where() + "program, file, device and driver must not be empty (use * " +
                           "for any device or driver)");
@@ -81,15 +96,20 @@ std::vector<ManifestEntry> parse_manifest(const std::string& text, const std::st
 
 std::string format_manifest(const std::vector<ManifestEntry>& entries) {
   std::string out =
-      "# planarvo kernel binaries manifest, format 2 (see src/ocl/README.md).\n"
+      "# planarvo kernel binaries manifest, format 3 (see src/ocl/README.md).\n"
       "# One binary per line, TAB-separated: program, options-hash (FNV-1a 64 of the options,\n"
       "# or - to skip the check), file (relative to this directory), device (CL_DEVICE_NAME or\n"
       "# *), driver (CL_DRIVER_VERSION or *), options (normalised build options; may be absent),\n"
-      "# for (the commands that need it, comma-separated; may be absent).\n";
+      "# for (the commands that need it, comma-separated; may be absent), size (bytes) and\n"
+      "# sha256 of the file (both absent, or -, to skip the check).\n";
   for (const ManifestEntry& e : entries) {
     out += e.program + '\t' + e.options_hash + '\t' + e.file + '\t' + e.device + '\t' + e.driver;
-    if (!e.options.empty() || !e.uses.empty()) out += '\t' + e.options;
-    if (!e.uses.empty()) out += '\t' + e.uses;
+    const bool checked = e.size >= 0 || !e.sha256.empty();
+    if (!e.options.empty() || !e.uses.empty() || checked) out += '\t' + e.options;
+    if (!e.uses.empty() || checked) out += '\t' + e.uses;
+    if (checked)
+      out += '\t' + (e.size >= 0 ? std::to_string(e.size) : std::string("-")) + '\t' +
+             (e.sha256.empty() ? std::string("-") : e.sha256);
     out += '\n';
   }
   return out;

@@ -1,11 +1,12 @@
 // The manifest of a prebuilt-binaries directory: which file holds which program, built with
-// which options, for which device. Internal to src/ocl; README.md repeats the format for users.
+// which options, for which device, and what its bytes are. Internal to src/ocl; README.md
+// repeats the format for users.
 //
 // <dir>/planarvo-kernels.txt is UTF-8 text. Lines that are blank or whose first non-blank
-// character is '#' are comments. Every other line describes one binary in 5, 6 or 7 fields
+// character is '#' are comments. Every other line describes one binary in 5 to 9 fields
 // separated by TAB characters (spaces around a field are ignored):
 //
-//   program  options-hash  file  device  driver  [options  [for]]
+//   program  options-hash  file  device  driver  [options  [for  [size  sha256]]]
 //
 //   program       the program's name: kernels/<program>.cl, e.g. "fill"
 //   options-hash  FNV-1a 64 of the normalised options, as 16 lowercase hex digits; "-" skips
@@ -22,6 +23,10 @@
 //                 absent or empty when unknown. Informative only: lookups never read it.
 //                 Manifests of format 1 (before this field) have 5 or 6 fields and stay valid;
 //                 a line with this field and no options has an empty sixth field.
+//   size, sha256  the file's size in bytes and its SHA-256 (64 lowercase hex digits), written
+//                 by export since format 3; "-" (or absent) skips the check. A file that does
+//                 not match is refused before the driver sees it: a truncated, swapped or
+//                 corrupted binary crashed or silently misled drivers (issue 27).
 //
 // A program is looked up by (program, normalised options); among its lines, the first whose
 // device and driver match the running device is used. Lines for other devices may share one
@@ -40,6 +45,8 @@ struct ManifestEntry {
   std::string driver;        // or "*"
   std::string options;       // normalised
   std::string uses;          // the "for" field: comma-separated uses, "" when unknown
+  long long size = -1;       // bytes; -1: not recorded
+  std::string sha256;        // 64 hex digits; "": not recorded
   int line = 0;              // 1-based line in the manifest, for messages
 };
 

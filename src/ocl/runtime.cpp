@@ -12,6 +12,7 @@
 #include <system_error>
 
 #include "core/error.h"
+#include "core/sha256.h"
 #include "ocl/cache_dirs.h"
 #include "ocl/embedded.h"
 #include "ocl/manifest.h"
@@ -392,6 +393,9 @@ cl::Program Runtime::load_from_binaries(const std::string& name, const std::stri
   const std::string where = "the prebuilt binaries directory " + quote(dir) +
                             " (--kernel-binaries)";
 
+  std::error_code ec;
+  if (fs::exists(manifest_path, ec) && !fs::is_regular_file(manifest_path, ec))
+    throw_invalid_input("the manifest " + quote(manifest_path.string()) + " is not a file (" + where + ")");
   const auto text = detail::read_file(manifest_path);
   if (!text)
     throw_invalid_input("cannot load " + what + ": " + where + " has no manifest " +
@@ -445,6 +449,9 @@ cl::Program Runtime::load_from_binaries(const std::string& name, const std::stri
   }
 
   const fs::path file = fs::path(dir) / entry->file;
+  if (fs::exists(file, ec) && !fs::is_regular_file(file, ec))
+    throw_invalid_input("the binary file " + quote(file.string()) + " for " + what + " is not a file (" + where +
+                        ", manifest line " + std::to_string(entry->line) + ")");
   const auto binary = detail::read_file(file);
   if (!binary)
     throw_invalid_input("the binary file " + quote(file.string()) + " for " + what +
@@ -453,6 +460,17 @@ cl::Program Runtime::load_from_binaries(const std::string& name, const std::stri
   if (binary->empty())
     throw_invalid_input("the binary file " + quote(file.string()) + " for " + what +
                         " is empty (" + where + ")");
+  // Checked before the driver parses it: a truncated binary crashed a driver, and one program's
+  // binary under another's name ran and tracked nothing.
+  const std::string manifest_line = where + ", manifest line " + std::to_string(entry->line);
+  if (entry->size >= 0 && static_cast<long long>(binary->size()) != entry->size)
+    throw_invalid_input("the binary file " + quote(file.string()) + " for " + what + " is " +
+                        std::to_string(binary->size()) + " bytes, the manifest says " + std::to_string(entry->size) +
+                        " (truncated or replaced? " + manifest_line + "); export the binaries again");
+  if (!entry->sha256.empty() && sha256_hex(binary->data(), binary->size()) != entry->sha256)
+    throw_invalid_input("the binary file " + quote(file.string()) + " for " + what +
+                        " does not have the SHA-256 the manifest records (corrupted or another program's? " +
+                        manifest_line + "); export the binaries again");
 
   const std::string effective = effective_build_options(options);
   cl::Program p;
@@ -562,6 +580,8 @@ size_t Runtime::export_binaries(const std::string& dir, const std::vector<std::s
       e.device = info_.device_name;
       e.driver = info_.driver_version;
       e.uses = join(registered_uses(name, options), ",");
+      e.size = static_cast<long long>(binaries[0].size());
+      e.sha256 = sha256_hex(binaries[0].data(), binaries[0].size());
       if (!detail::write_file_atomically(fs::path(dir) / e.file, binaries[0].data(),
                                          binaries[0].size()))
         throw Error(ErrorCode::Io, "cannot write " + quote((fs::path(dir) / e.file).string()));

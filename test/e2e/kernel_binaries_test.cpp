@@ -9,6 +9,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -197,6 +198,60 @@ TEST_F(KernelBinaries, MissingManifestEntryIsExit2AndWritesNothing) {
   EXPECT_EQ(r.output.find("::"), std::string::npos) << r.output;  // no C++ names
 }
 
+// Every binary of a copy of the export truncated, rotated (each under the next one's name),
+// corrupted by one byte, or replaced by a directory; and the manifest a directory. Each is exit
+// 2 naming the file before the driver sees the bytes (issue 27: a truncated binary crashed the
+// driver with SIGSEGV; one variant's binary under every variant's name ran and lost every frame;
+// a directory was "internal error"), and the trajectory is not written.
+TEST_F(KernelBinaries, DamagedBinariesAreExit2NamingTheFileBeforeTheDriverSeesThem) {
+  std::vector<std::string> bins;
+  for (const auto& e : fs::directory_iterator(all()))
+    if (e.path().extension() == ".bin") bins.push_back(e.path().filename().string());
+  std::sort(bins.begin(), bins.end());
+  ASSERT_GE(bins.size(), 2u);
+  const auto damaged = [&](const std::string& name, const std::function<void(const fs::path&)>& damage,
+                           const std::string& says) {
+    SCOPED_TRACE(name);
+    const fs::path dir = path("damaged-" + name);
+    fs::create_directories(dir);
+    for (const auto& e : fs::directory_iterator(all())) fs::copy_file(e.path(), dir / e.path().filename());
+    damage(dir);
+    const std::string out = path("track-" + name + ".txt");
+    const auto r = run_cli(track_args(out) + from_binaries(dir.string()), empty_pocl_cache(name));
+    EXPECT_EQ(r.exit_code, 2) << r.output;
+    EXPECT_FALSE(fs::exists(out));
+    EXPECT_NE(r.output.find(dir.string()), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find(says), std::string::npos) << r.output;
+  };
+  damaged("truncated", [&](const fs::path& d) {
+    for (const std::string& b : bins) fs::resize_file(d / b, fs::file_size(d / b) / 2);
+  }, "the manifest says");
+  damaged("rotated", [&](const fs::path& d) {
+    fs::rename(d / bins[0], d / "first");
+    for (size_t i = 0; i + 1 < bins.size(); ++i) fs::rename(d / bins[i + 1], d / bins[i]);
+    fs::rename(d / "first", d / bins.back());
+  }, "manifest");
+  damaged("corrupted", [&](const fs::path& d) {
+    for (const std::string& b : bins) {
+      std::fstream f(d / b, std::ios::in | std::ios::out | std::ios::binary);
+      f.seekg(static_cast<std::streamoff>(fs::file_size(d / b) / 2));
+      const char c = static_cast<char>(f.get());
+      f.seekp(static_cast<std::streamoff>(fs::file_size(d / b) / 2));
+      f.put(static_cast<char>(c ^ 0x5a));
+    }
+  }, "SHA-256");
+  damaged("directories", [&](const fs::path& d) {
+    for (const std::string& b : bins) {
+      fs::remove(d / b);
+      fs::create_directory(d / b);
+    }
+  }, "is not a file");
+  damaged("manifest-directory", [&](const fs::path& d) {
+    fs::remove(d / "planarvo-kernels.txt");
+    fs::create_directory(d / "planarvo-kernels.txt");
+  }, "is not a file");
+}
+
 TEST_F(KernelBinaries, ExportForTrackIsASubsetThatSufficesForTrack) {
   const std::string dir = path("track-kernels");
   auto r = run_cli("kernels --export " + dir + " --for track " + compiled());
@@ -211,7 +266,7 @@ TEST_F(KernelBinaries, ExportForTrackIsASubsetThatSufficesForTrack) {
       std::vector<std::string> f;
       std::istringstream in(line);
       for (std::string field; std::getline(in, field, '\t');) f.push_back(field);
-      EXPECT_EQ(f.size(), f[0] == "fill" ? 5u : 7u) << line;  // the engine's own say what they are for
+      EXPECT_EQ(f.size(), 9u) << line;  // ... for, size, sha256
       f.resize(7);
       out.push_back(f[0] + " | " + f[5] + " | " + f[6]);
     }

@@ -10,6 +10,7 @@
 
 #include "common/test_util.h"
 #include "core/error.h"
+#include "core/sha256.h"
 #include "ocl/manifest.h"
 #include "ocl/runtime.h"
 #include "unit/ocl_test_helpers.h"
@@ -177,10 +178,11 @@ TEST_F(OclBinaries, BinaryForAnotherDriverIsMismatched) {
   const auto line = fill_line("");
   ASSERT_GE(line.size(), 5u);
   std::string text = read_text(dir_ / ocl::kManifestFileName);
-  const std::string old_fields = '\t' + line[3] + '\t' + line[4] + '\n';
+  const char end = line.size() > 5 ? '\t' : '\n';
+  const std::string old_fields = '\t' + line[3] + '\t' + line[4] + end;
   const size_t at = text.find(line[2] + old_fields);
   ASSERT_NE(at, std::string::npos);
-  text.replace(at + line[2].size(), old_fields.size(), '\t' + line[3] + "\t0.0-older\n");
+  text.replace(at + line[2].size(), old_fields.size(), '\t' + line[3] + "\t0.0-older" + end);
   write_text(dir_ / ocl::kManifestFileName, text);
 
   ocl::Runtime rt(from_binaries(dir_));
@@ -203,10 +205,24 @@ TEST_F(OclBinaries, VariantNotExportedIsNamed) {
   EXPECT_EQ(rt.stats().built_from_source, 0);  // no fallback to the compiler
 }
 
+// Garbage under a manifest line that checks neither size nor hash (a hand-written one): the
+// driver's refusal. With the exported line's size and SHA-256 the file never reaches the driver
+// (KernelBinaries.DamagedBinariesAreExit2NamingTheFileBeforeTheDriverSeesThem).
 TEST_F(OclBinaries, DriverRejectingTheBinaryIsAnOpenCLError) {
   const auto line = fill_line("");
-  ASSERT_FALSE(line.empty());
+  ASSERT_EQ(line.size(), 9u);
   write_text(dir_ / line[2], std::string(4096, '\x7f'));
+  {
+    ocl::Runtime checked(from_binaries(dir_));
+    const std::string msg = test::error_message([&] { checked.program("fill"); }, ErrorCode::InvalidInput);
+    EXPECT_THAT(msg, HasSubstr("4096 bytes, the manifest says " + line[7]));
+  }
+  std::string text = read_text(dir_ / ocl::kManifestFileName);
+  const std::string checks = '\t' + line[7] + '\t' + line[8];
+  const size_t at = text.find(line[2] + '\t' + line[3] + '\t' + line[4]);
+  ASSERT_NE(at, std::string::npos);
+  text.replace(text.find(checks, at), checks.size(), "\t-\t-");
+  write_text(dir_ / ocl::kManifestFileName, text);
   ocl::Runtime rt(from_binaries(dir_));
   const std::string msg = test::error_message([&] { rt.program("fill"); }, ErrorCode::OpenCL);
   EXPECT_THAT(msg, HasSubstr("\"fill\""));
@@ -282,7 +298,7 @@ TEST(OclBinariesExport, ForAUseWritesOnlyItsVariantsAndSaysWhatTheyAreFor) {
   ASSERT_EQ(lines.size(), 2u);  // VARIANT=21 and 22; nothing of the engine's own programs
   std::map<std::string, std::string> for_field;
   for (const auto& f : lines) {
-    ASSERT_EQ(f.size(), 7u);
+    ASSERT_EQ(f.size(), 9u);  // ... for, size, sha256
     EXPECT_EQ(f[0], "fill");
     for_field[f[5]] = f[6];
   }
@@ -338,6 +354,52 @@ TEST(OclManifest, ReadsFormat1And2Lines) {
       ErrorCode::InvalidInput);
   EXPECT_THAT(eight, HasSubstr("m.txt:1"));
   EXPECT_THAT(eight, HasSubstr("found 8"));
+}
+
+// Format 3: each binary's size and SHA-256, checked before the driver sees the file.
+TEST(OclManifest, ReadsAndChecksFormat3SizeAndHash) {
+  const std::string hash(64, 'a');
+  const std::string text = "fill\t-\ta.bin\t*\t*\t\t\t1234\t" + hash + "\n" +
+                           "fill\t-\tb.bin\t*\t*\t-D VARIANT=7\ttrack\t-\t-\n";
+  const auto e = ocl::detail::parse_manifest(text, "m.txt");
+  ASSERT_EQ(e.size(), 2u);
+  EXPECT_EQ(e[0].size, 1234);
+  EXPECT_EQ(e[0].sha256, hash);
+  EXPECT_EQ(e[1].size, -1);
+  EXPECT_EQ(e[1].sha256, "");
+  EXPECT_EQ(e[1].uses, "track");
+  const auto back = ocl::detail::parse_manifest(ocl::detail::format_manifest(e), "m.txt");
+  ASSERT_EQ(back.size(), 2u);
+  EXPECT_EQ(back[0].size, 1234);
+  EXPECT_EQ(back[0].sha256, hash);
+  for (const char* bad : {"fill\t-\ta.bin\t*\t*\t\t\t12x\t-\n", "fill\t-\ta.bin\t*\t*\t\t\t-\tABC\n",
+                                 "fill\t-\ta.bin\t*\t*\t\t\t-1\t-\n"}) {
+    const std::string msg = test::error_message([&] { ocl::detail::parse_manifest(bad, "m.txt"); },
+                                                ErrorCode::InvalidInput);
+    EXPECT_THAT(msg, HasSubstr("m.txt:1")) << bad;
+  }
+}
+
+// Against FIPS 180-4's examples (and the million-'a' vector of its test suite).
+TEST(Sha256, MatchesThePublishedVectors) {
+  EXPECT_EQ(sha256_hex("", 0), "e3b0c44298fc1c149afbf4c8996fb92427ae41e4649b934ca495991b7852b855");
+  EXPECT_EQ(sha256_hex("abc", 3), "ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad");
+  const std::string two_blocks = "abcdbcdecdefdefgefghfghighijhijkijkljklmklmnlmnomnopnopq";
+  EXPECT_EQ(sha256_hex(two_blocks.data(), two_blocks.size()),
+            "248d6a61d20638b8e5c026930c3e6039a33ce45964ff2167f6ecedd419db06c1");
+  const std::string million(1000000, 'a');
+  EXPECT_EQ(sha256_hex(million.data(), million.size()),
+            "cdc76e5c9914fb9281a1c7e284d73e67f1809a48a497200e046d39ccc7112cd0");
+  // Lengths around the padding's block boundaries, against coreutils' sha256sum.
+  const std::map<size_t, std::string> sums = {
+      {55, "9f4390f8d30c2dd92ec9f095b65e2b9ae9b0a925a5258e241c9f1e910f734318"},
+      {56, "b35439a4ac6f0948b6d6f9e3c6af0f5f590ce20f1bde7090ef7970686ec6738a"},
+      {63, "7d3e74a05d7db15bce4ad9ec0658ea98e3f06eeecf16b4c6fff2da457ddc2f34"},
+      {64, "ffe054fe7ae0cb6dc65c3af9b61d5209f439851db43d0ba5997337df154668eb"},
+      {65, "635361c48bb9eab14198e76ea8ab7f1a41685d6ad62aa9146d301d4f17eb0ae0"},
+      {119, "31eba51c313a5c08226adf18d4a359cfdfd8d2e816b13f4af952f7ea6584dcfb"},
+      {120, "2f3d335432c70b580af0e8e1b3674a7c020d683aa5f73aaaedfdc55af904c21c"}};
+  for (const auto& [n, sum] : sums) EXPECT_EQ(sha256_hex(million.data(), n), sum) << n << " bytes";
 }
 
 TEST(OclBinariesExport, UnwritableDirectoryIsAnIoError) {
