@@ -77,6 +77,8 @@ cv::Mat read_image(const fs::path& file, const CameraModel& camera, const std::s
   const std::string name = file.string();
   std::error_code ec;
   if (!fs::exists(file, ec)) throw_invalid_input(name + ": the image does not exist (" + context + ")");
+  if (const std::string cut = detail::file_truncation_problem(name); !cut.empty())
+    throw_invalid_input(name + ": " + cut + " (" + context + ")");
   cv::Mat img;
   try {
     // ANYDEPTH so that 16-bit images are seen (and rejected) rather than silently scaled;

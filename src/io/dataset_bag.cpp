@@ -340,6 +340,8 @@ cv::Mat BagSource::frame(int64_t i) {
   try {
     if (d.compressed) {
       const bag::CompressedImageMessage m = bag::decode_compressed_image(ser, d.buffer.data(), d.buffer.size());
+      if (const std::string cut = detail::truncation_problem(m.data.data(), m.data.size()); !cut.empty())
+        throw_invalid_input("the \"" + m.format + "\" image: " + cut);
       cv::Mat img;
       try {
         img = cv::imdecode(m.data, cv::IMREAD_ANYDEPTH | cv::IMREAD_ANYCOLOR);

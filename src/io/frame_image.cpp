@@ -1,5 +1,8 @@
 #include "io/frame_image.h"
 
+#include <algorithm>
+#include <fstream>
+
 #include <opencv2/imgproc.hpp>
 
 #include "core/error.h"
@@ -32,6 +35,44 @@ cv::Mat to_grey_checked(const cv::Mat& img, const CameraModel& camera, const std
                           " channels (" + context + ")");
   }
   return grey;
+}
+
+std::string truncation_problem(const unsigned char* head, size_t head_size, const unsigned char* tail,
+                               size_t tail_size) {
+  const auto holds = [&](const unsigned char* marker, size_t n) {
+    for (size_t i = 0; i + n <= tail_size; ++i)
+      if (std::equal(marker, marker + n, tail + i)) return true;
+    return false;
+  };
+  if (head_size >= 3 && head[0] == 0xFF && head[1] == 0xD8 && head[2] == 0xFF) {
+    static const unsigned char eoi[2] = {0xFF, 0xD9};
+    if (!holds(eoi, 2)) return "the JPEG data end without their end-of-image marker: the file was cut short";
+  } else if (static const unsigned char png[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1A, '\n'};
+             head_size >= 8 && std::equal(head, head + 8, png)) {
+    static const unsigned char iend[4] = {'I', 'E', 'N', 'D'};
+    if (!holds(iend, 4)) return "the PNG data end without their IEND chunk: the file was cut short";
+  }
+  return "";
+}
+
+std::string truncation_problem(const unsigned char* data, size_t size) {
+  const size_t tail = std::min<size_t>(size, 64);
+  return truncation_problem(data, size, data + size - tail, tail);
+}
+
+std::string file_truncation_problem(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return "";  // the decoder says what is wrong with a file it cannot read
+  unsigned char head[8] = {}, tail[64] = {};
+  in.read(reinterpret_cast<char*>(head), sizeof head);
+  const auto got = static_cast<size_t>(in.gcount());
+  in.clear();
+  in.seekg(0, std::ios::end);
+  const auto size = static_cast<long long>(in.tellg());
+  const long long from = std::max<long long>(0, size - 64);
+  in.seekg(from);
+  in.read(reinterpret_cast<char*>(tail), static_cast<std::streamsize>(size - from));
+  return truncation_problem(head, got, tail, static_cast<size_t>(in.gcount()));
 }
 
 }  // namespace planarvo::io::detail

@@ -87,6 +87,55 @@ TEST(CliBadFrames, AreAnErrorUnlessSkippedThenGaps) {
   }
 }
 
+// A JPEG cut to a third (a copy interrupted, a card full): libjpeg decodes it with a warning
+// and grey rows where the data stop, so it passed `info --verify` and `track` and the tracker
+// lost frames on it (issue 27). It is a bad image now: exit 2 naming it, a gap with
+// --skip-bad-frames. The same for a PNG cut short.
+TEST(CliBadFrames, AnImageCutShortIsABadImage) {
+  test::ScratchDir d;
+  const fs::path seq = d / "seq";
+  auto r = run_cli("simulate --quiet --seconds 0.5 --width 160 --height 120 --seed 4 --out " + quoted(seq));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  std::vector<io::FrameEntry> frames = io::read_frames((seq / "frames.txt").string());
+  std::ofstream list(seq / "frames.txt");
+  for (io::FrameEntry& f : frames) {
+    const fs::path jpg = fs::path(f.path).replace_extension(".jpg");
+    ASSERT_TRUE(cv::imwrite((seq / jpg).string(), cv::imread((seq / f.path).string(), cv::IMREAD_GRAYSCALE)));
+    f.path = jpg.string();
+    list << f.t << " " << f.path << "\n";
+  }
+  list.close();
+  const fs::path traj = d / "traj.txt", stats = d / "stats.csv";
+  const std::string track = "track --quiet " + quoted(seq) + " --extrinsics " + quoted(seq / "extrinsics_gt.yaml") +
+                            " -o " + quoted(traj) + " --stats " + quoted(stats);
+  r = run_cli("info --verify " + quoted(seq));
+  ASSERT_EQ(r.exit_code, 0) << r.output;  // whole JPEGs are fine
+
+  const size_t cut = 6;
+  const fs::path cut_file = seq / frames[cut].path;
+  fs::resize_file(cut_file, fs::file_size(cut_file) / 3);
+  for (const std::string& cmd : {"info --verify " + quoted(seq), track}) {
+    r = run_cli(cmd);
+    EXPECT_EQ(r.exit_code, 2) << cmd << "\n" << r.output;
+    EXPECT_NE(r.output.find(cut_file.filename().string()), std::string::npos) << r.output;
+  }
+  r = run_cli(track + " --skip-bad-frames");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const std::vector<double> skipped = stats_times(stats, "skipped");
+  ASSERT_EQ(skipped.size(), 1u);
+  EXPECT_NEAR(skipped[0], frames[cut].t, 1e-6);
+  EXPECT_EQ(io::read_tum(traj.string()).size(), frames.size() - 1);
+
+  // A PNG cut short: the same refusal.
+  const fs::path png = d / "cut.png";
+  ASSERT_TRUE(cv::imwrite(png.string(), cv::imread(cut_file.string().replace(cut_file.string().size() - 4, 4, ".png"),
+                                                   cv::IMREAD_GRAYSCALE)));
+  fs::resize_file(png, fs::file_size(png) / 3);
+  fs::copy_file(png, seq / frames[cut].path, fs::copy_options::overwrite_existing);
+  r = run_cli("info --verify " + quoted(seq));
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+}
+
 // Two seconds of a textureless floor in the middle of a drive: a camera's image of flat grey
 // with its pixel noise (1 grey level), valid images, so no error. Every one of those frames is
 // Lost; so is the first textured frame after them when the robot has moved on from the keyframe

@@ -13,6 +13,7 @@
 
 #include "common/test_util.h"
 #include "io/dataset.h"
+#include "io/frame_image.h"
 #include "unit/io_test_helpers.h"
 
 namespace planarvo {
@@ -92,6 +93,29 @@ TEST(IoDataset, OpensImagesAndReadsFrames) {
   // Movable: the C API holds it by pointer, callers by value.
   Dataset moved = std::move(ds);
   EXPECT_EQ(moved.frame_count(), 4);
+}
+
+// Encoded images cut short (what a CompressedImage or an image file holds when its bytes stop
+// early): JPEG and PNG as OpenCV writes them, whole and cut at several places.
+TEST(IoImageBytes, CutJpegAndPngAreFoundWholeOnesPass) {
+  cv::Mat img(48, 64, CV_8UC1);
+  cv::randu(img, 0, 255);
+  for (const char* ext : {".jpg", ".png"}) {
+    std::vector<uchar> bytes;
+    ASSERT_TRUE(cv::imencode(ext, img, bytes));
+    EXPECT_EQ(io::detail::truncation_problem(bytes.data(), bytes.size()), "") << ext;
+    for (double keep : {0.2, 0.5, 0.9}) {
+      const size_t n = static_cast<size_t>(keep * static_cast<double>(bytes.size()));
+      EXPECT_NE(io::detail::truncation_problem(bytes.data(), n), "") << ext << " cut to " << keep;
+    }
+    // Data after the end (padding a camera adds) is still a whole image.
+    std::vector<uchar> padded = bytes;
+    padded.insert(padded.end(), 16, 0);
+    EXPECT_EQ(io::detail::truncation_problem(padded.data(), padded.size()), "") << ext;
+  }
+  // Other formats are left to their decoders.
+  const unsigned char bmp[4] = {'B', 'M', 0, 0};
+  EXPECT_EQ(io::detail::truncation_problem(bmp, sizeof bmp), "");
 }
 
 TEST(IoDataset, ColourImagesAreConvertedToGrey) {
