@@ -318,6 +318,40 @@ TEST_F(McapFiles, ATruncatedFileIsInvalidInputNamingTheByte) {
   }
 }
 
+// A byte of a message in an uncompressed chunk corrupted: read through the summary's index, the
+// message is refused by its chunk's uncompressed_crc (before, the index path read the message
+// straight from the file and returned the corrupt bytes).
+TEST_F(McapFiles, ACorruptMessageReadThroughTheIndexFailsItsChunksCrc) {
+  const auto clean = open_mcap(file("chunked_none"));
+  const std::vector<MessageRef> refs = clean->index(indexable(*clean, expected("chunked_none")));
+  ASSERT_FALSE(refs.empty());
+  std::vector<uint8_t> message;
+  const MessageRef& victim = refs[refs.size() / 2];
+  clean->read(victim, message);
+  ASSERT_GE(message.size(), 8u);
+  std::ifstream in(file("chunked_none"), std::ios::binary);
+  std::vector<uint8_t> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const auto at = std::search(bytes.begin(), bytes.end(), message.begin(), message.end());
+  ASSERT_NE(at, bytes.end());
+  at[static_cast<std::ptrdiff_t>(message.size() / 2)] ^= 0x5a;
+  const std::string corrupt = dir_ + "/corrupt_message.mcap";
+  std::ofstream(corrupt, std::ios::binary).write(reinterpret_cast<const char*>(bytes.data()),
+                                                 static_cast<std::streamsize>(bytes.size()));
+  const auto bag = open_mcap(corrupt);
+  const std::vector<MessageRef> again = bag->index(indexable(*bag, expected("chunked_none")));
+  ASSERT_EQ(again.size(), refs.size());
+  std::string msg;
+  try {
+    bag->read(again[refs.size() / 2], message);
+    ADD_FAILURE() << "the corrupt message was read";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.code(), ErrorCode::InvalidInput);
+    msg = e.what();
+  }
+  EXPECT_NE(msg.find("uncompressed_crc"), std::string::npos) << msg;
+  EXPECT_NE(msg.find(corrupt), std::string::npos) << msg;
+}
+
 TEST_F(McapFiles, TopicsOfOtherTypesAndChannelsSharingATopic) {
   const auto bag = open_mcap(file("chunked_none"));
   std::map<std::string, TopicInfo> by_name;

@@ -256,7 +256,10 @@ void Reader::read(const MessageRef& message, std::vector<uint8_t>& out) {
   if (message.offset > records_size || message.size > records_size - message.offset)
     throw_invalid_argument(path_ + ": a message reference outside its chunk (at byte " +
                            std::to_string(message.location) + ")");
-  if (place.compression.empty()) {  // an uncompressed chunk: straight from the file
+  // An uncompressed chunk without a CRC: straight from the file. With one, the whole chunk is
+  // read (once, then kept while its messages are read) so that its CRC is checked on this path
+  // too: a corrupt message read through the index went unnoticed (issue 27).
+  if (place.compression.empty() && place.crc == 0) {
     out.resize(message.size);
     read_exact(place.records_offset + message.offset, message.size, out.data());
     return;
