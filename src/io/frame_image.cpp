@@ -39,8 +39,12 @@ cv::Mat to_grey_checked(const cv::Mat& img, const CameraModel& camera, const std
 
 std::string truncation_problem(const unsigned char* head, size_t head_size, const unsigned char* tail,
                                size_t tail_size) {
+  // Zero bytes after the image (a card's block padding) are skipped; the marker is then looked
+  // for in the last 64 bytes.
+  while (tail_size > 0 && tail[tail_size - 1] == 0) --tail_size;
+  const size_t from = tail_size > 64 ? tail_size - 64 : 0;
   const auto holds = [&](const unsigned char* marker, size_t n) {
-    for (size_t i = 0; i + n <= tail_size; ++i)
+    for (size_t i = from; i + n <= tail_size; ++i)
       if (std::equal(marker, marker + n, tail + i)) return true;
     return false;
   };
@@ -56,20 +60,20 @@ std::string truncation_problem(const unsigned char* head, size_t head_size, cons
 }
 
 std::string truncation_problem(const unsigned char* data, size_t size) {
-  const size_t tail = std::min<size_t>(size, 64);
+  const size_t tail = std::min<size_t>(size, 4096);
   return truncation_problem(data, size, data + size - tail, tail);
 }
 
 std::string file_truncation_problem(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) return "";  // the decoder says what is wrong with a file it cannot read
-  unsigned char head[8] = {}, tail[64] = {};
+  unsigned char head[8] = {}, tail[4096] = {};
   in.read(reinterpret_cast<char*>(head), sizeof head);
   const auto got = static_cast<size_t>(in.gcount());
   in.clear();
   in.seekg(0, std::ios::end);
   const auto size = static_cast<long long>(in.tellg());
-  const long long from = std::max<long long>(0, size - 64);
+  const long long from = std::max<long long>(0, size - static_cast<long long>(sizeof tail));
   in.seekg(from);
   in.read(reinterpret_cast<char*>(tail), static_cast<std::streamsize>(size - from));
   return truncation_problem(head, got, tail, static_cast<size_t>(in.gcount()));

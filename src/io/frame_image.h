@@ -17,13 +17,13 @@ cv::Mat to_grey_checked(const cv::Mat& img, const CameraModel& camera, const std
                         const std::string& context, const std::string& camera_from = "camera.yaml");
 
 // What is wrong with an encoded image's bytes that its decoder only warns about ("" when
-// nothing): a JPEG whose end-of-image marker (FF D9) is missing from its last 64 bytes, or a PNG
-// without its IEND chunk there: the file was cut short. libjpeg decodes a truncated JPEG with a
+// nothing): a JPEG whose end-of-image marker (FF D9) is missing from its last 64 bytes (zero
+// padding after it skipped), or a PNG without its IEND chunk there: the file was cut short. libjpeg decodes a truncated JPEG with a
 // warning on stderr and grey rows where the data stopped, which the tracker then loses frames
-// on (issue 27). head: the first bytes (at least 8 for the check), tail: the last up to 64.
+// on (issue 27). head: the first bytes (at least 8 for the check), tail: the last (up to 4096).
 std::string truncation_problem(const unsigned char* head, size_t head_size, const unsigned char* tail,
                                size_t tail_size);
-// The same on a whole buffer, and on a file (reads its first 8 and last 64 bytes).
+// The same on a whole buffer, and on a file (reads its first 8 and last 4096 bytes).
 std::string truncation_problem(const unsigned char* data, size_t size);
 std::string file_truncation_problem(const std::string& path);
 

@@ -108,9 +108,11 @@ TEST(IoImageBytes, CutJpegAndPngAreFoundWholeOnesPass) {
       const size_t n = static_cast<size_t>(keep * static_cast<double>(bytes.size()));
       EXPECT_NE(io::detail::truncation_problem(bytes.data(), n), "") << ext << " cut to " << keep;
     }
-    // Data after the end (padding a camera adds) is still a whole image.
+    // Data after the end (a little, or a card's zero padding) is still a whole image.
     std::vector<uchar> padded = bytes;
-    padded.insert(padded.end(), 16, 0);
+    padded.insert(padded.end(), 16, 0x20);
+    EXPECT_EQ(io::detail::truncation_problem(padded.data(), padded.size()), "") << ext;
+    padded.insert(padded.end(), 2000, 0);
     EXPECT_EQ(io::detail::truncation_problem(padded.data(), padded.size()), "") << ext;
   }
   // Other formats are left to their decoders.
