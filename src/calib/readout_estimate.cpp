@@ -153,6 +153,58 @@ double finite_mean(const std::vector<double>& v) {
   return n > 0 ? s / n : HUGE_VAL;
 }
 
+// Each frame's residual variance as a parabola in r through the three candidates nearest `best`
+// (u = (r - best) / scale keeps the system well conditioned); the minimum of their sum and its
+// sandwich standard deviation over clusters of consecutive frames within a window.
+struct Fit {
+  int frames = 0;          // frames with all three variances
+  double curvature = 0.0;  // of the sum (positive: a minimum)
+  double minimum = 0.0, sigma = 0.0;  // seconds
+};
+
+Fit fit_parabolas(std::map<double, std::vector<double>>& at, const std::vector<Window>& windows, double best,
+                  double scale, size_t cluster) {
+  std::vector<std::pair<double, double>> near;  // (distance, r)
+  for (const auto& [r, v] : at) near.push_back({std::abs(r - best), r});
+  std::sort(near.begin(), near.end());
+  Eigen::Matrix3d A;
+  std::array<const std::vector<double>*, 3> y{};
+  for (size_t j = 0; j < 3; ++j) {
+    const double u = (near[j].second - best) / scale;
+    A.row(static_cast<Eigen::Index>(j)) << 1.0, u, u * u;
+    y[j] = &at[near[j].second];
+  }
+  const Eigen::Matrix3d Ainv = A.inverse();
+  const size_t n = y[0]->size();
+  std::vector<double> slope(n, kNaN), curvature(n, kNaN);
+  Fit fit;
+  double B = 0.0;
+  for (size_t i = 0; i < n; ++i) {
+    const Eigen::Vector3d v((*y[0])[i], (*y[1])[i], (*y[2])[i]);
+    if (!v.allFinite()) continue;
+    const Eigen::Vector3d c = Ainv * v;
+    slope[i] = c(1);
+    curvature[i] = c(2);
+    B += c(1);
+    fit.curvature += c(2);
+    ++fit.frames;
+  }
+  if (!(fit.curvature > 0)) return fit;
+  const double u_hat = -B / (2.0 * fit.curvature);
+  fit.minimum = best + u_hat * scale;
+  double meat = 0.0;
+  size_t i = 0;
+  for (const Window& w : windows)
+    for (size_t s = w.begin; s < w.end; s += cluster) {
+      double g = 0.0;
+      for (size_t k = s; k < std::min(w.end, s + cluster); ++k, ++i)
+        if (std::isfinite(slope[i])) g += slope[i] + 2.0 * curvature[i] * u_hat;
+      meat += g * g;
+    }
+  fit.sigma = std::sqrt(meat) / (2.0 * fit.curvature) * scale;
+  return fit;
+}
+
 }  // namespace
 
 ReadoutEstimate estimate_readout(ocl::Runtime& runtime, const CameraModel& camera, const Extrinsics& camera_frame,
@@ -232,50 +284,13 @@ ReadoutEstimate estimate_readout(ocl::Runtime& runtime, const CameraModel& camer
   }
   std::sort(out.curve.begin(), out.curve.end());
 
-  // Each frame's variance as a parabola in r through the three candidates nearest the best.
-  const double b = best();
-  std::vector<std::pair<double, double>> near;  // (distance, r)
-  for (const auto& [r, v] : at) near.push_back({std::abs(r - b), r});
-  std::sort(near.begin(), near.end());
-  Eigen::Matrix3d A;
-  std::array<const std::vector<double>*, 3> y{};
-  const double scale = R / 8;  // u in units of the last step keeps A well conditioned
-  for (int j = 0; j < 3; ++j) {
-    const double u = (near[static_cast<size_t>(j)].second - b) / scale;
-    A.row(j) << 1.0, u, u * u;
-    y[static_cast<size_t>(j)] = &at[near[static_cast<size_t>(j)].second];
-  }
-  const Eigen::Matrix3d Ainv = A.inverse();
-  const size_t n = y[0]->size();
-  std::vector<double> slope(n, kNaN), curvature(n, kNaN);
-  double B = 0.0, C = 0.0;
-  for (size_t i = 0; i < n; ++i) {
-    const Eigen::Vector3d v((*y[0])[i], (*y[1])[i], (*y[2])[i]);
-    if (!v.allFinite()) continue;
-    const Eigen::Vector3d c = Ainv * v;
-    slope[i] = c(1);
-    curvature[i] = c(2);
-    B += c(1);
-    C += c(2);
-    ++out.frames;
-  }
-  if (out.frames < options.window_frames / 2 || !(C > 0))
+  const Fit fit = fit_parabolas(at, windows, best(), R / 8, static_cast<size_t>(options.cluster_frames));
+  out.frames = fit.frames;
+  if (out.frames < options.window_frames / 2 || !(fit.curvature > 0))
     return finish("the images do not change with the readout time: the drive is too slow or too short to shear "
                   "them (drive faster, or turn)");
-  const double u_hat = -B / (2.0 * C);
-  out.estimate = std::clamp(b + u_hat * scale, 0.0, R);
-  // Sandwich variance over clusters of consecutive frames within a window.
-  double meat = 0.0;
-  size_t i = 0;
-  for (const Window& w : windows)
-    for (size_t s = w.begin; s < w.end; s += static_cast<size_t>(options.cluster_frames)) {
-      double g = 0.0;
-      const size_t e = std::min(w.end, s + static_cast<size_t>(options.cluster_frames));
-      for (size_t k = s; k < e; ++k, ++i)
-        if (std::isfinite(slope[i])) g += slope[i] + 2.0 * curvature[i] * u_hat;
-      meat += g * g;
-    }
-  out.sigma = std::sqrt(meat) / (2.0 * C) * scale;
+  out.estimate = std::clamp(fit.minimum, 0.0, R);
+  out.sigma = fit.sigma;
   out.readout = out.estimate > options.zero_below_sigmas * out.sigma ? out.estimate : 0.0;
   progress(1.0);
   return finish("");
