@@ -386,7 +386,9 @@ typedef struct planarvo_track_result {
 
 PLANARVO_API void planarvo_tracker_options_init(planarvo_tracker_options* options);
 /* camera: the distorted camera the frames come from; extrinsics: the camera on the robot.
- * options may be NULL. */
+ * options may be NULL. PLANARVO_ERROR_INVALID_ARGUMENT for extrinsics that are not finite, a
+ * height z <= 0, or angles with which no part of the image looks below the horizon (the camera
+ * would not see the ground: degrees given for radians, for example). */
 PLANARVO_API planarvo_status planarvo_tracker_create(planarvo_context* context,
                                                      const planarvo_camera* camera,
                                                      const planarvo_extrinsics* extrinsics,

@@ -61,10 +61,30 @@ constexpr const char* kNotAligned = "not aligned";
 // 0.17 at level 3 (its grout lines are finer than 8 pixels) while it tracks at every frame.
 constexpr double kMinSelfTexture = 0.1;
 
+// Some of the image (a 9 x 9 grid of undistorted pixels) looks at least 0.5 degrees below the
+// horizon: the ground plane is in view. A camera pitched to look up sees none of it, and every
+// frame would be Lost (or, with a sky texture, Ok and meaningless).
+bool sees_the_ground(const CameraModel& c, const Extrinsics& e) {
+  const Eigen::Vector3d n = e.plane_normal_camera();  // ground points X: n.X = -z
+  const Eigen::Matrix3d Kinv = c.K().inverse();
+  for (int i = 0; i <= 8; ++i)
+    for (int j = 0; j <= 8; ++j) {
+      const Eigen::Vector3d d = (Kinv * Eigen::Vector3d(c.width * i / 8.0, c.height * j / 8.0, 1.0)).normalized();
+      if (n.dot(d) < -std::sin(0.5 * M_PI / 180.0)) return true;
+    }
+  return false;
+}
+
 CameraModel validated(const CameraModel& c, const Extrinsics& e, const TrackerOptions& o) {
   if (o.levels < 1 || o.levels > kMaxLevels)
     throw_invalid_argument("TrackerOptions::levels must be 1.." + std::to_string(kMaxLevels));
   if (!(e.z > 0.0)) throw_invalid_argument("Tracker: the camera height z must be positive");
+  if (!std::isfinite(e.x + e.y + e.z + e.roll + e.pitch + e.yaw))
+    throw_invalid_argument("Tracker: the extrinsics must be finite numbers");
+  if (!sees_the_ground(c, e))
+    throw_invalid_argument("Tracker: with these extrinsics (roll " + std::to_string(e.roll) + ", pitch " +
+                           std::to_string(e.pitch) + " rad) no part of the image looks below the horizon: the "
+                           "camera does not see the ground (angles in radians, not degrees?)");
   for (int b : o.select_blocks)
     if (b < 0 || b > 16) throw_invalid_argument("TrackerOptions::select_blocks must be 0..16");
   if (o.auto_finer_block < 0 || o.auto_finer_block > 16)

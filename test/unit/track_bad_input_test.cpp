@@ -243,5 +243,37 @@ TEST_F(TrackBadInput, ResetStartsOver) {
   EXPECT_STATUS(track(good(3 * dt), 3 * dt), Ok);
 }
 
+// Extrinsics that cannot be a camera over the ground: not finite, or pitched so that no part of
+// the image looks below the horizon (issue 27: accepted, then every frame Lost, or Ok on a sky).
+// A steep rear camera (40 degrees from horizontal) and a strongly rolled one are fine.
+TEST(TrackerExtrinsics, NotFiniteOrLookingUpIsInvalidArgument) {
+  ocl::Runtime rt;
+  const CameraModel cam = sim::default_camera(160, 120);
+  const Extrinsics good{0.2, 0.0, 0.3, 0.2, 0.3, 0.0};
+  EXPECT_NO_THROW(Tracker(rt, cam, good));
+  EXPECT_NO_THROW(Tracker(rt, cam, Extrinsics{-1.0, 0.0, 0.9, 0.0, 40.0 * M_PI / 180.0, M_PI}));
+  EXPECT_NO_THROW(Tracker(rt, cam, Extrinsics{0.25, 0.05, 0.12, -27.0 * M_PI / 180.0, 0.14, 0.0}));
+  for (double bad : {std::nan(""), HUGE_VAL}) {
+    Extrinsics e = good;
+    e.roll = bad;
+    EXPECT_THROW(Tracker(rt, cam, e), Error);
+    e = good;
+    e.yaw = bad;
+    EXPECT_THROW(Tracker(rt, cam, e), Error);
+  }
+  // Looking straight down is pitch 0; at 150 degrees the optical axis is 60 degrees above the
+  // horizon and the image's lowest row (the 80-degree camera is 64 degrees high) still above it.
+  for (double pitch_deg : {150.0, 180.0}) {
+    Extrinsics e = good;
+    e.pitch = pitch_deg * M_PI / 180.0;
+    try {
+      Tracker t(rt, cam, e);
+      ADD_FAILURE() << "pitch " << pitch_deg << " deg accepted";
+    } catch (const Error& err) {
+      EXPECT_EQ(err.code(), ErrorCode::InvalidArgument) << pitch_deg;
+    }
+  }
+}
+
 }  // namespace
 }  // namespace planarvo::track
