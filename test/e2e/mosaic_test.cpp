@@ -187,6 +187,19 @@ TEST(Mosaic, BadInputIsExitCode2) {
   // A trajectory may leave frames out.
   t.erase(t.begin() + 4);
   p.erase(p.begin() + 4);
+  // Extrinsics that are not finite, or a camera under the ground (issue 27: every frame was
+  // left out and an empty mosaic returned).
+  for (const double bad : {std::nan(""), HUGE_VAL}) {
+    planarvo_extrinsics b = e;
+    b.pitch = bad;
+    EXPECT_EQ(planarvo_mosaic_build(ctx.get(), ds.get(), &b, t.data(), p.data(), t.size(), nullptr, &m),
+              PLANARVO_ERROR_INVALID_ARGUMENT);
+    EXPECT_EQ(m, nullptr);
+  }
+  planarvo_extrinsics under = e;
+  under.z = -0.1;
+  EXPECT_EQ(planarvo_mosaic_build(ctx.get(), ds.get(), &under, t.data(), p.data(), t.size(), nullptr, &m),
+            PLANARVO_ERROR_INVALID_ARGUMENT);
   EXPECT_EQ(planarvo_mosaic_build(ctx.get(), ds.get(), &e, t.data(), p.data(), t.size(), nullptr, &m), PLANARVO_OK)
       << planarvo_last_error();
   planarvo_mosaic_destroy(m);
