@@ -146,10 +146,9 @@ planarvo::calib::PipelineOptions pipeline_options_from_c(const planarvo_camera_c
                : readout == PLANARVO_READOUT_ESTIMATE ? planarvo::calib::PipelineOptions::Readout::On
                                                       : planarvo::calib::PipelineOptions::Readout::IfUnknown;
   if (o.has_initial) {
-    require(o.initial.z > 0 && std::isfinite(o.initial.x + o.initial.y + o.initial.z + o.initial.roll +
-                                             o.initial.pitch + o.initial.yaw),
-            "planarvo_camera_calibration_options.initial must be finite with z > 0");
     po.initial = planarvo::capi::to_cpp(o.initial);
+    require(po.initial->z > 0 && po.initial->finite(),
+            "planarvo_camera_calibration_options.initial must be finite with z > 0");
   }
   if (o.progress) {
     const planarvo_progress_fn fn = o.progress;

@@ -2,6 +2,8 @@
 // docs/conventions.md: R_vc = Rz(yaw) Ry(pitch) Rx(roll) R0, with R0 the camera looking
 // straight down, image top towards the robot's front.
 #pragma once
+#include <cmath>
+
 #include <Eigen/Core>
 
 namespace planarvo {
@@ -9,6 +11,9 @@ namespace planarvo {
 struct Extrinsics {
   double x = 0.0, y = 0.0, z = 0.0;           // camera centre in the robot frame, metres
   double roll = 0.0, pitch = 0.0, yaw = 0.0;  // radians
+
+  // All six values are finite numbers.
+  bool finite() const { return std::isfinite(x + y + z + roll + pitch + yaw); }
 
   Eigen::Matrix3d R_vc() const;
   Eigen::Vector3d t_vc() const { return {x, y, z}; }

@@ -342,8 +342,7 @@ Mosaic build_mosaic(ocl::Runtime& runtime, io::Dataset& dataset, const Extrinsic
                     const std::vector<PosedFrame>& frames, const MosaicOptions& options) {
   const Clock::time_point t0 = Clock::now();
   check_options(options);
-  if (!std::isfinite(extrinsics.x + extrinsics.y + extrinsics.z + extrinsics.roll + extrinsics.pitch + extrinsics.yaw) ||
-      !(extrinsics.z > 0))
+  if (!extrinsics.finite() || !(extrinsics.z > 0))
     throw_invalid_argument("mosaic: the extrinsics must be finite numbers with a height z > 0");
   if (frames.empty()) throw_invalid_input("mosaic: no poses: the trajectory is empty");
   for (const PosedFrame& f : frames) {

@@ -79,7 +79,7 @@ CameraModel validated(const CameraModel& c, const Extrinsics& e, const TrackerOp
   if (o.levels < 1 || o.levels > kMaxLevels)
     throw_invalid_argument("TrackerOptions::levels must be 1.." + std::to_string(kMaxLevels));
   if (!(e.z > 0.0)) throw_invalid_argument("Tracker: the camera height z must be positive");
-  if (!std::isfinite(e.x + e.y + e.z + e.roll + e.pitch + e.yaw))
+  if (!e.finite())
     throw_invalid_argument("Tracker: the extrinsics must be finite numbers");
   if (!sees_the_ground(c, e))
     throw_invalid_argument("Tracker: with these extrinsics (roll " + std::to_string(e.roll) + ", pitch " +
