@@ -74,7 +74,8 @@ typedef enum planarvo_status {
   PLANARVO_ERROR_FAILED = 6,           /* ran, but failed: lost tracking, no convergence... */
   PLANARVO_ERROR_CANCELLED = 7,        /* a progress callback returned non-zero */
   PLANARVO_ERROR_BUFFER_TOO_SMALL = 8, /* an output buffer is too small; see the function */
-  PLANARVO_ERROR_INTERNAL = 9          /* a bug in planarvo: please report it */
+  PLANARVO_ERROR_INTERNAL = 9,         /* a bug in planarvo: please report it */
+  PLANARVO_ERROR_OUT_OF_MEMORY = 10     /* host memory, or the device's for its buffers, ran out */
 } planarvo_status;
 
 /* The message of the calling thread's last failed call ("" if none). Valid until the thread's

@@ -20,6 +20,7 @@ class Status(enum.IntEnum):
     CANCELLED = 7
     BUFFER_TOO_SMALL = 8
     INTERNAL = 9
+    OUT_OF_MEMORY = 10
 
 
 class Error(Exception):

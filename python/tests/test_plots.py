@@ -214,6 +214,31 @@ def test_mosaic_figure_reads_the_map_yaml_and_draws_each_mosaic(tmp_path):
     from PIL import Image as I
     with I.open(tmp_path / "out" / "mosaic.png") as im:
         assert im.size[0] == 1125 and np.asarray(im.convert("L")).std() > 10
+    # What the figure draws (issue 27: the test checked only a width and a pixel spread): one
+    # panel per mosaic, each image at the extent its YAML gives (origin + size x resolution), its
+    # pixels as read with the unseen ones masked, the zoom box as the limits, the trajectory's
+    # poses as the line.
+    figures = []
+    monkey = _mosaic_figure.S.save
+    try:
+        _mosaic_figure.S.save = lambda fig, *a, **k: figures.append(fig) or []
+        _mosaic_figure.mosaic_figure([str(tmp_path / "a.png"), str(tmp_path / "b.png")], ["one", "two"],
+                                     str(tmp_path / "traj.txt"), "0,0.26,0.2,0.45", str(tmp_path / "out"), "m", ["png"])
+    finally:
+        _mosaic_figure.S.save = monkey
+    (fig,) = figures
+    panels = [ax for ax in fig.axes if ax.images]
+    assert len(panels) == 2
+    for ax, ox, title in zip(panels, (-0.1, 0.0), ("one", "two")):
+        (im,) = ax.images
+        assert im.get_extent() == pytest.approx([ox, ox + 200 * 0.002, 0.25, 0.25 + 120 * 0.002])
+        shown = im.get_array()
+        assert np.array_equal(np.ma.getdata(shown), image)
+        assert np.array_equal(np.ma.getmaskarray(shown), image == 0)
+        assert ax.get_xlim() == pytest.approx((0.0, 0.2)) and ax.get_ylim() == pytest.approx((0.26, 0.45))
+        assert ax.get_title() == title
+        line = ax.lines[0]
+        assert np.allclose(line.get_xdata(), [0.0, 0.2]) and np.allclose(line.get_ydata(), [0.3, 0.4])
     # Bad input: a YAML without an origin, a title count that does not match, a bad zoom box.
     (tmp_path / "b.yaml").write_text("image: b.png\nresolution: 0.002\n")
     assert run_plot("mosaic", tmp_path / "b.png", "--out-dir", tmp_path / "out").returncode == 2

@@ -1,5 +1,6 @@
 #include "capi/status.h"
 
+#include <algorithm>
 #include <atomic>
 #include <new>
 #include <stdexcept>
@@ -22,6 +23,7 @@ planarvo_status to_status(ErrorCode code) {
     case ErrorCode::OpenCL: return PLANARVO_ERROR_OPENCL;
     case ErrorCode::Failed: return PLANARVO_ERROR_FAILED;
     case ErrorCode::Cancelled: return PLANARVO_ERROR_CANCELLED;
+    case ErrorCode::OutOfMemory: return PLANARVO_ERROR_OUT_OF_MEMORY;
     case ErrorCode::Internal: return PLANARVO_ERROR_INTERNAL;
   }
   return PLANARVO_ERROR_INTERNAL;
@@ -32,12 +34,12 @@ planarvo_status to_status(ErrorCode code) {
 void set_error_sink(ErrorSink sink) noexcept { g_error_sink.store(sink); }
 
 planarvo_status fail(planarvo_status status, const std::string& message) {
-  if (const ErrorSink sink = g_error_sink.load()) {
-    sink(message.c_str());
-    return status;
-  }
   try {
-    t_last_error = message;
+    if (const ErrorSink sink = g_error_sink.load()) {
+      sink(printable_message(message).c_str());
+      return status;
+    }
+    t_last_error = printable_message(message);
   } catch (...) {
     // Out of memory while recording the message: keep the status, lose the text.
   }
@@ -52,7 +54,7 @@ planarvo_status translate_current_exception() noexcept {
   } catch (const BufferTooSmall& e) {
     return fail(PLANARVO_ERROR_BUFFER_TOO_SMALL, e.what());
   } catch (const std::bad_alloc&) {
-    return fail(PLANARVO_ERROR_INTERNAL, "out of memory");
+    return fail(PLANARVO_ERROR_OUT_OF_MEMORY, "out of memory: an allocation failed");
   } catch (const std::exception& e) {
     return translate_foreign_exception(e);
   } catch (...) {
@@ -93,6 +95,7 @@ PLANARVO_API const char* planarvo_status_name(planarvo_status status) {
     case PLANARVO_ERROR_CANCELLED: return "PLANARVO_ERROR_CANCELLED";
     case PLANARVO_ERROR_BUFFER_TOO_SMALL: return "PLANARVO_ERROR_BUFFER_TOO_SMALL";
     case PLANARVO_ERROR_INTERNAL: return "PLANARVO_ERROR_INTERNAL";
+    case PLANARVO_ERROR_OUT_OF_MEMORY: return "PLANARVO_ERROR_OUT_OF_MEMORY";
   }
   return "PLANARVO_ERROR_UNKNOWN";
 }

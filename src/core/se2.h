@@ -6,6 +6,11 @@
 
 namespace planarvo {
 
+// The farthest a position (metres from its frame's origin) may lie in any input: a robot's drive
+// or a map is far smaller, and beyond it a double keeps less than 0.1 µm, so a value past it is
+// a corrupt file or a unit mistake, refused where it is read.
+inline constexpr double kMaxPositionMetres = 1e6;
+
 // Wraps an angle to (-pi, pi].
 inline double wrap_angle(double a) {
   a = std::remainder(a, 2.0 * M_PI);

@@ -47,16 +47,24 @@ OdometryGraph build_odometry_graph(const Context& ctx, const std::vector<SE2>& p
   g.set_fixed(og.poses[0]);
   for (size_t i = 0; i < ctx.samples.size(); ++i) {
     const MotionSample& s = ctx.samples[i];
+    if (!ctx.inlier[i]) {
+      // A gated sample keeps neither factor: its odometry alone would only tie the two poses
+      // together (it adds nothing about z), and a glitch of kilometres there would put lever
+      // arms of that size into the normal equations. Fixing the next pose stands in for it as
+      // the gauge of the poses after the gap.
+      og.odometry_factor.push_back(-1);
+      og.sensor_factor.push_back(-1);
+      g.set_fixed(og.poses[i + 1]);
+      continue;
+    }
     og.odometry_factor.push_back(g.add_factor(
         std::make_unique<OdometryFactor>(og.poses[i], og.poses[i + 1], s.odometry->value,
                                          motion_information(ctx.odo_cov[i], s.odometry->value.theta)),
         kernel));
-    og.sensor_factor.push_back(
-        ctx.inlier[i] ? g.add_factor(std::make_unique<SensorMotionFactor>(
-                                         og.poses[i], og.poses[i + 1], og.z, s.sensor.value,
-                                         motion_information(ctx.sensor_cov[i], s.sensor.value.theta)),
-                                     kernel)
-                      : -1);
+    og.sensor_factor.push_back(g.add_factor(
+        std::make_unique<SensorMotionFactor>(og.poses[i], og.poses[i + 1], og.z, s.sensor.value,
+                                             motion_information(ctx.sensor_cov[i], s.sensor.value.theta)),
+        kernel));
   }
   return og;
 }

@@ -75,8 +75,8 @@ class Progress {
 
 cv::Mat read_image(const fs::path& file, const CameraModel& camera, const std::string& context) {
   const std::string name = file.string();
-  std::error_code ec;
-  if (!fs::exists(file, ec)) throw_invalid_input(name + ": the image does not exist (" + context + ")");
+  if (const std::string problem = detail::input_file_problem(name); !problem.empty())
+    throw_invalid_input(name + ": the image " + problem + " (" + context + ")");
   if (const std::string cut = detail::file_truncation_problem(name); !cut.empty())
     throw_invalid_input(name + ": " + cut + " (" + context + ")");
   cv::Mat img;
@@ -99,8 +99,8 @@ class VideoSource {
   VideoSource(std::string path, const CameraModel& camera, bool verify, const Progress& progress,
               double progress_from)
       : path_(std::move(path)), camera_(camera) {
-    std::error_code ec;
-    if (!fs::exists(path_, ec)) throw_invalid_input(path_ + ": the video does not exist");
+    if (const std::string problem = detail::input_file_problem(path_); !problem.empty())
+      throw_invalid_input(path_ + ": the video " + problem);
     open_first_backend();
     const double fps = cap_.get(cv::CAP_PROP_FPS);
     const double count_hint = cap_.get(cv::CAP_PROP_FRAME_COUNT);
@@ -320,10 +320,9 @@ Dataset::Dataset(const std::string& directory, DatasetOptions options) : impl_(s
     if (d.frames.empty()) throw_invalid_input(d.frames_file + ": lists no frames");
     // A stat per image is cheap and finds a misspelt path now, not an hour into a run.
     for (size_t i = 0; i < d.frames.size() && !options.allow_missing_images; ++i) {
-      const fs::path file = d.dir / d.frames[i].path;
-      if (!fs::is_regular_file(file, ec))
-        throw_invalid_input(file.string() + ": the image does not exist (" +
-                            d.context(static_cast<int64_t>(i)) + ")");
+      const std::string file = (d.dir / d.frames[i].path).string();
+      if (const std::string problem = detail::input_file_problem(file); !problem.empty())
+        throw_invalid_input(file + ": the image " + problem + " (" + d.context(static_cast<int64_t>(i)) + ")");
     }
   } else {
     d.video = std::make_unique<VideoSource>(options.video, d.camera, options.verify_images,

@@ -64,8 +64,19 @@ std::optional<uint32_t> only_topic(const bag::BagFile& file, std::initializer_li
 }
 
 // nav_msgs/Odometry's pose as a planar pose: x, y and the yaw of the quaternion (ZYX order).
+// A position or orientation that is not finite, or a position beyond kMaxPositionMetres, is a
+// corrupt message (InvalidInput, placed by the caller).
 SE2 planar_pose(const bag::OdometryMessage& m) {
+  for (int k = 0; k < 2; ++k) {
+    const double p = m.position[static_cast<size_t>(k)];
+    if (!std::isfinite(p) || std::abs(p) > kMaxPositionMetres)
+      throw_invalid_input(std::string("the odometry's position ") + "xy"[k] + " = " + std::to_string(p) +
+                          (std::isfinite(p) ? " m is beyond 1e6 m: a corrupt value or another unit"
+                                            : " is not finite"));
+  }
   const auto& q = m.orientation;  // x y z w
+  if (!std::all_of(q.begin(), q.end(), [](double v) { return std::isfinite(v); }))
+    throw_invalid_input("the odometry's orientation is not finite");
   const double yaw = std::atan2(2.0 * (q[3] * q[2] + q[0] * q[1]), 1.0 - 2.0 * (q[1] * q[1] + q[2] * q[2]));
   return SE2(m.position[0], m.position[1], yaw);
 }
@@ -214,8 +225,10 @@ Scanned read_stamps(bag::BagFile& file, const std::vector<bag::MessageRef>& refs
         s.images.push_back({receive_time ? m.receive_time_ns : bag::decode_header(ser, buf.data(), buf.size()).stamp_ns, r});
       if (topics.info && m.topic == *topics.info) {
         bag::CameraInfoMessage ci = bag::decode_camera_info(ser, buf.data(), buf.size());
-        if (!s.info)
+        if (!s.info) {
+          camera_from_info(ci, "the camera info");  // a bad first one is named as bad, not as different
           s.info = std::move(ci);
+        }
         else if (!same_camera(*s.info, ci))
           throw_invalid_input("the camera info differs from the first one; planarvo uses one camera for a run");
       }

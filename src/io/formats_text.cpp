@@ -52,6 +52,10 @@ std::vector<StampedPose> read_tum(const std::string& path) {
     for (int k = 0; k < 8; ++k) v[k] = parse_number(r, f[k], kNames[k]);
     const double t = v[0];
     check_increasing(r, !poses.empty(), poses.empty() ? 0.0 : poses.back().t, t);
+    for (int k = 1; k <= 2; ++k)
+      if (std::abs(v[k]) > kMaxPositionMetres)
+        r.fail(std::string(kNames[k]) + " = " + format_exact(v[k]) + " m is beyond " +
+               format_exact(kMaxPositionMetres) + " m: a corrupt value or another unit");
     if (std::abs(v[3]) > kPlanarTolerance)
       r.fail("z = " + format_exact(v[3]) + " is not 0: only planar poses are supported");
     const double norm = std::sqrt(v[4] * v[4] + v[5] * v[5] + v[6] * v[6] + v[7] * v[7]);

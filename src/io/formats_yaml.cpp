@@ -307,9 +307,7 @@ void check_yaml_limits(const std::string& path) {
 
 // Opens path for reading, with our own message for a missing file (OpenCV's is a log line).
 void open_for_reading(cv::FileStorage& fs, const std::string& path) {
-  std::error_code ec;
-  if (!std::filesystem::exists(path, ec)) fail(path, "does not exist");
-  if (std::filesystem::is_directory(path, ec)) fail(path, "is a directory, not a file");
+  if (const std::string problem = detail::input_file_problem(path); !problem.empty()) fail(path, problem);
   check_yaml_limits(path);
   try {
     if (!fs.open(path, cv::FileStorage::READ)) fail(path, "cannot be opened as OpenCV YAML");

@@ -77,11 +77,18 @@ MotionPairs read_motion_pairs(const std::string& path, double still_speed) {
       r.fail("expected " + std::to_string(names.size()) + " comma-separated values, found " +
              std::to_string(f.size()));
     auto value = [&](const char* name) { return detail::parse_number(r, f[column.at(name)], name); };
+    auto metres = [&](const char* name) {
+      const double v = value(name);
+      if (std::abs(v) > kMaxPositionMetres)
+        r.fail(std::string(name) + " = " + detail::format_exact(v) + " m is beyond " +
+               detail::format_exact(kMaxPositionMetres) + " m: a corrupt value or another unit");
+      return v;
+    };
     MotionPair p;
     p.interval = value("interval_s");
     if (!(p.interval > 0)) r.fail("interval_s must be positive");
-    p.sensor.value = SE2(value("sensor_dx"), value("sensor_dy"), value("sensor_dtheta"));
-    if (out.has_odometry) p.odometry = Motion{SE2(value("odo_dx"), value("odo_dy"), value("odo_dtheta"))};
+    p.sensor.value = SE2(metres("sensor_dx"), metres("sensor_dy"), value("sensor_dtheta"));
+    if (out.has_odometry) p.odometry = Motion{SE2(metres("odo_dx"), metres("odo_dy"), value("odo_dtheta"))};
     if (out.has_direction_column) {
       const double s = value("direction");
       if (s != 1.0 && s != -1.0 && s != 0.0) r.fail("direction must be +1, -1 or 0");

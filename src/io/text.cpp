@@ -5,6 +5,9 @@
 #include <cmath>
 #include <system_error>
 
+#include <sys/stat.h>
+#include <unistd.h>
+
 #include "core/error.h"
 
 namespace planarvo::io::detail {
@@ -25,7 +28,32 @@ std::string where(const std::string& path, int line) {
   return path + ":" + std::to_string(line);
 }
 
-LineReader::LineReader(std::string path) : path_(std::move(path)), in_(path_, std::ios::binary) {
+std::string input_file_problem(const std::string& path) {
+  struct stat st {};
+  if (::stat(path.c_str(), &st) != 0) {
+    const int err = errno;
+    if (err == ENOENT || err == ENOTDIR) return "does not exist";
+    return "cannot be read (" + std::generic_category().message(err) + ")";
+  }
+  if (S_ISDIR(st.st_mode)) return "is a directory, not a file";
+  if (S_ISFIFO(st.st_mode)) return "is a named pipe (FIFO), not a regular file";
+  if (S_ISSOCK(st.st_mode)) return "is a socket, not a regular file";
+  if (!S_ISREG(st.st_mode)) return "is a device, not a regular file";
+  if (::access(path.c_str(), R_OK) != 0) {
+    const int err = errno;
+    return "cannot be read (" + std::generic_category().message(err) + ")";
+  }
+  return std::string();
+}
+
+void check_input_file(const std::string& path, const std::string& context) {
+  const std::string problem = input_file_problem(path);
+  if (!problem.empty()) throw_invalid_input(path + ": " + problem + (context.empty() ? "" : " (" + context + ")"));
+}
+
+LineReader::LineReader(std::string path) : path_(std::move(path)) {
+  check_input_file(path_);
+  in_.open(path_, std::ios::binary);
   if (!in_) {
     const int err = errno;
     throw_invalid_input(path_ + ": cannot open (" + std::generic_category().message(err) + ")");

@@ -15,6 +15,14 @@ namespace planarvo::io::detail {
 // "path:line: message", the form compilers use, so editors can jump to it.
 std::string where(const std::string& path, int line);
 
+// Why path cannot be read as an input file ("does not exist", "is a directory, not a file", "is a
+// named pipe (FIFO), not a regular file", "cannot be read (Permission denied)", ...), or "" when
+// it is a regular file this process may read. Called before opening, so that a FIFO never blocks
+// the reader and each case gets its own words instead of a decoder's.
+std::string input_file_problem(const std::string& path);
+// Throws InvalidInput "path: <problem> (context)" when there is one; context may be empty.
+void check_input_file(const std::string& path, const std::string& context = std::string());
+
 // Reads a text file line by line, skipping blank lines and lines whose first non-blank character
 // is '#'. Strips a trailing '\r' (files written on Windows) and surrounding blanks. Throws
 // InvalidInput naming the file when it cannot be opened or read.

@@ -28,6 +28,8 @@ using Clock = std::chrono::steady_clock;
 double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
 constexpr double kTurnForNewFrame = 5.0 * M_PI / 180.0;
+// The fewest pixels across a frame's footprint on the ground that a resolution may give.
+constexpr int kMinFootprintPixels = 4;
 
 // v with `decimals` digits after the point (decimals < 0: the shortest general form, 3 digits).
 std::string num(double v, int decimals) {
@@ -351,6 +353,10 @@ Mosaic build_mosaic(ocl::Runtime& runtime, io::Dataset& dataset, const Extrinsic
                              std::to_string(dataset.frame_count()) + ")");
     if (!std::isfinite(f.pose.x) || !std::isfinite(f.pose.y) || !std::isfinite(f.pose.theta))
       throw_invalid_input("mosaic: the pose of frame " + std::to_string(f.frame) + " is not finite");
+    if (std::max(std::abs(f.pose.x), std::abs(f.pose.y)) > kMaxPositionMetres)
+      throw_invalid_input("mosaic: the pose of frame " + std::to_string(f.frame) + " (x " + num(f.pose.x, -1) +
+                          ", y " + num(f.pose.y, -1) + " m) is beyond " + num(kMaxPositionMetres, -1) +
+                          " m from the origin: a corrupt trajectory or another unit");
   }
   const CameraModel& cam = dataset.camera();
   const PixelRegion region = cam.region();
@@ -361,6 +367,15 @@ Mosaic build_mosaic(ocl::Runtime& runtime, io::Dataset& dataset, const Extrinsic
   if (fp.empty()) throw_invalid_input("mosaic: the camera sees no ground within the range limit");
   Box robot_box;
   for (const Eigen::Vector2d& p : fp) robot_box.add(p);
+  // A frame must cover pixels: at a resolution coarser than a few pixels per footprint, every
+  // frame would fall between pixel centres and the image would be empty.
+  const double footprint_side = std::min(robot_box.x1 - robot_box.x0, robot_box.y1 - robot_box.y0);
+  if (!(footprint_side / options.resolution >= kMinFootprintPixels))
+    throw_invalid_argument("mosaic: the resolution " + num(options.resolution, -1) +
+                           " m per pixel is too coarse for the camera's footprint on the ground (" +
+                           num(footprint_side, -1) + " m across): a frame would cover fewer than " +
+                           std::to_string(kMinFootprintPixels) + " pixels across; give " +
+                           num(footprint_side / kMinFootprintPixels, -1) + " m per pixel or finer");
   const double spacing = options.frame_spacing != 0
                              ? options.frame_spacing
                              : std::min(robot_box.x1 - robot_box.x0, robot_box.y1 - robot_box.y0) / 8.0;
@@ -422,6 +437,9 @@ Mosaic build_mosaic(ocl::Runtime& runtime, io::Dataset& dataset, const Extrinsic
   if (options.progress) options.progress(1.0, "mosaic");
   m.image = blender.image();
   m.stats.peak_tile_bytes = blender.peak_bytes();
+  if (m.stats.covered_pixels == 0)
+    throw Error(ErrorCode::Failed, "mosaic: no frame covered a pixel of the mosaic (" + std::to_string(used.size()) +
+                                       " frames placed), so there is no image to write");
   m.stats.seconds_total = seconds_since(t0);
   return m;
 }

@@ -144,28 +144,46 @@ TEST(Mosaic, BadInputIsExitCode2) {
   const std::string traj = (dir / "traj.txt").string();
   ASSERT_EQ(run_cli("track --quiet " + seq + " --extrinsics " + seq + "/extrinsics_gt.yaml -o " + traj).exit_code, 0);
   const std::string common = "mosaic --quiet " + seq + " --extrinsics " + seq + "/extrinsics_gt.yaml ";
-  const std::string out = " -o " + (dir / "m.png").string();
-  EXPECT_EQ(run_cli(common + "--trajectory " + traj + out).exit_code, 0);
+  const fs::path png = dir / "m.png";
+  const std::string out = " -o " + png.string();
+  ASSERT_EQ(run_cli(common + "--trajectory " + traj + out).exit_code, 0);
+  ASSERT_TRUE(fs::exists(png));
+  fs::remove(png);
+  fs::remove(dir / "m.yaml");
+  // Each bad run below exits with 2 and writes neither the image nor its YAML.
+  const auto refused = [&](const std::string& args) {
+    const auto r = run_cli(common + args);
+    EXPECT_EQ(r.exit_code, 2) << args << "\n" << r.output;
+    EXPECT_FALSE(fs::exists(png)) << args;
+    EXPECT_FALSE(fs::exists(dir / "m.yaml")) << args;
+    return r;
+  };
 
   // A pose at a time that is no frame's (the 5th line moved by 10 ms).
   std::vector<io::StampedPose> poses = io::read_tum(traj);
   std::vector<io::StampedPose> moved = poses;
   moved[4].t += 0.010;
   io::write_tum((dir / "moved.txt").string(), moved);
-  EXPECT_EQ(run_cli(common + "--trajectory " + (dir / "moved.txt").string() + out).exit_code, 2);
+  refused("--trajectory " + (dir / "moved.txt").string() + out);
   // An empty trajectory (the header only).
   std::ofstream(dir / "empty.txt") << "# timestamp x y z qx qy qz qw\n";
-  EXPECT_EQ(run_cli(common + "--trajectory " + (dir / "empty.txt").string() + out).exit_code, 2);
+  refused("--trajectory " + (dir / "empty.txt").string() + out);
   // A resolution that would make the image over 20000 pixels on a side; the size it would be is
   // printed: the drive's extent over the resolution.
-  const auto big = run_cli(common + "--trajectory " + traj + " --resolution 0.00001" + out);
-  EXPECT_EQ(big.exit_code, 2);
-  EXPECT_FALSE(fs::exists(dir / "big.png"));
+  refused("--trajectory " + traj + " --resolution 0.00001" + out);
+  // A resolution so coarse that no frame covers a pixel (issue 27: an empty image, exit 0).
+  refused("--trajectory " + traj + " --resolution 1e300" + out);
+  // A trajectory 1e17 m away (issue 27: an empty image, exit 0): refused at its line.
+  std::vector<io::StampedPose> far = poses;
+  for (auto& s : far) s.pose.x += 1e17;
+  io::write_tum((dir / "far.txt").string(), far);
+  const auto far_run = refused("--trajectory " + (dir / "far.txt").string() + out);
+  EXPECT_NE(far_run.output.find((dir / "far.txt").string() + ":2:"), std::string::npos) << far_run.output;
   // Bad options.
-  EXPECT_EQ(run_cli(common + "--trajectory " + traj + " --resolution -1" + out).exit_code, 2);
-  EXPECT_EQ(run_cli(common + out).exit_code, 2);  // no trajectory
-  EXPECT_EQ(run_cli(common + "--trajectory " + traj).exit_code, 2);  // no output
-  EXPECT_EQ(run_cli(common + "--trajectory " + (dir / "missing.txt").string() + out).exit_code, 2);
+  refused("--trajectory " + traj + " --resolution -1" + out);
+  refused(out);                        // no trajectory
+  refused("--trajectory " + traj);     // no output
+  refused("--trajectory " + (dir / "missing.txt").string() + out);
 
   // Through the C API: the first mismatch is INVALID_INPUT; so is an empty trajectory.
   test::ApiContext ctx = test::api_context();
@@ -200,6 +218,17 @@ TEST(Mosaic, BadInputIsExitCode2) {
   under.z = -0.1;
   EXPECT_EQ(planarvo_mosaic_build(ctx.get(), ds.get(), &under, t.data(), p.data(), t.size(), nullptr, &m),
             PLANARVO_ERROR_INVALID_ARGUMENT);
+  // Poses 1e17 m away, and a resolution coarser than a frame (issue 27: empty mosaics).
+  std::vector<planarvo_se2> far_poses = p;
+  for (auto& q : far_poses) q.x += 1e17;
+  EXPECT_EQ(planarvo_mosaic_build(ctx.get(), ds.get(), &e, t.data(), far_poses.data(), t.size(), nullptr, &m),
+            PLANARVO_ERROR_INVALID_INPUT);
+  planarvo_mosaic_options coarse;
+  planarvo_mosaic_options_init(&coarse);
+  coarse.resolution = 1e300;
+  EXPECT_EQ(planarvo_mosaic_build(ctx.get(), ds.get(), &e, t.data(), p.data(), t.size(), &coarse, &m),
+            PLANARVO_ERROR_INVALID_ARGUMENT);
+  EXPECT_EQ(m, nullptr);
   EXPECT_EQ(planarvo_mosaic_build(ctx.get(), ds.get(), &e, t.data(), p.data(), t.size(), nullptr, &m), PLANARVO_OK)
       << planarvo_last_error();
   planarvo_mosaic_destroy(m);

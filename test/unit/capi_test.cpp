@@ -3,6 +3,8 @@
 #include <cmath>
 #include <cstddef>
 #include <cstring>
+#include <fstream>
+#include <set>
 #include <string>
 #include <thread>
 
@@ -135,7 +137,46 @@ TEST(CApi, LastErrorIsPerThread) {
 TEST(CApi, StatusNamesAreDistinct) {
   EXPECT_STREQ(planarvo_status_name(PLANARVO_OK), "PLANARVO_OK");
   EXPECT_STREQ(planarvo_status_name(PLANARVO_ERROR_NO_DEVICE), "PLANARVO_ERROR_NO_DEVICE");
+  EXPECT_STREQ(planarvo_status_name(PLANARVO_ERROR_OUT_OF_MEMORY), "PLANARVO_ERROR_OUT_OF_MEMORY");
   EXPECT_STREQ(planarvo_status_name(static_cast<planarvo_status>(999)), "PLANARVO_ERROR_UNKNOWN");
+  std::set<std::string> names;
+  for (int s = PLANARVO_OK; s <= PLANARVO_ERROR_OUT_OF_MEMORY; ++s) {
+    const std::string name = planarvo_status_name(static_cast<planarvo_status>(s));
+    EXPECT_NE(name, "PLANARVO_ERROR_UNKNOWN") << s;
+    names.insert(name);
+  }
+  EXPECT_EQ(names.size(), static_cast<size_t>(PLANARVO_ERROR_OUT_OF_MEMORY + 1));
+}
+
+// The message reaches a C caller whole: a NUL byte from a file is written \x00 rather than cutting
+// the message there, and a path of megabytes is shortened in its middle, keeping how the message
+// ends (issue 27: the message stopped mid-word; a 5 MB path was echoed whole).
+TEST(CApi, MessagesCarryEveryByteAndStayShort) {
+  planarvo::test::ScratchDir dir;
+  const std::string tum = (dir / "nul.txt").string();
+  {
+    std::ofstream f(tum, std::ios::binary);
+    f << "# t x y z qx qy qz qw\n0.0 0";
+    f.put('\0');
+    f << "abc 0 0 0 0 0 1\n";
+  }
+  double t[1];
+  planarvo_se2 p[1];
+  size_t n = 0;
+  EXPECT_EQ(planarvo_read_tum(tum.c_str(), t, p, 1, &n), PLANARVO_ERROR_INVALID_INPUT);
+  const std::string nul = planarvo_last_error();
+  EXPECT_NE(nul.find(tum + ":2:"), std::string::npos) << nul;
+  EXPECT_NE(nul.find("'0\\x00abc' is not a number"), std::string::npos) << nul;
+
+  const std::string long_path = "/nonexistent-planarvo/" + std::string(5u << 20, 'a') + "/camera.yaml";
+  planarvo_camera camera;
+  EXPECT_EQ(planarvo_camera_load(long_path.c_str(), &camera), PLANARVO_ERROR_INVALID_INPUT);
+  const std::string msg = planarvo_last_error();
+  EXPECT_LE(msg.size(), 4096u + 64u);
+  EXPECT_EQ(msg.substr(0, 22), long_path.substr(0, 22));
+  const std::string end = "a/camera.yaml: cannot be read (File name too long)";
+  ASSERT_GE(msg.size(), end.size());
+  EXPECT_EQ(msg.substr(msg.size() - end.size()), end);
 }
 
 TEST(CApi, ExtrinsicsMatrixFollowsConventions) {

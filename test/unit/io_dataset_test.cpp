@@ -7,6 +7,8 @@
 #include <string>
 #include <vector>
 
+#include <sys/stat.h>
+
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
@@ -314,6 +316,27 @@ TEST(IoDatasetBadInput, ImageUnreadable) {
   DatasetOptions verify;
   verify.verify_images = true;
   EXPECT_THAT(open_error(dir.path(), 0, file, verify), HasSubstr("cannot be decoded"));
+}
+
+// An image path that is a directory or a named pipe is named as such at open (issue 27: "does
+// not exist", or "cannot be decoded" when read); a pipe is never opened.
+TEST(IoDatasetBadInput, ImagePathsThatAreNotFilesAreNamedAsSuch) {
+  for (const bool pipe : {false, true}) {
+    ScratchDir dir;
+    make_dataset(dir.path());
+    const std::string file = (dir / image_name(2)).string();
+    fs::remove(file);
+    if (pipe)
+      ASSERT_EQ(mkfifo(file.c_str(), 0600), 0);
+    else
+      fs::create_directory(file);
+    EXPECT_THAT(open_error(dir.path(), 0, file), HasSubstr(pipe ? "named pipe" : "is a directory"));
+    // Opened without the check, the frame itself says so when read.
+    DatasetOptions lenient;
+    lenient.allow_missing_images = true;
+    Dataset ds(dir.path().string(), lenient);
+    EXPECT_THAT(expect_invalid_input([&] { ds.frame(2); }, file), HasSubstr(pipe ? "named pipe" : "is a directory"));
+  }
 }
 
 TEST(IoDatasetBadInput, ImageOfTheWrongSize) {

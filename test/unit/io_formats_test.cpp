@@ -7,12 +7,15 @@
 #include <random>
 #include <string>
 
+#include <sys/stat.h>
+
 #include <opencv2/core.hpp>
 
 #include "common/test_util.h"
 #include "core/output_file.h"
 #include "io/formats.h"
 #include "io/stats.h"
+#include "io/text.h"
 #include "unit/io_test_helpers.h"
 
 namespace planarvo {
@@ -26,6 +29,7 @@ using test::expect_invalid_input;
 using test::ScratchDir;
 using test::write_text;
 using ::testing::HasSubstr;
+namespace fs = std::filesystem;
 
 CameraModel test_camera() {
   CameraModel c;
@@ -430,8 +434,40 @@ TEST(IoTum, MalformedLinesNameFileAndLine) {
   bad("tilt.txt", "1.0 0 0 0 0.01 0 0 1", "about z");
   bad("tilt_y.txt", "1.0 0 0 0 0 -0.001 0.7 0.7", "about z");
   bad("zero_q.txt", "1.0 0 0 0 0 0 0 0", "zero length");
+  // Beyond 1e6 m: a corrupt value or another unit (issue 27: 1e308 in odometry.txt ended in a
+  // factor's "information matrix must be finite" after the whole run, with no file or line).
+  bad("far_x.txt", "1.0 1e308 0 0 0 0 0 1", "beyond");
+  bad("far_y.txt", "1.0 0 -1000000.5 0 0 0 0 1", "beyond");
   const std::string missing = (dir / "missing.txt").string();
   expect_invalid_input([&] { io::read_tum(missing); }, missing);
+  // Just inside the bound reads.
+  write_text(dir / "near.txt", good + "1.0 999999.5 -1e6 0 0 0 0 1\n");
+  const auto near = io::read_tum((dir / "near.txt").string());
+  ASSERT_EQ(near.size(), 2u);
+  EXPECT_EQ(near[1].pose.x, 999999.5);
+  EXPECT_EQ(near[1].pose.y, -1e6);
+}
+
+// An input path that is a directory or a named pipe is named as such, and a pipe is never opened
+// (a reader would block until something writes to it). Issue 27: a directory read as "does not
+// exist" or "cannot be decoded".
+TEST(IoFiles, DirectoriesAndPipesAreNamedAsSuchAndNeverOpened) {
+  ScratchDir dir;
+  const std::string folder = (dir / "folder").string(), pipe = (dir / "pipe").string();
+  fs::create_directory(folder);
+  ASSERT_EQ(mkfifo(pipe.c_str(), 0600), 0);
+  EXPECT_EQ(io::detail::input_file_problem(folder), "is a directory, not a file");
+  EXPECT_EQ(io::detail::input_file_problem(pipe), "is a named pipe (FIFO), not a regular file");
+  EXPECT_EQ(io::detail::input_file_problem((dir / "none").string()), "does not exist");
+  EXPECT_EQ(io::detail::input_file_problem((dir / "none" / "x").string()), "does not exist");
+  write_text(dir / "file.txt", "x\n");
+  EXPECT_EQ(io::detail::input_file_problem((dir / "file.txt").string()), "");
+  for (const std::string& path : {folder, pipe}) {
+    SCOPED_TRACE(path);
+    EXPECT_THAT(expect_invalid_input([&] { io::read_tum(path); }, path), HasSubstr(path == folder ? "directory" : "pipe"));
+    EXPECT_THAT(expect_invalid_input([&] { io::read_camera_yaml(path); }, path), HasSubstr(path == folder ? "directory" : "pipe"));
+    EXPECT_THAT(expect_invalid_input([&] { io::read_frames(path); }, path), HasSubstr(path == folder ? "directory" : "pipe"));
+  }
 }
 
 TEST(IoTum, ToleratesRoundingOfZAndTilt) {

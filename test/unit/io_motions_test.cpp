@@ -78,6 +78,10 @@ TEST(IoMotions, MalformedFilesNameFileAndLine) {
   expect_error("# interval_s,sensor_dx,sensor_dy,sensor_dtheta,speed\n", "speed");
   expect_error(h + "0.1,0,0,0\n0.1,0,nan,0\n", "bad.csv:3");
   expect_error(h + "0.1,0,0\n", "bad.csv:2");
+  // Beyond 1e6 m: a corrupt value or another unit (issue 27).
+  expect_error(h + "0.1,0,0,0\n0.1,1e308,0,0\n", "bad.csv:3");
+  expect_error("# interval_s,odo_dx,odo_dy,odo_dtheta,sensor_dx,sensor_dy,sensor_dtheta\n0.1,0,-2e6,0,0,0,0\n",
+               "bad.csv:2");
   expect_error(h + "-0.1,0,0,0\n", "bad.csv:2");
   expect_error(h, "no motion pairs");
   expect_error("# interval_s,sensor_dx,sensor_dy,sensor_dtheta,direction\n0.1,0,0,0,2\n", "bad.csv:2");
