@@ -62,14 +62,21 @@ inline void write_file(const std::string& path, const uint8_t* data, size_t size
 
 // Every failed call leaves a message, and a status the API knows. PLANARVO_ERROR_INTERNAL means "a
 // bug in planarvo" (an exception the library did not expect, e.g. an OpenCV assertion), so bad
-// arguments or input must never give it; running out of memory is the one honest case.
+// arguments or input must never give it (running out of memory is PLANARVO_ERROR_OUT_OF_MEMORY).
+// The message is printable (no control character but newline and tab) and at most
+// 4096 bytes, whatever the input held.
 inline void check_status(planarvo_status st) {
   if (st == PLANARVO_OK) return;
   const char* name = planarvo_status_name(st);
   if (!name || !*name) broken("a failure status without a name");
   const char* msg = planarvo_last_error();
   if (!msg || !*msg) broken("a failure without a message");
-  if (st == PLANARVO_ERROR_INTERNAL && std::string(msg) != "out of memory") {
+  const std::string text(msg);
+  if (text.size() > 4096) broken("a message longer than 4096 bytes");
+  for (const char c : text)
+    if ((static_cast<unsigned char>(c) < 0x20 && c != '\n' && c != '\t') || c == 0x7f)
+      broken("a message with a control character");
+  if (st == PLANARVO_ERROR_INTERNAL) {
     std::fprintf(stderr, "planarvo fuzz: PLANARVO_ERROR_INTERNAL: %s\n", msg);
     broken("bad input or arguments gave PLANARVO_ERROR_INTERNAL");
   }

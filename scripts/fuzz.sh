@@ -13,6 +13,7 @@
 #   --no-build   use the targets already built
 #   --report     run nothing: print the table of the last runs in BUILD_DIR/fuzz-runs
 #   TARGET       camera_yaml extrinsics_yaml frames tum direction motion_pairs g2o capi mcap rosbag1
+#                image manifest
 #                (default all)
 #
 # Each run's log, working corpus and artifacts are in BUILD_DIR/fuzz-runs/TARGET/. Needs only
@@ -21,7 +22,7 @@
 set -euo pipefail
 
 root=$(cd "$(dirname "$0")/.." && pwd)
-all_targets=(camera_yaml extrinsics_yaml frames tum direction motion_pairs g2o capi mcap rosbag1)
+all_targets=(camera_yaml extrinsics_yaml frames tum direction motion_pairs g2o capi mcap rosbag1 image manifest)
 seconds=60
 jobs=1
 build="$root/build-fuzz"
@@ -67,6 +68,7 @@ dict_for() {
     capi) echo "" ;;
     mcap) echo "$root/fuzz/dict/mcap.dict" ;;
     rosbag1) echo "$root/fuzz/dict/rosbag1.dict" ;;
+    image) echo "$root/fuzz/dict/image.dict" ;;
     *) echo "$root/fuzz/dict/text.dict" ;;
   esac
 }

@@ -12,6 +12,9 @@ packages=(
   libsuitesparse-dev
   libzstd-dev liblz4-dev libbz2-dev
   libgtest-dev libgmock-dev
+  # The fuzz targets (fuzz/, scripts/fuzz.sh), which the test command builds and runs briefly:
+  # clang with libFuzzer and the sanitizers' runtimes.
+  clang libclang-rt-dev
   python3 python3-numpy python3-pytest
   # planarvo plot (python/planarvo/plot): the figures and the calibration report.
   python3-matplotlib

@@ -2,7 +2,8 @@
 # The whole check (README, Quick start; .ci/run runs it): installs what is missing, builds and
 # runs the test suite, then builds and runs it again under AddressSanitizer and
 # UndefinedBehaviorSanitizer, then runs the threaded tests (several trackers in threads, one per
-# camera) under ThreadSanitizer. Stops at the first failure; prints each stage's time.
+# camera) under ThreadSanitizer, then builds the fuzz targets and runs each for 10 s. Stops at the
+# first failure; prints each stage's time.
 #   PLANARVO_SANITIZERS=0 bash scripts/test.sh   the plain suite only
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -32,9 +33,15 @@ if [ "${PLANARVO_SANITIZERS:-1}" != 0 ]; then
 
   stage "build with ThreadSanitizer (the end-to-end tests)"
   cmake -S . -B build-tsan -G Ninja -DPLANARVO_WERROR=ON -DPLANARVO_TSAN=ON -DPLANARVO_BUILD_BENCHMARKS=OFF
-  cmake --build build-tsan --target planarvo_test_e2e
+  cmake --build build-tsan --target planarvo_test_threads
   stage "threaded tests under ThreadSanitizer"
   # Trackers in threads, and the mosaic's decoding thread (BadInput builds small mosaics).
   ctest --test-dir build-tsan --output-on-failure -R 'TrackerThreads\.|Mosaic\.BadInput'
+
+  # The fuzz targets (fuzz/README.md) built with clang, ASan and UBSan, and each run briefly on its
+  # seed corpus: they cannot rot, and a seed that crashes fails the run. The 10-minute runs are
+  # scripts/fuzz.sh -t 600 -j 2.
+  stage "fuzz targets: build (clang, AddressSanitizer + UndefinedBehaviorSanitizer) and 10 s each"
+  bash scripts/fuzz.sh -t 10 -j 2
 fi
 stage "done"

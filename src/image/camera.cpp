@@ -57,9 +57,9 @@ Eigen::Vector2d CameraModel::unproject(const Eigen::Vector2d& pixel) const {
 
 void CameraModel::validate(const char* what) const {
   const std::string where(what);
-  if (width < kMinRegionSide || height < kMinRegionSide)
-    throw_invalid_input(where + ": image_width and image_height must be at least " + std::to_string(kMinRegionSide) +
-                        " pixels (got " + std::to_string(width) + "x" + std::to_string(height) + ")");
+  if (width <= 0 || height <= 0)
+    throw_invalid_input(where + ": image_width and image_height must be positive (got " +
+                        std::to_string(width) + "x" + std::to_string(height) + ")");
   for (double v : {fx, fy, cx, cy, k1, k2, p1, p2, k3})
     if (!std::isfinite(v)) throw_invalid_input(where + ": camera parameters contain NaN or inf");
   if (!(fx > 0) || !(fy > 0))

@@ -30,8 +30,7 @@ void for_each_border_pixel(const PixelRegion& r, int step, F&& f) {
   }
 }
 
-// The smallest image, and the smallest region of interest, a camera may have, pixels per side
-// (the tracker's coarsest pyramid level needs a few pixels).
+// The smallest region of interest a camera may have, pixels per side.
 inline constexpr int kMinRegionSide = 16;
 
 struct CameraModel {
@@ -64,8 +63,8 @@ struct CameraModel {
   // Distorted pixel -> undistorted normalised coordinates (the ray (x, y, 1)).
   Eigen::Vector2d unproject(const Eigen::Vector2d& pixel) const;
 
-  // Throws InvalidInput (naming `what`, e.g. the file) when the image is smaller than
-  // kMinRegionSide pixels on a side, focal lengths are not positive or a value is not finite, the rolling shutter readout is negative, or the region
+  // Throws InvalidInput (naming `what`, e.g. the file) when sizes or focal lengths are not
+  // positive or a value is not finite, the rolling shutter readout is negative, or the region
   // of interest is not inside the image or is smaller than kMinRegionSide pixels on a side.
   void validate(const char* what) const;
 };

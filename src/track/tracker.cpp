@@ -64,6 +64,9 @@ constexpr double kMinSelfTexture = 0.1;
 // Some of the image (a 9 x 9 grid of undistorted pixels) looks at least 0.5 degrees below the
 // horizon: the ground plane is in view. A camera pitched to look up sees none of it, and every
 // frame would be Lost (or, with a sky texture, Ok and meaningless).
+// The fewest pixels on a side of the coarsest pyramid level the tracker accepts.
+constexpr int kMinCoarsestSide = 4;
+
 bool sees_the_ground(const CameraModel& c, const Extrinsics& e) {
   const Eigen::Vector3d n = e.plane_normal_camera();  // ground points X: n.X = -z
   const Eigen::Matrix3d Kinv = c.K().inverse();
@@ -98,6 +101,15 @@ CameraModel validated(const CameraModel& c, const Extrinsics& e, const TrackerOp
   if (!(o.consecutive_alignment_correlation >= 0.0 && o.consecutive_alignment_correlation <= 0.5))
     throw_invalid_argument("the tracker's consecutive alignment correlation must be within [0, 0.5]");
   c.validate("Tracker camera");
+  // The coarsest level must hold a few pixels for the alignment to work on (issue 27: a 1x1
+  // camera failed inside the aligner with an internal message).
+  const int coarsest_w = level_size(c.width, o.levels - 1), coarsest_h = level_size(c.height, o.levels - 1);
+  if (coarsest_w < kMinCoarsestSide || coarsest_h < kMinCoarsestSide)
+    throw_invalid_argument("Tracker: a " + std::to_string(c.width) + "x" + std::to_string(c.height) +
+                           " image is too small for " + std::to_string(o.levels) +
+                           " pyramid levels: the coarsest would be " + std::to_string(coarsest_w) + "x" +
+                           std::to_string(coarsest_h) + " pixels, and the tracker needs " +
+                           std::to_string(kMinCoarsestSide) + " on a side (fewer levels, or a larger image)");
   return c;
 }
 

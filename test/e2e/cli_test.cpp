@@ -17,6 +17,7 @@
 #include "common/printed_values.h"
 #include "common/test_util.h"
 #include "io/formats.h"
+#include "io/motions.h"
 
 namespace planarvo {
 namespace {
@@ -56,14 +57,16 @@ void make_dataset(const fs::path& dir) {
 }
 
 TEST(Cli, UsageErrorsExitWith2) {
+  // output unchecked: usage errors below, nothing runs
   EXPECT_EQ(run_cli("").exit_code, 2);
   EXPECT_EQ(run_cli("no-such-command").exit_code, 2);
-  auto r = run_cli("simulate --out /tmp/x --no-such-option 1");
+  auto r = run_cli("simulate --out /tmp/x --no-such-option 1");  // output unchecked: a usage error
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.output.find("--no-such-option"), std::string::npos) << r.output;
-  r = run_cli("simulate --out /tmp/x --seconds abc");
+  r = run_cli("simulate --out /tmp/x --seconds abc");  // output unchecked: a usage error
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.output.find("--seconds"), std::string::npos) << r.output;
+  // output unchecked: a usage error
   EXPECT_EQ(run_cli("simulate --out /tmp/x --motion zigzag").exit_code, 2);
   EXPECT_EQ(run_cli("info").exit_code, 2);
 }
@@ -82,8 +85,10 @@ TEST(Cli, UnknownDeviceExitsWith3) {
   auto r = run_cli("simulate --out " + (d / "s").string() + " --device no-such-device-xyz");
   EXPECT_EQ(r.exit_code, 3) << r.output;
   EXPECT_NE(r.output.find("no-such-device-xyz"), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(d / "s"));
   r = run_cli("kernels --export " + (d / "k").string() + " --device 99");
   EXPECT_EQ(r.exit_code, 3) << r.output;
+  EXPECT_FALSE(fs::exists(d / "k"));
 }
 
 // Each bad input: exit code 2, and the message names the file (and line where it applies).
@@ -143,6 +148,7 @@ TEST(Cli, SimulateRejectsBadTexture) {
   auto r = run_cli("simulate --quiet --out " + (d / "sim").string() + " --texture /nonexistent/floor.png");
   EXPECT_EQ(r.exit_code, 2) << r.output;
   EXPECT_NE(r.output.find("/nonexistent/floor.png"), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(d / "sim"));
 }
 
 // A car drive for a rear camera: every interval of the written ground truth is an arc no tighter
@@ -186,6 +192,7 @@ TEST(Cli, ARegionOfInterestLetsARearCameraSeeTheHorizon) {
                           "--motion car --max-speed 2 --min-turn-radius 6";
   auto r = run_cli("simulate --quiet --out " + (d / "whole").string() + cam);
   EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_FALSE(fs::exists(d / "whole"));
   const fs::path seq = d / "roi";
   r = run_cli("simulate --quiet --out " + seq.string() + cam + " --roi 0,0,320,150");
   ASSERT_EQ(r.exit_code, 0) << r.output;
@@ -231,7 +238,7 @@ TEST(Cli, UsageErrorsSayWhatWasWrong) {
       {"calibrate d --roi 5,5,0,0", "--roi: give a width and a height"},
       {"track d --finest-level 0 --level0-subsample 9", "--level0-subsample must be 1 to 8"},
       // Output files never get directories made for them (simulate --out and kernels --export,
-      // which name directories, do).
+      // which name directories, do). output unchecked: the directory does not exist
       {"track d -o /nonexistent-planarvo/t.txt", "-o: the directory /nonexistent-planarvo does not exist"},
       {"track d --stats /nonexistent-planarvo/s.csv", "--stats: the directory /nonexistent-planarvo does not exist"},
       {"calibrate d -o /nonexistent-planarvo/e.yaml", "-o: the directory /nonexistent-planarvo does not exist"},
@@ -283,6 +290,7 @@ TEST(Cli, TrackStoppedByACorruptFrameLeavesEarlierOutputsAsTheyWere) {
     EXPECT_EQ(tum[i].pose.y, frames[i].result.pose.y) << i;
   }
   EXPECT_EQ(test::read_csv(stats.string()).size(), 15u);
+  EXPECT_EQ(io::read_motion_pairs(motions.string()).pairs.size(), 14u);  // one per interval
   for (const fs::path& p : {stats, motions}) {
     EXPECT_NE(read(p).rfind("the user's earlier", 0), 0u) << p;
     EXPECT_EQ(test::partial_files(p), 0) << p;

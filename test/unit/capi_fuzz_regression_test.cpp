@@ -25,9 +25,10 @@ planarvo_status status_from_int(int v) {
 // planarvo_status_name switched on the enum itself: an out-of-range value is undefined behaviour in
 // C++ (UBSan: "load of value 2164260352, which is not a valid value for type 'planarvo_status'").
 TEST(CApiFuzzRegression, StatusNameOfAnyIntIsUnknown) {
-  for (int v : {-1, 10, 16, 999, static_cast<int>(0x80FFFF00u), 0x7fffffff})
+  for (int v : {-1, 11, 16, 999, static_cast<int>(0x80FFFF00u), 0x7fffffff})
     EXPECT_STREQ(planarvo_status_name(status_from_int(v)), "PLANARVO_ERROR_UNKNOWN") << v;
   EXPECT_STREQ(planarvo_status_name(status_from_int(9)), "PLANARVO_ERROR_INTERNAL");
+  EXPECT_STREQ(planarvo_status_name(status_from_int(10)), "PLANARVO_ERROR_OUT_OF_MEMORY");
   EXPECT_STREQ(planarvo_status_name(status_from_int(0)), "PLANARVO_OK");
 }
 

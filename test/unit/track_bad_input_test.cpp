@@ -4,6 +4,8 @@
 // good frames allow it.
 #include <cmath>
 #include <cstdio>
+#include <string>
+#include <tuple>
 
 #include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
@@ -271,6 +273,36 @@ TEST(TrackerExtrinsics, NotFiniteOrLookingUpIsInvalidArgument) {
       ADD_FAILURE() << "pitch " << pitch_deg << " deg accepted";
     } catch (const Error& err) {
       EXPECT_EQ(err.code(), ErrorCode::InvalidArgument) << pitch_deg;
+    }
+  }
+}
+
+// An image too small for the pyramid is refused when the tracker is made, naming the size, the
+// levels and what the coarsest level would be (issue 27: a 1x1 camera failed inside the aligner
+// with an internal "WarpReduce::run" message). level_size is ceil(w / 2^l): a 32x32 image has a
+// 4x4 coarsest level at 4 levels, a 31-pixel side 4 too, 24 gives 3.
+TEST(TrackerCamera, ImagesTooSmallForThePyramidAreInvalidArgument) {
+  ocl::Runtime rt;
+  const Extrinsics e{0.2, 0.0, 0.3, 0.2, 0.3, 0.0};
+  const auto make = [&](int w, int h, int levels) {
+    CameraModel cam = sim::default_camera(w, h);
+    TrackerOptions o;
+    o.levels = levels;
+    Tracker t(rt, cam, e, o);
+  };
+  EXPECT_NO_THROW(make(32, 32, 4));
+  EXPECT_NO_THROW(make(25, 25, 4));
+  EXPECT_NO_THROW(make(4, 4, 1));
+  for (const auto& [w, h, levels, coarsest] :
+       {std::tuple{1, 1, 1, "1x1"}, {1, 1, 4, "1x1"}, {24, 32, 4, "3x4"}, {64, 48, 5, "4x3"}, {3, 8, 1, "3x8"}}) {
+    try {
+      make(w, h, levels);
+      ADD_FAILURE() << w << "x" << h << " at " << levels << " levels accepted";
+    } catch (const Error& err) {
+      EXPECT_EQ(err.code(), ErrorCode::InvalidArgument) << err.what();
+      const std::string msg = err.what();
+      EXPECT_NE(msg.find(std::to_string(w) + "x" + std::to_string(h) + " image"), std::string::npos) << msg;
+      EXPECT_NE(msg.find("coarsest would be " + std::string(coarsest) + " pixels"), std::string::npos) << msg;
     }
   }
 }
