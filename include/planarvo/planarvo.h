@@ -79,7 +79,8 @@ typedef enum planarvo_status {
 } planarvo_status;
 
 /* The message of the calling thread's last failed call ("" if none). Valid until the thread's
- * next failing call. */
+ * next failing call. Printable: control bytes from the input (NUL, escapes) are written \xNN,
+ * and a message over 4096 bytes keeps its start and its end. */
 PLANARVO_API const char* planarvo_last_error(void);
 /* A fixed name for a status code, e.g. "PLANARVO_ERROR_INVALID_INPUT". */
 PLANARVO_API const char* planarvo_status_name(planarvo_status status);
