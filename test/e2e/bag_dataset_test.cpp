@@ -101,6 +101,19 @@ class BagDataset : public ::testing::Test {
     return out;
   }
 
+  // The bag `from` rewritten by python3-rosbag into scratch()/name: `body` is Python run for
+  // each message (topic, m, t; rosbag and rospy imported) and writes it with out.write(topic,
+  // m, time). Fails the test when the rewrite fails.
+  static fs::path rewrite_rosbag(const fs::path& from, const std::string& name, const std::string& body) {
+    const fs::path out = scratch() / name;
+    const auto r = run_command("/usr/bin/python3 -c \"import rosbag, rospy, sys\n"
+                               "out = rosbag.Bag(sys.argv[2], 'w')\n"
+                               "for topic, m, t in rosbag.Bag(sys.argv[1]).read_messages():\n" +
+                               body + "out.close()\" " + from.string() + " " + out.string());
+    EXPECT_EQ(r.exit_code, 0) << r.output;
+    return out;
+  }
+
   // Every frame tracked through the C API with the true extrinsics; options NULL for a folder.
   static std::vector<TrackedFrame> track(const std::string& path, const planarvo_dataset_options* options,
                                          planarvo_dataset_info* info_out = nullptr) {
@@ -243,15 +256,10 @@ TEST_F(BagDataset, ReceiveTimesShiftTheOriginOnly) {
 TEST_F(BagDataset, ReceiveTimesAreEachMessagesOwn) {
   SKIP_WITHOUT(rosbag_missing());
   const fs::path bag = write_rosbag("mono8_none.bag", "--compression none");
-  const fs::path jittered = scratch() / "jittered.bag";
-  const auto w = run_command(
-      "/usr/bin/python3 -c \"import rosbag, rospy, sys\n"
-      "out = rosbag.Bag(sys.argv[2], 'w')\n"
-      "for topic, m, t in rosbag.Bag(sys.argv[1]).read_messages():\n"
-      "    ns = m.header.stamp.to_nsec()\n"
-      "    out.write(topic, m, rospy.Time(0, ns + 5000000 + (ns % 11) * 1000000))\n"
-      "out.close()\" " + bag.string() + " " + jittered.string());
-  ASSERT_EQ(w.exit_code, 0) << w.output;
+  const fs::path jittered = rewrite_rosbag(bag, "jittered.bag",
+                                          "    ns = m.header.stamp.to_nsec()\n"
+                                          "    out.write(topic, m, rospy.Time(0, ns + 5000000 + (ns % 11) * 1000000))\n");
+  ASSERT_FALSE(HasFailure());
   const auto receive_ns = [](size_t i) {
     const int64_t stamp = kBaseNs + std::llround(folder_[i].data.timestamp * 1e9);
     return stamp + 5000000 + (stamp % 11) * 1000000;
@@ -305,15 +313,9 @@ TEST_F(BagDataset, TopicsAreListedWithTheirTypesAndCounts) {
 TEST_F(BagDataset, MessagesRecordedOutOfOrderAreTakenInStampOrder) {
   SKIP_WITHOUT(rosbag_missing());
   const fs::path bag = write_rosbag("mono8_none.bag", "--compression none");
-  const fs::path reversed = scratch() / "reversed.bag";
-  const auto w = run_command(
-      "/usr/bin/python3 -c \"import rosbag, rospy, sys\n"
-      "out = rosbag.Bag(sys.argv[2], 'w')\n"
-      "end = rospy.Time(1800000000)\n"
-      "for topic, m, t in rosbag.Bag(sys.argv[1]).read_messages():\n"
-      "    out.write(topic, m, end - (t - rospy.Time(1700000000)))\n"
-      "out.close()\" " + bag.string() + " " + reversed.string());
-  ASSERT_EQ(w.exit_code, 0) << w.output;
+  const fs::path reversed = rewrite_rosbag(
+      bag, "reversed.bag", "    out.write(topic, m, rospy.Time(1800000000) - (t - rospy.Time(1700000000)))\n");
+  ASSERT_FALSE(HasFailure());
   expect_same_as_folder(reversed);
 }
 
@@ -418,15 +420,10 @@ TEST_F(BagDataset, BadBagsAreExit2NamingTheProblem) {
 
   // A camera info 2 pixels wider than the images: the bag rewritten by python3-rosbag with
   // each CameraInfo's width changed.
-  const fs::path wide = scratch() / "wide.bag";
-  const auto w = run_command(
-      "/usr/bin/python3 -c \"import rosbag, sys\n"
-      "out = rosbag.Bag(sys.argv[2], 'w')\n"
-      "for topic, m, t in rosbag.Bag(sys.argv[1]).read_messages():\n"
-      "    if topic == '/camera/camera_info': m.width = 322\n"
-      "    out.write(topic, m, t)\n"
-      "out.close()\" " + bag.string() + " " + wide.string());
-  ASSERT_EQ(w.exit_code, 0) << w.output;
+  const fs::path wide = rewrite_rosbag(bag, "wide.bag",
+                                      "    if topic == '/camera/camera_info': m.width = 322\n"
+                                      "    out.write(topic, m, t)\n");
+  ASSERT_FALSE(HasFailure());
   const auto size = run_cli("track --quiet " + wide.string() + extr);
   EXPECT_EQ(size.exit_code, 2);
   EXPECT_THAT(size.output, HasSubstr("322x240"));
@@ -443,13 +440,7 @@ TEST_F(BagDataset, BadBagsAreExit2NamingTheProblem) {
   // A NaN focal length in every camera info is named as such, not as a camera that "differs from
   // the first one"; an odometry position of 1e308 m is refused naming its message (issue 27).
   const auto rewrite = [&](const std::string& name, const std::string& change) {
-    const fs::path out = scratch() / name;
-    const auto r = run_command("/usr/bin/python3 -c \"import rosbag, sys\n"
-                               "out = rosbag.Bag(sys.argv[2], 'w')\n"
-                               "for topic, m, t in rosbag.Bag(sys.argv[1]).read_messages():\n" +
-                               change + "    out.write(topic, m, t)\nout.close()\" " + bag.string() + " " + out.string());
-    EXPECT_EQ(r.exit_code, 0) << r.output;
-    return out;
+    return rewrite_rosbag(bag, name, change + "    out.write(topic, m, t)\n");
   };
   const fs::path nan_fx = rewrite("nan_fx.bag", "    if topic == '/camera/camera_info': m.K = [float('nan')] + list(m.K[1:])\n");
   const auto nan_run = run_cli("track --quiet " + nan_fx.string() + extr);
