@@ -102,6 +102,7 @@ class VideoSource {
     if (const std::string problem = detail::input_file_problem(path_); !problem.empty())
       throw_invalid_input(path_ + ": the video " + problem);
     open_first_backend();
+    const int64_t packets = find_cut_jpeg_frames();
     const double fps = cap_.get(cv::CAP_PROP_FPS);
     const double count_hint = cap_.get(cv::CAP_PROP_FRAME_COUNT);
     // OpenCV's own MJPEG reader reports the time after the grabbed frame, not its start.
@@ -120,6 +121,8 @@ class VideoSource {
     }
     next_ = static_cast<int64_t>(msec.size());
     if (msec.empty()) throw_invalid_input(path_ + ": the video has no frames that can be read");
+    // Packets and frames are one to one for JPEG frames; if they are not, the indices say nothing.
+    if (packets != next_) cut_frames_.clear();
 
     bool usable = true;
     for (size_t i = 0; i < msec.size(); ++i)
@@ -184,7 +187,36 @@ class VideoSource {
     if (!try_open(api)) throw_invalid_input(path_ + ": the video cannot be opened again");
   }
 
+  // An MJPEG video's frames are JPEG images, and FFmpeg decodes one that was cut short with only
+  // a warning and grey rows where its data stop (issue 27). In FFmpeg's raw mode the packets
+  // come undecoded, so each is checked as an image file is (truncation_problem): one pass that
+  // only demuxes, at open. Returns the number of packets, or -1 when the check does not apply:
+  // not FFmpeg (OpenCV's own MJPEG reader has no raw mode), or frames that are not JPEG images
+  // (other codecs are left to their decoders).
+  int64_t find_cut_jpeg_frames() {
+    if (api_ != cv::CAP_FFMPEG) return -1;
+    cv::VideoCapture raw;
+    try {
+      if (!raw.open(path_, cv::CAP_FFMPEG) || !raw.set(cv::CAP_PROP_FORMAT, -1)) return -1;
+      cv::Mat packet;
+      int64_t i = 0;
+      for (; raw.grab(); ++i) {
+        if (!raw.retrieve(packet) || packet.empty() || !packet.isContinuous()) return -1;
+        const auto* p = packet.ptr<unsigned char>();
+        const size_t n = packet.total() * packet.elemSize();
+        if (i == 0 && !(n >= 3 && p[0] == 0xFF && p[1] == 0xD8 && p[2] == 0xFF)) return -1;
+        if (std::string cut = detail::truncation_problem(p, n); !cut.empty()) cut_frames_.emplace_back(i, cut);
+      }
+      return i;
+    } catch (const cv::Exception&) {
+      cut_frames_.clear();
+      return -1;
+    }
+  }
+
   cv::Mat retrieve(int64_t i) {
+    for (const auto& [index, cut] : cut_frames_)
+      if (index == i) throw_invalid_input(path_ + ": frame " + std::to_string(i) + " of the video: " + cut);
     cv::Mat img;
     if (!cap_.retrieve(img) || img.empty())
       throw_invalid_input(path_ + ": frame " + std::to_string(i) + " of the video cannot be decoded");
@@ -209,6 +241,7 @@ class VideoSource {
   int64_t next_ = 0;  // the index the next grab() returns
   std::vector<double> times_;
   std::deque<std::pair<int64_t, cv::Mat>> cache_;
+  std::vector<std::pair<int64_t, std::string>> cut_frames_;  // JPEG frames cut short, and why
 };
 
 }  // namespace

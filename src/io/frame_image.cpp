@@ -50,11 +50,11 @@ std::string truncation_problem(const unsigned char* head, size_t head_size, cons
   };
   if (head_size >= 3 && head[0] == 0xFF && head[1] == 0xD8 && head[2] == 0xFF) {
     static const unsigned char eoi[2] = {0xFF, 0xD9};
-    if (!holds(eoi, 2)) return "the JPEG data end without their end-of-image marker: the file was cut short";
+    if (!holds(eoi, 2)) return "the JPEG data end without their end-of-image marker: they were cut short";
   } else if (static const unsigned char png[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1A, '\n'};
              head_size >= 8 && std::equal(head, head + 8, png)) {
     static const unsigned char iend[4] = {'I', 'E', 'N', 'D'};
-    if (!holds(iend, 4)) return "the PNG data end without their IEND chunk: the file was cut short";
+    if (!holds(iend, 4)) return "the PNG data end without their IEND chunk: they were cut short";
   }
   return "";
 }

@@ -3,7 +3,9 @@
 // interval midpoint, every bad input as InvalidInput naming the file (and line), progress and
 // cancelling, and a video standing in for images/ + frames.txt.
 #include <cmath>
+#include <cstdint>
 #include <filesystem>
+#include <fstream>
 #include <string>
 #include <vector>
 
@@ -508,6 +510,76 @@ TEST(IoDatasetVideo, VerifyDecodesEverythingAtOpen) {
   o.progress = nullptr;
   Dataset ds(dir.path().string(), o);
   EXPECT_EQ(ds.frame_count(), kVideoFrames);
+}
+
+// An MJPEG video (an AVI as OpenCV's FFmpeg writer makes it) whose frame `cut` keeps only the
+// first half of its image data, as a camera that delivered part of a frame leaves it: the frame's
+// chunk is shortened, its index entry too, and the rest of its bytes become a JUNK chunk, which
+// readers skip.
+void cut_jpeg_frame(const std::string& video, int cut) {
+  std::string bytes = test::read_file(video);
+  const auto le32 = [&](size_t at) {
+    uint32_t v = 0;
+    for (int k = 3; k >= 0; --k) v = v << 8 | static_cast<unsigned char>(bytes[at + static_cast<size_t>(k)]);
+    return v;
+  };
+  const auto put32 = [&](size_t at, uint32_t v) {
+    for (int k = 0; k < 4; ++k) bytes[at + static_cast<size_t>(k)] = static_cast<char>(v >> (8 * k) & 0xFF);
+  };
+  // Frame chunks: "00dc", a 4-byte little-endian size, the JPEG data (SOI, FF D8 FF).
+  size_t at = 0;
+  for (int seen = -1; seen < cut; at += 4) {
+    at = bytes.find("00dc", at);
+    ASSERT_NE(at, std::string::npos) << "frame " << seen + 1;
+    if (bytes.compare(at + 8, 3, "\xFF\xD8\xFF") == 0 && ++seen == cut) break;  // not the index's
+  }
+  const uint32_t size = le32(at + 4);
+  ASSERT_GT(size, 100u);
+  ASSERT_EQ(bytes.compare(at + 8 + size - 2, 2, "\xFF\xD9"), 0);  // the frame's end-of-image marker
+  // Its headers and the first half of its entropy-coded data, after the start of scan (FF DA).
+  const size_t scan = bytes.find("\xFF\xDA", at + 8);
+  ASSERT_LT(scan, at + 8 + size);
+  const uint32_t kept = static_cast<uint32_t>(scan - (at + 8) + (at + 8 + size - scan) / 2) & ~1u;
+  ASSERT_GE(size - kept, 16u);
+  put32(at + 4, kept);
+  bytes.replace(at + 8 + kept, 4, "JUNK");
+  put32(at + 12 + kept, size - kept - 8);
+  // The index (idx1): 16 bytes per chunk, "00dc", flags, offset, size; the frame's is its cut-th.
+  size_t index = bytes.find("idx1");
+  ASSERT_NE(index, std::string::npos);
+  int entry = -1;
+  for (size_t e = index + 8; e + 16 <= bytes.size(); e += 16)
+    if (bytes.compare(e, 4, "00dc") == 0 && ++entry == cut) {
+      ASSERT_EQ(le32(e + 12), size);
+      put32(e + 12, kept);
+      break;
+    }
+  ASSERT_EQ(entry, cut);
+  std::ofstream(video, std::ios::binary | std::ios::trunc) << bytes;
+}
+
+TEST(IoDatasetVideo, AJpegFrameCutShortIsNamed) {
+  ScratchDir dir;
+  DatasetOptions o;
+  o.video = make_video_dataset(dir.path());
+  cut_jpeg_frame(o.video, 5);
+  // The decoder itself takes the frame (with a warning on stderr): all 12 frames decode.
+  cv::VideoCapture plain(o.video);
+  int decoded = 0;
+  for (cv::Mat f; plain.read(f);) ++decoded;
+  EXPECT_EQ(decoded, kVideoFrames);
+  // Read in order, the frames before it are as written; the cut one is InvalidInput naming it.
+  Dataset ds(dir.path().string(), o);
+  ASSERT_EQ(ds.frame_count(), kVideoFrames);
+  for (int i = 0; i < 5; ++i)
+    EXPECT_LT(cv::norm(ds.frame(i), video_frame(i), cv::NORM_L1) / (kVW * kVH), 3.0) << i;
+  const std::string msg = expect_invalid_input([&] { ds.frame(5); }, o.video);
+  EXPECT_THAT(msg, HasSubstr("frame 5 of the video"));
+  EXPECT_THAT(msg, HasSubstr("cut short"));
+  EXPECT_LT(cv::norm(ds.frame(6), video_frame(6), cv::NORM_L1) / (kVW * kVH), 3.0);
+  // Verified at open, it is found there.
+  o.verify_images = true;
+  EXPECT_THAT(open_error(dir.path(), 0, o.video, o), HasSubstr("frame 5 of the video"));
 }
 
 TEST(IoDatasetVideo, BadVideos) {
