@@ -65,6 +65,12 @@ class Profile {
 Profile make_profile(const Options& o, double duration, Random& rng) {
   Profile p(o.max_acceleration, o.max_angular_acceleration);
   const double vm = o.max_speed, wm = o.max_turn_rate;
+  // Each segment's random parts are drawn into named values, the duration first, then the turn
+  // rate, then the speed: C++ leaves the order of a call's arguments unspecified, and these were
+  // once drawn inside p.add(v, w, seconds)'s arguments, so that clang (left to right) made
+  // another drive for a seed than GCC (right to left). GCC's order is kept: every drive measured
+  // on the simulator stays the same.
+  const auto add = [&](double v, double w, double seconds) { p.add(v, w, seconds); };
   switch (o.motion) {
     case MotionProfile::Mixed:
       // One cycle takes 7 to 9.5 s at the default limits, so a 10 s sequence has every
@@ -72,22 +78,46 @@ Profile make_profile(const Options& o, double duration, Random& rng) {
       // ways, reversing.
       while (p.end() < duration) {
         const int turn = rng.sign(), spin = rng.sign();
-        p.add(0.0, 0.0, rng.uniform(0.2, 0.35));                                      // stop
-        p.add(rng.uniform(0.6, 1.0) * vm, rng.uniform(-0.05, 0.05) * wm, rng.uniform(0.4, 0.7));
-        p.add(rng.uniform(0.35, 0.6) * vm, turn * rng.uniform(0.4, 0.8) * wm, rng.uniform(0.4, 0.7));
-        p.add(0.0, 0.0, rng.uniform(0.1, 0.2));                                       // stop
-        p.add(0.0, spin * rng.uniform(0.6, 1.0) * wm, rng.uniform(0.3, 0.5));         // in place
-        p.add(0.0, -spin * rng.uniform(0.6, 1.0) * wm, rng.uniform(0.3, 0.5));
-        p.add(-rng.uniform(0.35, 0.6) * vm, -turn * rng.uniform(0.1, 0.5) * wm, rng.uniform(0.5, 0.8));
-        p.add(rng.uniform(0.35, 0.6) * vm, -turn * rng.uniform(0.4, 0.8) * wm, rng.uniform(0.4, 0.7));
+        add(0.0, 0.0, rng.uniform(0.2, 0.35));  // stop
+        {
+          const double s = rng.uniform(0.4, 0.7), w = rng.uniform(-0.05, 0.05) * wm, v = rng.uniform(0.6, 1.0) * vm;
+          add(v, w, s);
+        }
+        {
+          const double s = rng.uniform(0.4, 0.7), w = turn * rng.uniform(0.4, 0.8) * wm, v = rng.uniform(0.35, 0.6) * vm;
+          add(v, w, s);
+        }
+        add(0.0, 0.0, rng.uniform(0.1, 0.2));  // stop
+        {
+          const double s = rng.uniform(0.3, 0.5), w = spin * rng.uniform(0.6, 1.0) * wm;  // in place
+          add(0.0, w, s);
+        }
+        {
+          const double s = rng.uniform(0.3, 0.5), w = -spin * rng.uniform(0.6, 1.0) * wm;
+          add(0.0, w, s);
+        }
+        {
+          const double s = rng.uniform(0.5, 0.8), w = -turn * rng.uniform(0.1, 0.5) * wm, v = -rng.uniform(0.35, 0.6) * vm;
+          add(v, w, s);
+        }
+        {
+          const double s = rng.uniform(0.4, 0.7), w = -turn * rng.uniform(0.4, 0.8) * wm, v = rng.uniform(0.35, 0.6) * vm;
+          add(v, w, s);
+        }
       }
       break;
     case MotionProfile::Straight:
       while (p.end() < duration) {
-        p.add(0.0, 0.0, rng.uniform(0.2, 0.4));
-        p.add(rng.uniform(0.5, 1.0) * vm, 0.0, rng.uniform(0.8, 1.5));
-        p.add(0.0, 0.0, rng.uniform(0.2, 0.4));
-        p.add(-rng.uniform(0.5, 1.0) * vm, 0.0, rng.uniform(0.8, 1.5));
+        add(0.0, 0.0, rng.uniform(0.2, 0.4));
+        {
+          const double s = rng.uniform(0.8, 1.5), v = rng.uniform(0.5, 1.0) * vm;
+          add(v, 0.0, s);
+        }
+        add(0.0, 0.0, rng.uniform(0.2, 0.4));
+        {
+          const double s = rng.uniform(0.8, 1.5), v = -rng.uniform(0.5, 1.0) * vm;
+          add(v, 0.0, s);
+        }
       }
       break;
     case MotionProfile::Circle: {
@@ -95,17 +125,23 @@ Profile make_profile(const Options& o, double duration, Random& rng) {
       const double radius = rng.uniform(0.3, 1.0);
       double v = rng.uniform(0.4, 0.7) * vm;
       if (v / radius > 0.9 * wm) v = 0.9 * wm * radius;
-      p.add(0.0, 0.0, 0.2);
-      p.add(v, rng.sign() * v / radius, std::numeric_limits<double>::infinity());
+      add(0.0, 0.0, 0.2);
+      add(v, rng.sign() * v / radius, std::numeric_limits<double>::infinity());
       break;
     }
     case MotionProfile::Spin:
       while (p.end() < duration) {
-        const int s = rng.sign();
-        p.add(0.0, 0.0, rng.uniform(0.2, 0.4));
-        p.add(0.0, s * rng.uniform(0.5, 1.0) * wm, rng.uniform(0.8, 1.5));
-        p.add(0.0, 0.0, rng.uniform(0.2, 0.4));
-        p.add(0.0, -s * rng.uniform(0.5, 1.0) * wm, rng.uniform(0.8, 1.5));
+        const int sign = rng.sign();
+        add(0.0, 0.0, rng.uniform(0.2, 0.4));
+        {
+          const double s = rng.uniform(0.8, 1.5), w = sign * rng.uniform(0.5, 1.0) * wm;
+          add(0.0, w, s);
+        }
+        add(0.0, 0.0, rng.uniform(0.2, 0.4));
+        {
+          const double s = rng.uniform(0.8, 1.5), w = -sign * rng.uniform(0.5, 1.0) * wm;
+          add(0.0, w, s);
+        }
       }
       break;
     case MotionProfile::Car: {
@@ -117,18 +153,24 @@ Profile make_profile(const Options& o, double duration, Random& rng) {
         const double k = share * kmax;
         return std::isfinite(k) ? k : share * 4.0;  // no radius given: up to 4 rad per metre
       };
+      // v is drawn before its segment (a statement of its own); then the duration, then the turn.
+      const auto add_turning = [&](double v, double share_min, double share_max, double side, double s_min,
+                                   double s_max) {
+        const double s = rng.uniform(s_min, s_max), share = side * rng.uniform(share_min, share_max);
+        add(v, turn(v, curvature(share)), s);
+      };
       while (p.end() < duration) {
         const int side = rng.sign();
-        p.add(0.0, 0.0, rng.uniform(0.3, 0.6));                                          // stop
+        add(0.0, 0.0, rng.uniform(0.3, 0.6));  // stop
         double v = rng.uniform(0.6, 1.0) * vm;
-        p.add(v, turn(v, curvature(rng.uniform(-0.1, 0.1))), rng.uniform(1.0, 2.0));     // straight on
+        add_turning(v, -0.1, 0.1, 1.0, 1.0, 2.0);  // straight on
         v = rng.uniform(0.4, 0.8) * vm;
-        p.add(v, turn(v, curvature(side * rng.uniform(0.6, 1.0))), rng.uniform(1.0, 2.0));  // a bend
+        add_turning(v, 0.6, 1.0, side, 1.0, 2.0);  // a bend
         v = rng.uniform(0.6, 1.0) * vm;
-        p.add(v, turn(v, curvature(-side * rng.uniform(0.3, 1.0))), rng.uniform(0.8, 1.5));
-        p.add(0.0, 0.0, rng.uniform(0.3, 0.6));                                          // stop
-        v = -rng.uniform(0.1, 0.25) * vm;                                                // reverse
-        p.add(v, turn(v, curvature(side * rng.uniform(0.5, 1.0))), rng.uniform(1.0, 2.0));
+        add_turning(v, 0.3, 1.0, -side, 0.8, 1.5);
+        add(0.0, 0.0, rng.uniform(0.3, 0.6));  // stop
+        v = -rng.uniform(0.1, 0.25) * vm;     // reverse
+        add_turning(v, 0.5, 1.0, side, 1.0, 2.0);
       }
       break;
     }

@@ -87,9 +87,13 @@ inline SimulatedMotions simulate_motions(const std::array<double, 4>& z, const C
     const SE2 metric = T.inverse() * robot * T;
     graph::MotionSample s;
     s.interval = o.dt;
-    s.sensor.value = SE2(metric.x / scale + o.sensor_sigma_t * g(rng),
-                         metric.y / scale + o.sensor_sigma_t * g(rng),
-                         wrap_angle(metric.theta + o.sensor_sigma_theta * g(rng)));
+    // The noises drawn theta, y, x: the order GCC evaluated SE2(...)'s arguments in when they
+    // were drawn there (unspecified in C++: clang drew other data sets), so the data are the same.
+    {
+      const double n_theta = g(rng), n_y = g(rng), n_x = g(rng);
+      s.sensor.value = SE2(metric.x / scale + o.sensor_sigma_t * n_x, metric.y / scale + o.sensor_sigma_t * n_y,
+                           wrap_angle(metric.theta + o.sensor_sigma_theta * n_theta));
+    }
     // Isotropic in translation: the same as a covariance of the right perturbation.
     if (o.sensor_sigma_t > 0.0 && o.sensor_sigma_theta > 0.0)
       s.sensor.covariance = Eigen::Vector3d(o.sensor_sigma_t * o.sensor_sigma_t,
@@ -97,8 +101,9 @@ inline SimulatedMotions simulate_motions(const std::array<double, 4>& z, const C
                                             o.sensor_sigma_theta * o.sensor_sigma_theta)
                                 .asDiagonal();
     if (o.odometry) {
-      s.odometry = Motion{SE2(robot.x + o.odometry_sigma_t * g(rng), robot.y + o.odometry_sigma_t * g(rng),
-                              wrap_angle(robot.theta + o.odometry_sigma_theta * g(rng)))};
+      const double n_theta = g(rng), n_y = g(rng), n_x = g(rng);  // as above
+      s.odometry = Motion{SE2(robot.x + o.odometry_sigma_t * n_x, robot.y + o.odometry_sigma_t * n_y,
+                              wrap_angle(robot.theta + o.odometry_sigma_theta * n_theta))};
       if (o.odometry_sigma_t > 0.0 && o.odometry_sigma_theta > 0.0)
         s.odometry->covariance = Eigen::Vector3d(o.odometry_sigma_t * o.odometry_sigma_t,
                                                 o.odometry_sigma_t * o.odometry_sigma_t,
