@@ -1,9 +1,9 @@
 #!/usr/bin/env bash
 # The whole check (README, Quick start; .ci/run runs it): installs what is missing, builds and
-# runs the test suite, then builds and runs it again under AddressSanitizer and
-# UndefinedBehaviorSanitizer, then runs the threaded tests (several trackers in threads, one per
-# camera) under ThreadSanitizer, then builds the fuzz targets and runs each for 10 s. Stops at the
-# first failure; prints each stage's time.
+# runs the test suite, then builds it again with clang under AddressSanitizer and
+# UndefinedBehaviorSanitizer, with the fuzz targets, and runs it, then runs the threaded tests
+# (several trackers in threads, one per camera) under ThreadSanitizer, then runs each fuzz
+# target for 10 s. Stops at the first failure; prints each stage's time.
 #   PLANARVO_SANITIZERS=0 bash scripts/test.sh   the plain suite only
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -24,9 +24,13 @@ stage "test suite"
 ctest --test-dir build --output-on-failure -j2
 
 if [ "${PLANARVO_SANITIZERS:-1}" != 0 ]; then
-  # The sanitizer builds leave out the benchmarks (test/bench), which the suite does not run.
-  stage "build with AddressSanitizer + UndefinedBehaviorSanitizer"
-  cmake -S . -B build-asan -G Ninja -DPLANARVO_WERROR=ON -DPLANARVO_SANITIZE=ON -DPLANARVO_BUILD_BENCHMARKS=OFF
+  # The sanitizer build is clang's (a second compiler's warnings, too), and it also builds the
+  # fuzz targets (PLANARVO_FUZZ: the library's objects instrumented for libFuzzer's coverage as
+  # well), so one build serves both stages. It leaves out the benchmarks (test/bench), which
+  # the suite does not run.
+  stage "build with AddressSanitizer + UndefinedBehaviorSanitizer (clang), and the fuzz targets"
+  cmake -S . -B build-asan -G Ninja -DCMAKE_C_COMPILER=clang -DCMAKE_CXX_COMPILER=clang++ \
+    -DPLANARVO_WERROR=ON -DPLANARVO_SANITIZE=ON -DPLANARVO_FUZZ=ON -DPLANARVO_BUILD_BENCHMARKS=OFF
   cmake --build build-asan
   stage "test suite under AddressSanitizer + UndefinedBehaviorSanitizer"
   ctest --test-dir build-asan --output-on-failure -j2
@@ -38,10 +42,9 @@ if [ "${PLANARVO_SANITIZERS:-1}" != 0 ]; then
   # Trackers in threads, and the mosaic's decoding thread (BadInput builds small mosaics).
   ctest --test-dir build-tsan --output-on-failure -R 'TrackerThreads\.|Mosaic\.BadInput'
 
-  # The fuzz targets (fuzz/README.md) built with clang, ASan and UBSan, and each run briefly on its
-  # seed corpus: they cannot rot, and a seed that crashes fails the run. The 10-minute runs are
-  # scripts/fuzz.sh -t 600 -j 2.
-  stage "fuzz targets: build (clang, AddressSanitizer + UndefinedBehaviorSanitizer) and 10 s each"
-  bash scripts/fuzz.sh -t 10 -j 2
+  # The fuzz targets (fuzz/README.md), each run briefly on its seed corpus: they cannot rot, and
+  # a seed that crashes fails the run. The 10-minute runs are scripts/fuzz.sh -t 600 -j 2.
+  stage "fuzz targets: 10 s each"
+  bash scripts/fuzz.sh -t 10 -j 2 -b build-asan --no-build
 fi
 stage "done"

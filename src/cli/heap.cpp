@@ -27,9 +27,11 @@
 #endif
 
 namespace planarvo::cli {
+#if !defined(PLANARVO_SANITIZED_HEAP) && defined(__GLIBC__) && defined(MADV_HUGEPAGE)
 namespace {
 void* volatile heap_filler = nullptr;  // kept, so that the compiler cannot drop the allocation
 }  // namespace
+#endif
 
 void prepare_heap() {
 #if !defined(PLANARVO_SANITIZED_HEAP) && defined(__GLIBC__) && defined(MADV_HUGEPAGE)

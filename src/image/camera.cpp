@@ -33,13 +33,14 @@ Eigen::Vector2d CameraModel::undistort(const Eigen::Vector2d& xd) const {
     const double r2 = u * u + v * v;
     const double radial = 1.0 + r2 * (k1 + r2 * (k2 + r2 * k3));
     const double dradial = k1 + r2 * (2.0 * k2 + 3.0 * r2 * k3);  // d radial / d r2
-    Eigen::Matrix2d J;
-    J(0, 0) = radial + 2.0 * u * u * dradial + 2.0 * p1 * v + 6.0 * p2 * u;
-    J(0, 1) = 2.0 * u * v * dradial + 2.0 * p1 * u + 2.0 * p2 * v;
-    J(1, 0) = 2.0 * u * v * dradial + 2.0 * p1 * u + 2.0 * p2 * v;
-    J(1, 1) = radial + 2.0 * v * v * dradial + 6.0 * p1 * v + 2.0 * p2 * u;
+    // The Jacobian is symmetric, [a b; b c], and near the identity inside the model's domain:
+    // its inverse in closed form (an LU of a 2x2 matrix cost more than the rest of the step).
+    const double a = radial + 2.0 * u * u * dradial + 2.0 * p1 * v + 6.0 * p2 * u;
+    const double b = 2.0 * u * v * dradial + 2.0 * p1 * u + 2.0 * p2 * v;
+    const double c = radial + 2.0 * v * v * dradial + 6.0 * p1 * v + 2.0 * p2 * u;
     const Eigen::Vector2d r = distort(x) - xd;
-    const Eigen::Vector2d step = J.partialPivLu().solve(r);
+    const double det = a * c - b * b;
+    const Eigen::Vector2d step = Eigen::Vector2d(c * r.x() - b * r.y(), a * r.y() - b * r.x()) / det;
     x -= step;
     if (step.squaredNorm() < 1e-30) break;
   }
