@@ -55,7 +55,10 @@ PLANARVO_API void planarvo_mosaic_options_init(planarvo_mosaic_options* options)
  * time; each time must be a frame's (within 1 ms, or a quarter of the shortest frame interval),
  * else PLANARVO_ERROR_INVALID_INPUT naming the first that is not; a trajectory may leave frames
  * out. extrinsics: the camera on the robot, in the units of the poses. options may be NULL.
- * PLANARVO_ERROR_INVALID_INPUT also for count 0 and a mosaic over max_side pixels on a side. */
+ * PLANARVO_ERROR_INVALID_INPUT also for count 0 and a mosaic over max_side pixels on a side.
+ * A rolling-shutter camera (the data set's readout: its camera file's, or
+ * planarvo_dataset_set_readout's) is warped row by row, each row from the robot's pose when it was
+ * read: the motion between two poses held constant (an arc), the last interval's after the last. */
 PLANARVO_API planarvo_status planarvo_mosaic_build(planarvo_context* context, planarvo_dataset* dataset,
                                                    const planarvo_extrinsics* extrinsics,
                                                    const double* timestamps, const planarvo_se2* poses,

@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -43,6 +44,7 @@ int cmd_mosaic(int argc, char** argv) {
                              "one used", "an eighth of the ground in view"},
       {"every-frame", "", "use every frame of the trajectory", ""},
       {"no-gain", "", "no per-frame brightness correction", ""},
+      readout_option(),
       {"quiet", "", "no progress bar", ""},
       {"help", "", "show this help", ""}};
   for (auto& b : bag_options()) specs.push_back(b);
@@ -52,7 +54,8 @@ int cmd_mosaic(int argc, char** argv) {
     std::printf("usage: planarvo mosaic DATASET --trajectory traj.txt [--extrinsics FILE] [--resolution M] -o floor.png\n\n"
                 "The ground under a trajectory as one image: each frame warped onto the ground plane, brightness-\n"
                 "corrected and blended. Writes the image and, beside it, a ROS map_server YAML (floor.yaml) that\n"
-                "places it in the trajectory's frame. Pixels no frame saw are 0.\n\n%s",
+                "places it in the trajectory's frame. Pixels no frame saw are 0. A rolling-shutter camera's frames\n"
+                "are warped row by row, each row from the robot's pose when it was read.\n\n%s",
                 format_options(specs).c_str());
     return kExitOk;
   }
@@ -80,10 +83,12 @@ int cmd_mosaic(int argc, char** argv) {
   o.frame_spacing = args.has("every-frame") ? -1.0 : args.get_double("frame-spacing", 0.0);
   if (!(o.frame_spacing >= -1.0) || !std::isfinite(o.frame_spacing)) throw UsageError("--frame-spacing must be positive");
   o.estimate_gain = args.has("no-gain") ? 0 : 1;
+  const std::optional<double> readout = parse_readout(args);
   const planarvo_extrinsics e = extrinsics_for(args, dir);
   ContextPtr ctx = make_context(args);
   Progress progress(!args.has("quiet"));
   DatasetPtr ds = open_dataset(dir, args, false, &progress);
+  apply_readout(readout, ds.get());
   planarvo_dataset_info info{};
   info.struct_size = sizeof info;
   check(planarvo_dataset_info_get(ds.get(), &info));

@@ -2,6 +2,7 @@
 #include "mosaic/mosaic.h"
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -102,6 +103,24 @@ Box frame_box(const std::vector<Eigen::Vector2d>& fp, const SE2& pose) {
   Box b;
   for (const Eigen::Vector2d& p : fp) b.add(pose * p);
   return b;
+}
+
+// The robot's poses when frame k's first, middle and last rows were read (a rolling shutter):
+// the trajectory's motion from pose k to the next held constant over the interval, an arc on
+// SE(2) (the tracker's and the simulator's model); after the last pose, the last interval's
+// velocity continued. A global shutter, or a single pose: the frame's pose three times.
+std::array<SE2, 3> readout_poses(const std::vector<PosedFrame>& frames, const std::vector<double>& times,
+                                 size_t k, double readout) {
+  const SE2& pose = frames[k].pose;
+  std::array<SE2, 3> out{pose, pose, pose};
+  if (!(readout > 0) || frames.size() < 2) return out;
+  const size_t a = k + 1 < frames.size() ? k : k - 1;
+  const double dt = times[a + 1] - times[a];
+  if (!(dt > 0)) return out;
+  const Eigen::Vector3d velocity = (frames[a].pose.inverse() * frames[a + 1].pose).log() / dt;
+  out[1] = pose * SE2::exp(velocity * (0.5 * readout));
+  out[2] = pose * SE2::exp(velocity * readout);
+  return out;
 }
 
 // The frames to use: the first, then each whose camera foot point has moved `spacing` or whose
@@ -381,10 +400,18 @@ Mosaic build_mosaic(ocl::Runtime& runtime, io::Dataset& dataset, const Extrinsic
                              : std::min(robot_box.x1 - robot_box.x0, robot_box.y1 - robot_box.y0) / 8.0;
   const std::vector<size_t> used = select_frames(frames, extrinsics.t_vc().head<2>(), spacing);
 
+  // Each frame's poses while its rows were read (all three its pose for a global shutter); its
+  // window holds the ground seen from any of them.
+  std::vector<double> times(frames.size());
+  for (size_t k = 0; k < frames.size(); ++k) times[k] = dataset.timestamp(frames[k].frame);
+  std::vector<std::array<SE2, 3>> row_poses;
   std::vector<Box> boxes;
   Box all;
   for (size_t k : used) {
-    boxes.push_back(frame_box(fp, frames[k].pose));
+    row_poses.push_back(readout_poses(frames, times, k, cam.rolling_shutter_readout));
+    Box b;
+    for (const SE2& pose : row_poses.back()) b.add(frame_box(fp, pose));
+    boxes.push_back(b);
     all.add(boxes.back());
   }
   Mosaic m;
@@ -416,9 +443,8 @@ Mosaic build_mosaic(ocl::Runtime& runtime, io::Dataset& dataset, const Extrinsic
     if (k + 1 < used.size()) next = std::async(std::launch::async, decode, k + 1);
     const Window& w = windows[k];
     if (w.empty()) continue;
-    const PosedFrame& f = frames[used[k]];
     Clock::time_point t = Clock::now();
-    warp.run(frame, warp_params(setup, f.pose, m.grid, w), w.width, w.height, &samples);
+    warp.run(frame, warp_params(setup, row_poses[k], m.grid, w), w.width, w.height, &samples);
     m.stats.seconds_warp += seconds_since(t);
     t = Clock::now();
     double g = 1.0;

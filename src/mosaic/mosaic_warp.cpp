@@ -30,7 +30,11 @@ WarpSetup make_warp_setup(const CameraModel& camera, const Extrinsics& extrinsic
   return s;
 }
 
-WarpParams warp_params(const WarpSetup& setup, const SE2& pose, const MosaicGrid& grid, const Window& window) {
+namespace {
+
+// The homography (window pixel -> camera-frame ground point, in camera heights) at a robot pose.
+Eigen::Matrix3d window_homography(const WarpSetup& setup, const SE2& pose, const MosaicGrid& grid,
+                                  const Window& window, Eigen::Vector3d* camera_centre) {
   // Camera in the trajectory's frame: T_wc = T_wv T_vc; a ground point P = (X, Y, 0) is at
   // R_cw (P - C) in the camera, i.e. [c1 c2 -R_cw C] (X, Y, 1) with c_i the columns of R_cw.
   const Eigen::Matrix4d T_wc = pose.matrix3d() * setup.extrinsics.T_vc();
@@ -46,11 +50,26 @@ WarpParams warp_params(const WarpSetup& setup, const SE2& pose, const MosaicGrid
   A << res, 0, grid.origin.x() + window.x * res,  //
       0, -res, grid.origin.y() + (grid.height - window.y) * res,  //
       0, 0, 1;
+  *camera_centre = C;
   // Scaled so that the camera-frame coordinates are in units of the camera height: the same
   // homography up to scale, with float-friendly magnitudes.
-  const Eigen::Matrix3d H = (G * A) / setup.extrinsics.z;
+  return (G * A) / setup.extrinsics.z;
+}
+
+void put_homography(const Eigen::Matrix3d& H, int at, WarpParams* p) {
+  for (int i = 0; i < 9; ++i) (*p)[static_cast<size_t>(at + i)] = static_cast<float>(H(i / 3, i % 3));
+}
+
+}  // namespace
+
+WarpParams warp_params(const WarpSetup& setup, const SE2& pose, const MosaicGrid& grid, const Window& window) {
+  Eigen::Vector3d C;
+  const Eigen::Matrix3d H = window_homography(setup, pose, grid, window, &C);
+  const double res = grid.resolution;
   WarpParams p{};
-  for (int i = 0; i < 9; ++i) p[static_cast<size_t>(kParamH + i)] = static_cast<float>(H(i / 3, i % 3));
+  put_homography(H, kParamH, &p);
+  put_homography(H, kParamHMiddle, &p);
+  put_homography(H, kParamHLast, &p);
   const CameraModel& c = setup.camera;
   const double intr[4] = {c.fx, c.fy, c.cx, c.cy};
   const double dist[5] = {c.k1, c.k2, c.p1, c.p2, c.k3};
@@ -68,45 +87,79 @@ WarpParams warp_params(const WarpSetup& setup, const SE2& pose, const MosaicGrid
   p[kParamFoot + 1] = static_cast<float>(grid.height - (C.y() - grid.origin.y()) / res - window.y);
   const double range_px = setup.max_range / res;
   p[kParamRange2] = static_cast<float>(range_px * range_px);
+  p[kParamInvRows] = 0.0f;
   return p;
 }
+
+WarpParams warp_params(const WarpSetup& setup, const std::array<SE2, 3>& row_poses, const MosaicGrid& grid,
+                       const Window& window) {
+  WarpParams p = warp_params(setup, row_poses[0], grid, window);
+  if (!(setup.camera.rolling_shutter_readout > 0) || setup.camera.height < 2) return p;
+  Eigen::Vector3d C;
+  put_homography(window_homography(setup, row_poses[1], grid, window, &C), kParamHMiddle, &p);
+  put_homography(window_homography(setup, row_poses[2], grid, window, &C), kParamHLast, &p);
+  p[kParamInvRows] = static_cast<float>(1.0 / (setup.camera.height - 1));
+  return p;
+}
+
+namespace {
+
+// The kernel's projection of window pixel (mx, my) at readout fraction s: false where the ground
+// point is behind the camera or outside the distortion model's domain.
+bool project_reference(const WarpParams& prm, float mx, float my, float s, float* u, float* v) {
+  const float w0 = (1.0f - s) * (1.0f - 2.0f * s), wm = 4.0f * s * (1.0f - s), w1 = s * (2.0f * s - 1.0f);
+  float h[9];
+  for (int i = 0; i < 9; ++i)
+    h[i] = w0 * prm[static_cast<size_t>(kParamH + i)] + wm * prm[static_cast<size_t>(kParamHMiddle + i)] +
+           w1 * prm[static_cast<size_t>(kParamHLast + i)];
+  const float X = h[0] * mx + h[1] * my + h[2];
+  const float Y = h[3] * mx + h[4] * my + h[5];
+  const float Z = h[6] * mx + h[7] * my + h[8];
+  if (!(Z > 0.0f)) return false;
+  const float iz = 1.0f / Z;
+  const float x = X * iz, y = Y * iz;
+  const float r2 = x * x + y * y;
+  if (!(r2 <= prm[18])) return false;
+  const float k1 = prm[13], k2 = prm[14], p1 = prm[15], p2 = prm[16], k3 = prm[17];
+  const float radial = 1.0f + r2 * (k1 + r2 * (k2 + r2 * k3));
+  const float xd = x * radial + 2.0f * p1 * x * y + p2 * (r2 + 2.0f * x * x);
+  const float yd = y * radial + p1 * (r2 + 2.0f * y * y) + 2.0f * p2 * x * y;
+  *u = prm[9] * xd + prm[11];
+  *v = prm[10] * yd + prm[12];
+  return true;
+}
+
+}  // namespace
 
 cv::Mat mosaic_warp_reference(const cv::Mat& frame, const WarpParams& prm, int width, int height) {
   if (frame.type() != CV_8UC1) throw_invalid_argument("mosaic_warp_reference: the frame must be CV_8UC1");
   cv::Mat out(height, width, CV_32FC2);
   const int stride = static_cast<int>(frame.step[0]);
   const uint8_t* data = frame.ptr<uint8_t>();
+  const float inv_rows = prm[kParamInvRows];
   for (int row = 0; row < height; ++row)
     for (int col = 0; col < width; ++col) {
       const float mx = static_cast<float>(col) + 0.5f, my = static_cast<float>(row) + 0.5f;
       const float dx = mx - prm[24], dy = my - prm[25];
-      const float X = prm[0] * mx + prm[1] * my + prm[2];
-      const float Y = prm[3] * mx + prm[4] * my + prm[5];
-      const float Z = prm[6] * mx + prm[7] * my + prm[8];
-      float value = 0.0f, weight = 0.0f;
-      if (Z > 0.0f && dx * dx + dy * dy <= prm[26]) {
-        const float iz = 1.0f / Z;
-        const float x = X * iz, y = Y * iz;
-        const float r2 = x * x + y * y;
-        if (r2 <= prm[18]) {
-          const float k1 = prm[13], k2 = prm[14], p1 = prm[15], p2 = prm[16], k3 = prm[17];
-          const float radial = 1.0f + r2 * (k1 + r2 * (k2 + r2 * k3));
-          const float xd = x * radial + 2.0f * p1 * x * y + p2 * (r2 + 2.0f * x * x);
-          const float yd = y * radial + p1 * (r2 + 2.0f * y * y) + 2.0f * p2 * x * y;
-          const float u = prm[9] * xd + prm[11];
-          const float v = prm[10] * yd + prm[12];
-          if (u >= prm[19] && v >= prm[20] && u < prm[21] && v < prm[22]) {
-            const float u0 = std::floor(u), v0 = std::floor(v);
-            const float fu = u - u0, fv = v - v0;
-            const uint8_t* p = data + static_cast<int>(v0) * stride + static_cast<int>(u0);
-            const float a = p[0], b = p[1], c = p[stride], d = p[stride + 1];
-            const float top = a + fu * (b - a);
-            const float bottom = c + fu * (d - c);
-            value = top + fv * (bottom - top);
-            const float edge = std::min(std::min(u - prm[19], prm[21] - u), std::min(v - prm[20], prm[22] - v));
-            weight = std::min(1.0f, (edge + 0.5f) * prm[23]);
-          }
-        }
+      float value = 0.0f, weight = 0.0f, u = 0.0f, v = 0.0f;
+      bool seen = dx * dx + dy * dy <= prm[26] && project_reference(prm, mx, my, 0.0f, &u, &v);
+      // The row that saw the point: s = v(s) / (rows - 1), iterated until it stands still.
+      for (int k = 0; seen && inv_rows > 0.0f && k < 100; ++k) {
+        const float s = std::clamp(v * inv_rows, 0.0f, 1.0f);
+        const float v_before = v;
+        seen = project_reference(prm, mx, my, s, &u, &v);
+        if (std::abs(v - v_before) < 1e-4f) break;
+      }
+      if (seen && u >= prm[19] && v >= prm[20] && u < prm[21] && v < prm[22]) {
+        const float u0 = std::floor(u), v0 = std::floor(v);
+        const float fu = u - u0, fv = v - v0;
+        const uint8_t* p = data + static_cast<int>(v0) * stride + static_cast<int>(u0);
+        const float a = p[0], b = p[1], c = p[stride], d = p[stride + 1];
+        const float top = a + fu * (b - a);
+        const float bottom = c + fu * (d - c);
+        value = top + fv * (bottom - top);
+        const float edge = std::min(std::min(u - prm[19], prm[21] - u), std::min(v - prm[20], prm[22] - v));
+        weight = std::min(1.0f, (edge + 0.5f) * prm[23]);
       }
       out.at<cv::Vec2f>(row, col) = cv::Vec2f(value, weight);
     }

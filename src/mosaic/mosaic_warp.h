@@ -45,7 +45,13 @@ enum MosaicWarpParam {
   kParamInvFeather = 23,  // 1 / the feathering ramp in frame pixels
   kParamFoot = 24,        // 2: the camera's foot point in window pixels
   kParamRange2 = 26,      // squared range limit in mosaic pixels
-  kParamCount = 27
+  // A rolling shutter (docs/conventions.md: row r is read at stamp + r / (rows - 1) * readout):
+  // the homographies of the robot's poses when the middle row and the last row were read (kParamH
+  // is the first row's), and 1 / (rows - 1) of the frame; 0 there for a global shutter.
+  kParamHMiddle = 27,     // 9
+  kParamHLast = 36,       // 9
+  kParamInvRows = 45,
+  kParamCount = 46
 };
 using WarpParams = std::array<float, kParamCount>;
 
@@ -67,9 +73,17 @@ WarpSetup make_warp_setup(const CameraModel& camera, const Extrinsics& extrinsic
 // The warp of one frame, at robot pose `pose` in the trajectory's frame, onto `window` of `grid`.
 // Computed in double, stored as float.
 WarpParams warp_params(const WarpSetup& setup, const SE2& pose, const MosaicGrid& grid, const Window& window);
+// The same for a rolling-shutter camera (setup.camera.rolling_shutter_readout > 0): the robot's
+// poses when the frame's first, middle and last rows were read. Each ground point is then
+// sampled on the row that saw it: the row r with r = v(H(r / (rows - 1))), H(s) the quadratic
+// through the three rows' homographies (exact to 1e-5 px for a turn of 0.1 rad over the
+// readout), solved in the kernel by two fixed-point steps and Aitken's extrapolation.
+WarpParams warp_params(const WarpSetup& setup, const std::array<SE2, 3>& row_poses, const MosaicGrid& grid,
+                       const Window& window);
 
 // The plain C++ reference of the kernel: frame CV_8UC1 (the camera's size), output CV_32FC2
-// (value, weight) of the window's size.
+// (value, weight) of the window's size. A rolling shutter's row is found by plain fixed-point
+// iteration run to convergence (not the kernel's Aitken step).
 cv::Mat mosaic_warp_reference(const cv::Mat& frame, const WarpParams& params, int width, int height);
 
 // The kernel on an OpenCL device. Buffers are kept and grown as needed. Not thread-safe.
