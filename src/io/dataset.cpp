@@ -79,6 +79,8 @@ cv::Mat read_image(const fs::path& file, const CameraModel& camera, const std::s
     throw_invalid_input(name + ": the image " + problem + " (" + context + ")");
   if (const std::string cut = detail::file_truncation_problem(name); !cut.empty())
     throw_invalid_input(name + ": " + cut + " (" + context + ")");
+  if (const std::string size = detail::file_declared_size_problem(name, camera); !size.empty())
+    throw_invalid_input(name + ": " + size + " (" + context + ")");
   cv::Mat img;
   try {
     // ANYDEPTH so that 16-bit images are seen (and rejected) rather than silently scaled;

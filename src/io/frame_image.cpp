@@ -1,7 +1,9 @@
 #include "io/frame_image.h"
 
 #include <algorithm>
+#include <cstdint>
 #include <fstream>
+#include <vector>
 
 #include <opencv2/imgproc.hpp>
 
@@ -57,6 +59,65 @@ std::string truncation_problem(const unsigned char* head, size_t head_size, cons
     if (!holds(iend, 4)) return "the PNG data end without their IEND chunk: they were cut short";
   }
   return "";
+}
+
+cv::Size declared_size(const unsigned char* data, size_t size) {
+  const auto be16 = [&](size_t at) { return static_cast<int>(data[at]) << 8 | data[at + 1]; };
+  const auto be32 = [&](size_t at) {
+    return static_cast<uint32_t>(be16(at)) << 16 | static_cast<uint32_t>(be16(at + 2));
+  };
+  static const unsigned char png[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1A, '\n'};
+  if (size >= 24 && std::equal(png, png + 8, data) && std::equal(data + 12, data + 16, "IHDR")) {
+    const uint32_t w = be32(16), h = be32(20);
+    if (w > 0x7FFFFFFFu || h > 0x7FFFFFFFu) return {-1, -1};  // beyond any image: PNG forbids it
+    return {static_cast<int>(w), static_cast<int>(h)};
+  }
+  if (size < 4 || data[0] != 0xFF || data[1] != 0xD8) return {0, 0};
+  // Markers after SOI: bytes before a marker's FF are skipped (libjpeg warns "extraneous bytes"
+  // and goes on), fill FFs too; standalone markers have no length.
+  size_t at = 2;
+  while (at + 1 < size) {
+    if (data[at] != 0xFF) {
+      ++at;
+      continue;
+    }
+    while (at + 1 < size && data[at + 1] == 0xFF) ++at;
+    if (at + 1 >= size) break;
+    const int marker = data[at + 1];
+    if (marker == 0xD9 || marker == 0xDA) break;  // end of image, start of scan: no frame header
+    if (marker == 0x00 || marker == 0x01 || (marker >= 0xD0 && marker <= 0xD7)) {
+      at += 2;
+      continue;
+    }
+    if (at + 4 > size) break;
+    const size_t length = static_cast<size_t>(be16(at + 2));
+    const bool frame = marker >= 0xC0 && marker <= 0xCF && marker != 0xC4 && marker != 0xC8 && marker != 0xCC;
+    if (frame) {
+      if (at + 9 > size) break;
+      return {be16(at + 7), be16(at + 5)};  // P, Y (height), X (width)
+    }
+    at += 2 + length;
+  }
+  return {0, 0};
+}
+
+std::string declared_size_problem(const unsigned char* data, size_t size, const CameraModel& camera,
+                                  const std::string& camera_from) {
+  const cv::Size s = declared_size(data, size);
+  if (s == cv::Size(0, 0)) return "";
+  if ((s.width == camera.width && s.height == camera.height) || (s.width == camera.height && s.height == camera.width))
+    return "";
+  const std::string declared = s.width < 0 ? "over 2^31 pixels on a side" : size_text(s.width, s.height);
+  return "the image declares " + declared + " pixels, but " + camera_from + " says " +
+         size_text(camera.width, camera.height) + " (not decoded)";
+}
+
+std::string file_declared_size_problem(const std::string& path, const CameraModel& camera) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return "";
+  std::vector<unsigned char> head(size_t{1} << 20);
+  in.read(reinterpret_cast<char*>(head.data()), static_cast<std::streamsize>(head.size()));
+  return declared_size_problem(head.data(), static_cast<size_t>(in.gcount()), camera);
 }
 
 std::string truncation_problem(const unsigned char* data, size_t size) {

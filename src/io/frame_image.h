@@ -23,6 +23,17 @@ cv::Mat to_grey_checked(const cv::Mat& img, const CameraModel& camera, const std
 // on (issue 27). head: the first bytes (at least 8 for the check), tail: the last (up to 4096).
 std::string truncation_problem(const unsigned char* head, size_t head_size, const unsigned char* tail,
                                size_t tail_size);
+// The width and height an encoded PNG (its IHDR) or JPEG (its first start-of-frame marker, found
+// as libjpeg finds it) declares, read from its first bytes without decoding; {0, 0} when the
+// data are neither or the header is not within them.
+cv::Size declared_size(const unsigned char* data, size_t size);
+// "" when the image's declared size is the camera's (or its transpose: EXIF orientation may turn
+// it), or not declared; otherwise what is wrong, naming both sizes. Checked before decoding: a
+// 300-byte JPEG that declares 18756x16724 pixels made the decoder allocate 1.9 GB (fuzz_image).
+std::string declared_size_problem(const unsigned char* data, size_t size, const CameraModel& camera,
+                                  const std::string& camera_from = "camera.yaml");
+// The same on a file's first MiB.
+std::string file_declared_size_problem(const std::string& path, const CameraModel& camera);
 // The same on a whole buffer, and on a file (reads its first 8 and last 4096 bytes).
 std::string truncation_problem(const unsigned char* data, size_t size);
 std::string file_truncation_problem(const std::string& path);

@@ -445,6 +445,51 @@ TEST(IoDataset, ReportsProgressAndCanBeCancelled) {
   EXPECT_EQ(calls, 2);  // stopped at the first image
 }
 
+// The size an encoded image declares, read before decoding: as OpenCV decodes it, for JPEG
+// (baseline, progressive, with extra bytes before a marker) and PNG; a declared size that is not
+// the camera's is refused before the decoder allocates it (fuzz_image: a 296-byte JPEG that
+// declared 18756x16724 pixels made it allocate 1.9 GB).
+TEST(IoImageBytes, TheDeclaredSizeIsReadBeforeDecoding) {
+  cv::Mat img(37, 53, CV_8UC1);
+  cv::randu(img, 0, 255);
+  for (const auto& [ext, params] : {std::pair<const char*, std::vector<int>>{".jpg", {}},
+                                    {".jpg", {cv::IMWRITE_JPEG_PROGRESSIVE, 1}},
+                                    {".png", {}}}) {
+    std::vector<uchar> bytes;
+    ASSERT_TRUE(cv::imencode(ext, img, bytes, params));
+    const cv::Mat decoded = cv::imdecode(bytes, cv::IMREAD_UNCHANGED);
+    EXPECT_EQ(io::detail::declared_size(bytes.data(), bytes.size()), decoded.size()) << ext;
+  }
+  std::vector<uchar> jpeg;
+  ASSERT_TRUE(cv::imencode(".jpg", img, jpeg));
+  // Bytes before a marker (libjpeg skips them with a warning) do not hide the frame header.
+  std::vector<uchar> extraneous(jpeg.begin(), jpeg.begin() + 2);
+  extraneous.insert(extraneous.end(), {0x12, 0x34, 0x56});
+  extraneous.insert(extraneous.end(), jpeg.begin() + 2, jpeg.end());
+  EXPECT_EQ(io::detail::declared_size(extraneous.data(), extraneous.size()), cv::Size(53, 37));
+  EXPECT_EQ(io::detail::declared_size(jpeg.data(), 2), cv::Size(0, 0));  // not within the bytes given
+
+  // The data set refuses a file that declares another size, naming both, before decoding it.
+  ScratchDir dir;
+  make_dataset(dir.path());
+  std::vector<uchar> big;
+  cv::Mat frame(kH, kW, CV_8UC1, cv::Scalar(90));
+  ASSERT_TRUE(cv::imencode(".jpg", frame, big));
+  for (size_t at = 2; at + 9 < big.size(); ++at)
+    if (big[at] == 0xFF && big[at + 1] == 0xC0) {  // SOF0: FF C0, length, precision, height, width
+      big[at + 5] = 0x49, big[at + 6] = 0x44, big[at + 7] = 0x41, big[at + 8] = 0x54;
+      break;
+    }
+  EXPECT_EQ(io::detail::declared_size(big.data(), big.size()), cv::Size(0x4154, 0x4944));
+  const fs::path file = dir.path() / "images" / "000002.jpg";
+  std::ofstream(file, std::ios::binary).write(reinterpret_cast<const char*>(big.data()),
+                                              static_cast<std::streamsize>(big.size()));
+  write_text(dir.path() / "frames.txt", "0.0 " + image_name(0) + "\n0.1 " + image_name(1) + "\n0.2 images/000002.jpg\n");
+  DatasetOptions verify;
+  verify.verify_images = true;
+  EXPECT_THAT(open_error(dir.path(), 0, file.string(), verify), HasSubstr("declares 16724x18756 pixels"));
+}
+
 // ---------------------------------------------------------------------------------------------
 // Video
 
