@@ -38,8 +38,8 @@ if(PLANARVO_SANITIZE)
     # with --no-undefined) and Python need the shared runtime, so every binary takes that one.
     execute_process(COMMAND ${CMAKE_CXX_COMPILER} -print-file-name=libclang_rt.asan-x86_64.so
                     OUTPUT_VARIABLE PLANARVO_CLANG_ASAN_RUNTIME OUTPUT_STRIP_TRAILING_WHITESPACE)
-    get_filename_component(runtime_dir "${PLANARVO_CLANG_ASAN_RUNTIME}" DIRECTORY)
-    add_link_options(-shared-libsan "LINKER:-rpath,${runtime_dir}")
+    get_filename_component(PLANARVO_CLANG_ASAN_RUNTIME_DIR "${PLANARVO_CLANG_ASAN_RUNTIME}" DIRECTORY)
+    add_link_options(-shared-libsan "LINKER:-rpath,${PLANARVO_CLANG_ASAN_RUNTIME_DIR}")
   endif()
 endif()
 if(PLANARVO_TSAN)

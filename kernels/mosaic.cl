@@ -74,8 +74,8 @@ void mosaic_warp(__global const uchar* frame, const int frame_stride, __constant
   if (seen && inv_rows > 0.0f) {
     // The steps are not clamped to the frame's rows (a clamped step breaks the extrapolation for
     // a point seen near the first or last row): H(s) is extrapolated up to half a readout beyond
-    // them. The answer is, and a point no row saw (the fixed point beyond the last row) still
-    // projects beyond it from the row it is clamped to, since the map's slope is below 1.
+    // them. Only the answer is clamped to them: a point no row saw (its fixed point beyond the
+    // last row) still projects beyond that row from it, since the map's slope is below 1.
     const float s1 = clamp(v * inv_rows, -0.5f, 1.5f);
     seen = mosaic_project(prm, mx, my, s1, &u, &v);
     const float s2 = clamp(v * inv_rows, -0.5f, 1.5f);

@@ -15,6 +15,8 @@
 #include <cstdio>
 #include <deque>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <tuple>
 #include <utility>
 
@@ -77,16 +79,19 @@ cv::Mat read_image(const fs::path& file, const CameraModel& camera, const std::s
   const std::string name = file.string();
   if (const std::string problem = detail::input_file_problem(name); !problem.empty())
     throw_invalid_input(name + ": the image " + problem + " (" + context + ")");
-  if (const std::string cut = detail::file_truncation_problem(name); !cut.empty())
-    throw_invalid_input(name + ": " + cut + " (" + context + ")");
-  if (const std::string size = detail::file_declared_size_problem(name, camera); !size.empty())
-    throw_invalid_input(name + ": " + size + " (" + context + ")");
+  // Read once: the bytes are checked (cut short, a declared size that is not the camera's) and
+  // then decoded from memory.
+  std::ifstream in(name, std::ios::binary);
+  const std::vector<unsigned char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (!in && !in.eof()) throw_invalid_input(name + ": the image cannot be read (" + context + ")");
+  if (const std::string problem = detail::encoded_image_problem(bytes.data(), bytes.size(), camera); !problem.empty())
+    throw_invalid_input(name + ": " + problem + " (" + context + ")");
   cv::Mat img;
   try {
     // ANYDEPTH so that 16-bit images are seen (and rejected) rather than silently scaled;
     // ANYCOLOR keeps grey images one channel. EXIF orientation is applied, as by cv::imread's
     // default, so images look as they did to the calibration.
-    img = cv::imread(name, cv::IMREAD_ANYDEPTH | cv::IMREAD_ANYCOLOR);
+    if (!bytes.empty()) img = cv::imdecode(bytes, cv::IMREAD_ANYDEPTH | cv::IMREAD_ANYCOLOR);
   } catch (const cv::Exception& e) {
     throw_invalid_input(name + ": the image cannot be decoded (" + context + "): " + e.err);
   }

@@ -353,11 +353,9 @@ cv::Mat BagSource::frame(int64_t i) {
   try {
     if (d.compressed) {
       const bag::CompressedImageMessage m = bag::decode_compressed_image(ser, d.buffer.data(), d.buffer.size());
-      if (const std::string cut = detail::truncation_problem(m.data.data(), m.data.size()); !cut.empty())
-        throw_invalid_input("the \"" + m.format + "\" image: " + cut);
-      if (const std::string size = detail::declared_size_problem(m.data.data(), m.data.size(), camera_, camera_source_);
-          !size.empty())
-        throw_invalid_input("the \"" + m.format + "\" image: " + size);
+      if (const std::string problem = detail::encoded_image_problem(m.data.data(), m.data.size(), camera_, camera_source_);
+          !problem.empty())
+        throw_invalid_input("the \"" + m.format + "\" image: " + problem);
       cv::Mat img;
       try {
         img = cv::imdecode(m.data, cv::IMREAD_ANYDEPTH | cv::IMREAD_ANYCOLOR);

@@ -2,8 +2,6 @@
 
 #include <algorithm>
 #include <cstdint>
-#include <fstream>
-#include <vector>
 
 #include <opencv2/imgproc.hpp>
 
@@ -39,22 +37,22 @@ cv::Mat to_grey_checked(const cv::Mat& img, const CameraModel& camera, const std
   return grey;
 }
 
-std::string truncation_problem(const unsigned char* head, size_t head_size, const unsigned char* tail,
-                               size_t tail_size) {
+std::string truncation_problem(const unsigned char* data, size_t size) {
   // Zero bytes after the image (a card's block padding) are skipped; the marker is then looked
   // for in the last 64 bytes.
-  while (tail_size > 0 && tail[tail_size - 1] == 0) --tail_size;
-  const size_t from = tail_size > 64 ? tail_size - 64 : 0;
+  size_t end = size;
+  while (end > 0 && data[end - 1] == 0) --end;
+  const size_t from = end > 64 ? end - 64 : 0;
   const auto holds = [&](const unsigned char* marker, size_t n) {
-    for (size_t i = from; i + n <= tail_size; ++i)
-      if (std::equal(marker, marker + n, tail + i)) return true;
+    for (size_t i = from; i + n <= end; ++i)
+      if (std::equal(marker, marker + n, data + i)) return true;
     return false;
   };
-  if (head_size >= 3 && head[0] == 0xFF && head[1] == 0xD8 && head[2] == 0xFF) {
+  if (size >= 3 && data[0] == 0xFF && data[1] == 0xD8 && data[2] == 0xFF) {
     static const unsigned char eoi[2] = {0xFF, 0xD9};
     if (!holds(eoi, 2)) return "the JPEG data end without their end-of-image marker: they were cut short";
   } else if (static const unsigned char png[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1A, '\n'};
-             head_size >= 8 && std::equal(head, head + 8, png)) {
+             size >= 8 && std::equal(data, data + 8, png)) {
     static const unsigned char iend[4] = {'I', 'E', 'N', 'D'};
     if (!holds(iend, 4)) return "the PNG data end without their IEND chunk: they were cut short";
   }
@@ -112,32 +110,10 @@ std::string declared_size_problem(const unsigned char* data, size_t size, const 
          size_text(camera.width, camera.height) + " (not decoded)";
 }
 
-std::string file_declared_size_problem(const std::string& path, const CameraModel& camera) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return "";
-  std::vector<unsigned char> head(size_t{1} << 20);
-  in.read(reinterpret_cast<char*>(head.data()), static_cast<std::streamsize>(head.size()));
-  return declared_size_problem(head.data(), static_cast<size_t>(in.gcount()), camera);
-}
-
-std::string truncation_problem(const unsigned char* data, size_t size) {
-  const size_t tail = std::min<size_t>(size, 4096);
-  return truncation_problem(data, size, data + size - tail, tail);
-}
-
-std::string file_truncation_problem(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return "";  // the decoder says what is wrong with a file it cannot read
-  unsigned char head[8] = {}, tail[4096] = {};
-  in.read(reinterpret_cast<char*>(head), sizeof head);
-  const auto got = static_cast<size_t>(in.gcount());
-  in.clear();
-  in.seekg(0, std::ios::end);
-  const auto size = static_cast<long long>(in.tellg());
-  const long long from = std::max<long long>(0, size - static_cast<long long>(sizeof tail));
-  in.seekg(from);
-  in.read(reinterpret_cast<char*>(tail), static_cast<std::streamsize>(size - from));
-  return truncation_problem(head, got, tail, static_cast<size_t>(in.gcount()));
+std::string encoded_image_problem(const unsigned char* data, size_t size, const CameraModel& camera,
+                                  const std::string& camera_from) {
+  if (std::string cut = truncation_problem(data, size); !cut.empty()) return cut;
+  return declared_size_problem(data, size, camera, camera_from);
 }
 
 }  // namespace planarvo::io::detail

@@ -18,11 +18,10 @@ cv::Mat to_grey_checked(const cv::Mat& img, const CameraModel& camera, const std
 
 // What is wrong with an encoded image's bytes that its decoder only warns about ("" when
 // nothing): a JPEG whose end-of-image marker (FF D9) is missing from its last 64 bytes (zero
-// padding after it skipped), or a PNG without its IEND chunk there: the file was cut short. libjpeg decodes a truncated JPEG with a
-// warning on stderr and grey rows where the data stopped, which the tracker then loses frames
-// on (issue 27). head: the first bytes (at least 8 for the check), tail: the last (up to 4096).
-std::string truncation_problem(const unsigned char* head, size_t head_size, const unsigned char* tail,
-                               size_t tail_size);
+// padding after it skipped), or a PNG without its IEND chunk there: the data were cut short.
+// libjpeg decodes a truncated JPEG with a warning on stderr and grey rows where the data
+// stopped, which the tracker then loses frames on (issue 27).
+std::string truncation_problem(const unsigned char* data, size_t size);
 // The width and height an encoded PNG (its IHDR) or JPEG (its first start-of-frame marker, found
 // as libjpeg finds it) declares, read from its first bytes without decoding; {0, 0} when the
 // data are neither or the header is not within them.
@@ -32,10 +31,8 @@ cv::Size declared_size(const unsigned char* data, size_t size);
 // 300-byte JPEG that declares 18756x16724 pixels made the decoder allocate 1.9 GB (fuzz_image).
 std::string declared_size_problem(const unsigned char* data, size_t size, const CameraModel& camera,
                                   const std::string& camera_from = "camera.yaml");
-// The same on a file's first MiB.
-std::string file_declared_size_problem(const std::string& path, const CameraModel& camera);
-// The same on a whole buffer, and on a file (reads its first 8 and last 4096 bytes).
-std::string truncation_problem(const unsigned char* data, size_t size);
-std::string file_truncation_problem(const std::string& path);
+// Both checks, in that order: what an image file or a CompressedImage must pass before decoding.
+std::string encoded_image_problem(const unsigned char* data, size_t size, const CameraModel& camera,
+                                  const std::string& camera_from = "camera.yaml");
 
 }  // namespace planarvo::io::detail

@@ -32,9 +32,10 @@ WarpSetup make_warp_setup(const CameraModel& camera, const Extrinsics& extrinsic
 
 namespace {
 
-// The homography (window pixel -> camera-frame ground point, in camera heights) at a robot pose.
+// The homography (window pixel -> camera-frame ground point, in camera heights) at a robot pose,
+// and the camera centre in the trajectory's frame (when camera_centre is not null).
 Eigen::Matrix3d window_homography(const WarpSetup& setup, const SE2& pose, const MosaicGrid& grid,
-                                  const Window& window, Eigen::Vector3d* camera_centre) {
+                                  const Window& window, Eigen::Vector3d* camera_centre = nullptr) {
   // Camera in the trajectory's frame: T_wc = T_wv T_vc; a ground point P = (X, Y, 0) is at
   // R_cw (P - C) in the camera, i.e. [c1 c2 -R_cw C] (X, Y, 1) with c_i the columns of R_cw.
   const Eigen::Matrix4d T_wc = pose.matrix3d() * setup.extrinsics.T_vc();
@@ -50,7 +51,7 @@ Eigen::Matrix3d window_homography(const WarpSetup& setup, const SE2& pose, const
   A << res, 0, grid.origin.x() + window.x * res,  //
       0, -res, grid.origin.y() + (grid.height - window.y) * res,  //
       0, 0, 1;
-  *camera_centre = C;
+  if (camera_centre) *camera_centre = C;
   // Scaled so that the camera-frame coordinates are in units of the camera height: the same
   // homography up to scale, with float-friendly magnitudes.
   return (G * A) / setup.extrinsics.z;
@@ -95,9 +96,8 @@ WarpParams warp_params(const WarpSetup& setup, const std::array<SE2, 3>& row_pos
                        const Window& window) {
   WarpParams p = warp_params(setup, row_poses[0], grid, window);
   if (!(setup.camera.rolling_shutter_readout > 0) || setup.camera.height < 2) return p;
-  Eigen::Vector3d C;
-  put_homography(window_homography(setup, row_poses[1], grid, window, &C), kParamHMiddle, &p);
-  put_homography(window_homography(setup, row_poses[2], grid, window, &C), kParamHLast, &p);
+  put_homography(window_homography(setup, row_poses[1], grid, window), kParamHMiddle, &p);
+  put_homography(window_homography(setup, row_poses[2], grid, window), kParamHLast, &p);
   p[kParamInvRows] = static_cast<float>(1.0 / (setup.camera.height - 1));
   return p;
 }

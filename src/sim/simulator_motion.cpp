@@ -70,7 +70,6 @@ Profile make_profile(const Options& o, double duration, Random& rng) {
   // once drawn inside p.add(v, w, seconds)'s arguments, so that clang (left to right) made
   // another drive for a seed than GCC (right to left). GCC's order is kept: every drive measured
   // on the simulator stays the same.
-  const auto add = [&](double v, double w, double seconds) { p.add(v, w, seconds); };
   switch (o.motion) {
     case MotionProfile::Mixed:
       // One cycle takes 7 to 9.5 s at the default limits, so a 10 s sequence has every
@@ -78,45 +77,45 @@ Profile make_profile(const Options& o, double duration, Random& rng) {
       // ways, reversing.
       while (p.end() < duration) {
         const int turn = rng.sign(), spin = rng.sign();
-        add(0.0, 0.0, rng.uniform(0.2, 0.35));  // stop
+        p.add(0.0, 0.0, rng.uniform(0.2, 0.35));  // stop
         {
           const double s = rng.uniform(0.4, 0.7), w = rng.uniform(-0.05, 0.05) * wm, v = rng.uniform(0.6, 1.0) * vm;
-          add(v, w, s);
+          p.add(v, w, s);
         }
         {
           const double s = rng.uniform(0.4, 0.7), w = turn * rng.uniform(0.4, 0.8) * wm, v = rng.uniform(0.35, 0.6) * vm;
-          add(v, w, s);
+          p.add(v, w, s);
         }
-        add(0.0, 0.0, rng.uniform(0.1, 0.2));  // stop
+        p.add(0.0, 0.0, rng.uniform(0.1, 0.2));  // stop
         {
           const double s = rng.uniform(0.3, 0.5), w = spin * rng.uniform(0.6, 1.0) * wm;  // in place
-          add(0.0, w, s);
+          p.add(0.0, w, s);
         }
         {
           const double s = rng.uniform(0.3, 0.5), w = -spin * rng.uniform(0.6, 1.0) * wm;
-          add(0.0, w, s);
+          p.add(0.0, w, s);
         }
         {
           const double s = rng.uniform(0.5, 0.8), w = -turn * rng.uniform(0.1, 0.5) * wm, v = -rng.uniform(0.35, 0.6) * vm;
-          add(v, w, s);
+          p.add(v, w, s);
         }
         {
           const double s = rng.uniform(0.4, 0.7), w = -turn * rng.uniform(0.4, 0.8) * wm, v = rng.uniform(0.35, 0.6) * vm;
-          add(v, w, s);
+          p.add(v, w, s);
         }
       }
       break;
     case MotionProfile::Straight:
       while (p.end() < duration) {
-        add(0.0, 0.0, rng.uniform(0.2, 0.4));
+        p.add(0.0, 0.0, rng.uniform(0.2, 0.4));
         {
           const double s = rng.uniform(0.8, 1.5), v = rng.uniform(0.5, 1.0) * vm;
-          add(v, 0.0, s);
+          p.add(v, 0.0, s);
         }
-        add(0.0, 0.0, rng.uniform(0.2, 0.4));
+        p.add(0.0, 0.0, rng.uniform(0.2, 0.4));
         {
           const double s = rng.uniform(0.8, 1.5), v = -rng.uniform(0.5, 1.0) * vm;
-          add(v, 0.0, s);
+          p.add(v, 0.0, s);
         }
       }
       break;
@@ -125,22 +124,22 @@ Profile make_profile(const Options& o, double duration, Random& rng) {
       const double radius = rng.uniform(0.3, 1.0);
       double v = rng.uniform(0.4, 0.7) * vm;
       if (v / radius > 0.9 * wm) v = 0.9 * wm * radius;
-      add(0.0, 0.0, 0.2);
-      add(v, rng.sign() * v / radius, std::numeric_limits<double>::infinity());
+      p.add(0.0, 0.0, 0.2);
+      p.add(v, rng.sign() * v / radius, std::numeric_limits<double>::infinity());
       break;
     }
     case MotionProfile::Spin:
       while (p.end() < duration) {
         const int sign = rng.sign();
-        add(0.0, 0.0, rng.uniform(0.2, 0.4));
+        p.add(0.0, 0.0, rng.uniform(0.2, 0.4));
         {
           const double s = rng.uniform(0.8, 1.5), w = sign * rng.uniform(0.5, 1.0) * wm;
-          add(0.0, w, s);
+          p.add(0.0, w, s);
         }
-        add(0.0, 0.0, rng.uniform(0.2, 0.4));
+        p.add(0.0, 0.0, rng.uniform(0.2, 0.4));
         {
           const double s = rng.uniform(0.8, 1.5), w = -sign * rng.uniform(0.5, 1.0) * wm;
-          add(0.0, w, s);
+          p.add(0.0, w, s);
         }
       }
       break;
@@ -157,18 +156,18 @@ Profile make_profile(const Options& o, double duration, Random& rng) {
       const auto add_turning = [&](double v, double share_min, double share_max, double side, double s_min,
                                    double s_max) {
         const double s = rng.uniform(s_min, s_max), share = side * rng.uniform(share_min, share_max);
-        add(v, turn(v, curvature(share)), s);
+        p.add(v, turn(v, curvature(share)), s);
       };
       while (p.end() < duration) {
         const int side = rng.sign();
-        add(0.0, 0.0, rng.uniform(0.3, 0.6));  // stop
+        p.add(0.0, 0.0, rng.uniform(0.3, 0.6));  // stop
         double v = rng.uniform(0.6, 1.0) * vm;
         add_turning(v, -0.1, 0.1, 1.0, 1.0, 2.0);  // straight on
         v = rng.uniform(0.4, 0.8) * vm;
         add_turning(v, 0.6, 1.0, side, 1.0, 2.0);  // a bend
         v = rng.uniform(0.6, 1.0) * vm;
         add_turning(v, 0.3, 1.0, -side, 0.8, 1.5);
-        add(0.0, 0.0, rng.uniform(0.3, 0.6));  // stop
+        p.add(0.0, 0.0, rng.uniform(0.3, 0.6));  // stop
         v = -rng.uniform(0.1, 0.25) * vm;     // reverse
         add_turning(v, 0.5, 1.0, side, 1.0, 2.0);
       }
