@@ -52,6 +52,15 @@ constexpr const char* kTimeGap = "time gap";
 constexpr const char* kWeak = "motion poorly constrained";
 constexpr const char* kBadTime = "timestamp not increasing";
 constexpr const char* kNotAligned = "not aligned";
+constexpr const char* kShutterUnknown =
+    "rolling shutter at speed with no twist measured before: the keyframe's shear is taken as the mean velocity's";
+
+// The first motion after a keyframe whose rolling-shutter twist was not measured (the first
+// frame, one after a Lost frame) is Degraded when the velocity's shift over the readout exceeds
+// this many pixels: the two frames' shears are taken as equal, and a robot that accelerates by
+// 1.5 m/s^2 puts about 4 % of that shift into the motion (0.4 px here, 0.2 mm on a robot camera
+// at 0.2 m; 1.1 mm measured at 1.1 m/s with a 25 ms readout).
+constexpr double kShutterUnknownPx = 10.0;
 
 // Mean squared gradient (grey levels^2 per pixel^2) a frame needs at the coarsest level to
 // become a keyframe. A flat or black frame has 0, the pixel noise of a flat frame at level 3
@@ -100,6 +109,12 @@ CameraModel validated(const CameraModel& c, const Extrinsics& e, const TrackerOp
     throw_invalid_argument("the tracker's covariance step fraction must be 0 or more");
   if (!(o.consecutive_alignment_correlation >= 0.0 && o.consecutive_alignment_correlation <= 0.5))
     throw_invalid_argument("the tracker's consecutive alignment correlation must be within [0, 0.5]");
+  const MotionSearchOptions& so = o.search;
+  if (!(so.max_shift >= 0.0 && so.max_shift <= 1.0) || !(so.grid_px >= 0.25) ||
+      !(so.max_rotation >= 0.0 && so.max_rotation <= 0.5) || so.max_pixels < 16 || so.max_candidates < 1 ||
+      !(so.min_overlap >= 0.0 && so.min_overlap <= 1.0))
+    throw_invalid_argument("TrackerOptions::search: max_shift in [0, 1], grid_px >= 0.25, max_rotation in [0, 0.5] rad, "
+                           "max_pixels >= 16, max_candidates >= 1, min_overlap in [0, 1]");
   c.validate("Tracker camera");
   // The coarsest level must hold a few pixels for the alignment to work on (issue 27: a 1x1
   // camera failed inside the aligner with an internal message).
@@ -159,6 +174,7 @@ struct Tracker::Impl {
   // whether the keyframe's was measured (not predicted).
   Eigen::Vector3d live_twist = Eigen::Vector3d::Zero();
   bool keyframe_twist_measured = false;
+  bool shutter_unknown = false;  // this frame's motion took the keyframe's twist as its own (kShutterUnknownPx)
   // Frames Lost in a row against the keyframe (keyframe hygiene: one failed frame never becomes
   // the keyframe; the second in a row does, as the keyframe is then what no longer matches).
   int lost_in_a_row = 0;
@@ -188,6 +204,7 @@ struct Tracker::Impl {
   bool has_last = false;
   const char* missing = nullptr;
   std::unique_ptr<ResidualImager> imager;
+  std::unique_ptr<MotionSearch> search;  // made when first needed
   ResidualImage cached;
   Pyramid spare;
 
@@ -383,7 +400,11 @@ struct Tracker::Impl {
     // not count as misalignment.
     const double grad2 = st.valid > 0 ? 0.5 * (st.gref + st.glive) / st.valid : 0.0;
     res->misalignment = grad2 > 0 ? 1.4826 * st.median_abs_residual() / std::sqrt(grad2) : HUGE_VAL;
-    light_holds = res->misalignment > opt.max_misalignment_px && std::isfinite(res->misalignment);
+    // The light holds an alignment whose images match as a whole but not in their detail; images
+    // that do not match at all (a frame with nothing in common with the keyframe, as after a gap
+    // at speed) say nothing about the light, and forced a model learnt from a few frames into use.
+    light_holds = res->misalignment > opt.max_misalignment_px && std::isfinite(res->misalignment) &&
+                  ratio <= opt.lost_residual_ratio;
     if (!(ratio <= opt.lost_residual_ratio)) {
       res->status = Status::Lost;
       res->reason = kMismatch;
@@ -482,6 +503,7 @@ struct Tracker::Impl {
   // offset the remaining twist error puts in the pose, to be taken out of est (after remember()).
   SE2 take_out_shutter(const Pyramid& live, double t, double dt, FrameResult* res, Estimate* est) {
     live_offset.setZero();
+    shutter_unknown = false;
     if (!rolling() || !(dt > 0.0) || &live != &slots[live_slot] || !keyframe_kept) return SE2();
     for (int round = 0;; ++round) {
       const Eigen::Vector3d v = (prev.T.inverse() * est->T).log() / dt;
@@ -496,6 +518,7 @@ struct Tracker::Impl {
         live_c = v;
         live_tc = t - 0.5 * dt;
         twist = v;
+        shutter_unknown = shutter_shift(Eigen::Vector3d::Zero(), v) > kShutterUnknownPx;
       } else {
         twist = readout_twist.measure(t, dt, v, live_twist, &live_c, &live_tc);
       }
@@ -621,6 +644,22 @@ struct Tracker::Impl {
     pipeline->reprocess(slots[live_slot]);
     select_keyframe_pixels();
     return true;
+  }
+
+  // The motion searched for on the coarsest level around the previous frame's pose
+  // (motion_search.h) and the frame aligned from the search's peaks, best first: true with the
+  // first result that is not Lost.
+  bool search_again(const Pyramid& live, const FrameResult& before, FrameResult* found, Estimate* est) {
+    if (!search) search = std::make_unique<MotionSearch>(rt);
+    const AlignmentLevels levels = aligner.levels(keyframe, live);
+    const std::vector<SE2> peaks =
+        search->candidates(keyframe, live, levels.coarsest, camera.K(), ext, prev.T, opt.search);
+    for (const SE2& peak : peaks) {
+      Estimate from = prev;
+      from.T = peak;
+      if (align_again(live, from, before, found, est) && found->status != Status::Lost) return true;
+    }
+    return false;
   }
 
   FrameResult track_gray(const uint8_t* gray, int width, int height, size_t stride, double t) {
@@ -770,6 +809,16 @@ struct Tracker::Impl {
         ok = true;
       }
     }
+    // Still lost: search for the motion around the previous frame's pose (no prior may hold).
+    if ((!ok || res.status == Status::Lost) && reason != kAlignNoLiveTexture && opt.search_motion) {
+      FrameResult found;
+      Estimate est4;
+      if (search_again(live, res, &found, &est4)) {
+        res = found;
+        est = est4;
+        ok = true;
+      }
+    }
     // Held by the light fixed to the camera: once more with the photometric model made now.
     if (ok && res.status == Status::Lost && res.reason == kMisaligned && correct_again(live)) {
       FrameResult again;
@@ -790,6 +839,10 @@ struct Tracker::Impl {
     if (time_problem && res.status == Status::Ok) {
       res.status = Status::Degraded;
       res.reason = time_problem;
+    }
+    if (shutter_unknown && res.status == Status::Ok) {
+      res.status = Status::Degraded;
+      res.reason = kShutterUnknown;
     }
     // Its pose is right, but the motion from the frame before carries that frame's prediction
     // error (the two motions together are right).

@@ -18,6 +18,7 @@
 #include "image/photometric.h"
 #include "image/pyramid.h"
 #include "track/aligner.h"
+#include "track/motion_search.h"
 #include "track/residual_image.h"
 #include "track/warp_reduce.h"
 
@@ -114,6 +115,14 @@ struct TrackerOptions : AlignerOptions {
   // measured twist (the first frame, one after a Lost frame) is undistorted again with the next
   // frame's. Pyramids given to track(Pyramid) are taken as they are.
   double rolling_shutter_tolerance_px = 1.0;
+
+  // A frame that would be Lost after the alignments from the prediction and from the previous
+  // frame (the first frames of a robot already at speed, a kick, the frames after a Lost run)
+  // is searched for (motion_search.h: a grid of motions around the previous frame's pose, scored
+  // at once on the coarsest level) and aligned from the search's best peaks, best first, until
+  // one is not Lost. false: no search (such frames are Lost).
+  bool search_motion = true;
+  MotionSearchOptions search;
 
   static WarpReduceOptions default_kernel_options();
 };
