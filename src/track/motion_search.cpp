@@ -93,22 +93,9 @@ std::vector<SearchSums> motion_search_reference(const LevelView& ref, const Leve
       for (int x = 0; x < ref.width; x += step) {
         const float* R = ref.data + 4 * (static_cast<size_t>(y) * ref.stride + x);
         if (R[3] == 0.0f) continue;
-        const float fu = static_cast<float>(x), fv = static_cast<float>(y);
-        const float qx = h[0] * fu + h[1] * fv + h[2];
-        const float qy = h[3] * fu + h[4] * fv + h[5];
-        const float qz = h[6] * fu + h[7] * fv + h[8];
-        if (!(qz > 1e-12f)) continue;
-        const float iz = 1.0f / qz;
-        const float wu = std::clamp(qx * iz, -1.0e6f, 1.0e6f), wv = std::clamp(qy * iz, -1.0e6f, 1.0e6f);
-        const float bu = std::floor(wu), bv = std::floor(wv);
-        const int iu = static_cast<int>(bu), iv = static_cast<int>(bv);
-        if (iu < 0 || iv < 0 || iu >= live.width - 1 || iv >= live.height - 1) continue;
-        const float* s00 = live.data + 4 * (static_cast<size_t>(iv) * live.stride + iu);
-        const float* s10 = s00 + 4 * static_cast<size_t>(live.stride);
-        if (s00[3] == 0.0f || s00[7] == 0.0f || s10[3] == 0.0f || s10[7] == 0.0f) continue;
-        const double ax = wu - bu, ay = wv - bv;
-        const double L = (1 - ax) * (1 - ay) * s00[0] + ax * (1 - ay) * s00[4] + (1 - ax) * ay * s10[0] +
-                         ax * ay * s10[4];
+        KernelSample sample;
+        if (!kernel_sample(h, x, y, live, &sample)) continue;
+        const double L = sample.value[0];
         const double a = R[0] - 128.0, b = L - 128.0;
         s.n += 1.0;
         s.sa += a;

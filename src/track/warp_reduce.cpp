@@ -118,6 +118,31 @@ double ReduceSums::median_abs_residual() const {
   return ReduceLayout::hist_threshold(hist_bins - 1);
 }
 
+bool kernel_sample(const float h[9], int u, int v, const LevelView& live, KernelSample* out) {
+  const float fu = static_cast<float>(u), fv = static_cast<float>(v);
+  const float qx = h[0] * fu + h[1] * fv + h[2];
+  const float qy = h[3] * fu + h[4] * fv + h[5];
+  const float qz = h[6] * fu + h[7] * fv + h[8];
+  if (!(qz > 1e-12f)) return false;
+  const float iz = 1.0f / qz;
+  const float wu = std::clamp(qx * iz, -1e6f, 1e6f), wv = std::clamp(qy * iz, -1e6f, 1e6f);
+  const float bu = std::floor(wu), bv = std::floor(wv);
+  const int iu = static_cast<int>(bu), iv = static_cast<int>(bv);
+  if (iu < 0 || iv < 0 || iu >= live.width - 1 || iv >= live.height - 1) return false;
+  const float* s00 = live.data + 4 * (static_cast<size_t>(iv) * live.stride + iu);
+  const float* s01 = s00 + 4;
+  const float* s10 = s00 + 4 * static_cast<size_t>(live.stride);
+  const float* s11 = s10 + 4;
+  if (s00[3] == 0.0f || s01[3] == 0.0f || s10[3] == 0.0f || s11[3] == 0.0f) return false;
+  const double ax = wu - bu, ay = wv - bv;
+  for (int c = 0; c < 3; ++c)
+    out->value[c] = (1 - ax) * (1 - ay) * s00[c] + ax * (1 - ay) * s01[c] + (1 - ax) * ay * s10[c] + ax * ay * s11[c];
+  out->qz = qz;
+  out->wu = wu;
+  out->wv = wv;
+  return true;
+}
+
 ReduceSums warp_reduce_reference(const LevelView& ref, const LevelView& live,
                                  const WarpInputs& in, const ReduceLayout& L, int wg_x,
                                  int pixels_per_item) {
@@ -162,27 +187,10 @@ ReduceSums warp_reduce_reference(const LevelView& ref, const LevelView& live,
         px = x * o.select_block + off % o.select_block;
         py = y * o.select_block + off / o.select_block;
       }
-      const float fu = static_cast<float>(px), fv = static_cast<float>(py);
-      // The warp in float, in the kernel's order.
-      const float qx = h[0] * fu + h[1] * fv + h[2];
-      const float qy = h[3] * fu + h[4] * fv + h[5];
-      const float qz = h[6] * fu + h[7] * fv + h[8];
-      if (!(qz > 1e-12f)) continue;
-      const float iz = 1.0f / qz;
-      const float wu = std::clamp(qx * iz, -1e6f, 1e6f), wv = std::clamp(qy * iz, -1e6f, 1e6f);
-      const float bu = std::floor(wu), bv = std::floor(wv);
-      const int iu = static_cast<int>(bu), iv = static_cast<int>(bv);
-      if (iu < 0 || iv < 0 || iu >= live.width - 1 || iv >= live.height - 1) continue;
-      const float* s00 = at(live, iu, iv);
-      const float* s01 = at(live, iu + 1, iv);
-      const float* s10 = at(live, iu, iv + 1);
-      const float* s11 = at(live, iu + 1, iv + 1);
-      if (s00[3] == 0.0f || s01[3] == 0.0f || s10[3] == 0.0f || s11[3] == 0.0f) continue;
-      const double ax = wu - bu, ay = wv - bv;
-      double Ls[3];
-      for (int c = 0; c < 3; ++c)
-        Ls[c] = (1 - ax) * (1 - ay) * s00[c] + ax * (1 - ay) * s01[c] + (1 - ax) * ay * s10[c] +
-                ax * ay * s11[c];
+      KernelSample sample;
+      if (!kernel_sample(h, px, py, live, &sample)) continue;
+      const double* Ls = sample.value;
+      const float qz = sample.qz, wu = sample.wu, wv = sample.wv;
       const double r = gain * Ls[0] + bias - R[0];
       const double dz = 1.0 / qz;
       const double d00 = dz * (h[0] - wu * h[6]), d01 = dz * (h[1] - wu * h[7]);

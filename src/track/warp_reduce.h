@@ -110,6 +110,17 @@ struct LevelView {
   int width = 0, height = 0, stride = 0;
 };
 
+// The kernels' warp of reference pixel (u, v) into a live level, in float in their order (so that
+// a reference decides validity as its kernel does), and the bilinear sample there, valid only when
+// all four neighbours lie inside and are valid: the part of kernels/warp_reduce.cl and
+// kernels/motion_search.cl that their plain C++ references share.
+struct KernelSample {
+  float qz = 0, wu = 0, wv = 0;  // q = H (u, v, 1); w = (q.x, q.y) / q.z (clamped to +-1e6)
+  double value[3] = {0, 0, 0};   // the live level's (I, dI/du, dI/dv) at w, bilinear, in double
+};
+// False (and *out unspecified) where the sample is not valid. h: H row by row, as the kernels get it.
+bool kernel_sample(const float h[9], int u, int v, const LevelView& live, KernelSample* out);
+
 struct WarpReduceOptions;
 
 // The plain C++ reference of the kernel: the same per-pixel formulas, the warp in float in the
