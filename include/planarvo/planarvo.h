@@ -786,7 +786,9 @@ PLANARVO_API planarvo_status planarvo_track_motions(planarvo_context* context, p
 /* Composition: roll and pitch (with their 2x2 covariance, row-major; NULL when they were given,
  * not estimated) and a graph calibration's x, y, scale (the height) and yaw as the camera's
  * extrinsics, their 6x6 covariance (order x y z roll pitch yaw, row-major; zero rows for what was
- * not estimated) and, per parameter, whether it was estimated (any output may be NULL). */
+ * not estimated) and, per parameter, whether it was estimated (any output may be NULL). The two
+ * stages are taken as independent here; the whole calibration (planarvo_calibrate_dataset, the
+ * calibrator) also carries the tilt's error into x, y, z and yaw, which motion pairs cannot. */
 PLANARVO_API planarvo_status planarvo_compose_extrinsics(double roll, double pitch,
                                                          const double* roll_pitch_covariance,
                                                          const planarvo_calibration_result* graph,

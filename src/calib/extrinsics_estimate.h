@@ -8,8 +8,10 @@
 // camera) in units of the height. With T_vs = (x, y, yaw) on the ground and T_sc = (Ry(pitch)
 // Rx(roll) R0 | (0, 0, z)), T_vs T_sc = (Rz(yaw) Ry(pitch) Rx(roll) R0 | (x, y, z)) is exactly
 // docs/conventions.md's T_vc, and the graph's m_r = T_vs S_z(m_s) T_vs^-1 estimates (x, y, z, yaw).
-// The two stages' errors are taken as independent (the cross-covariance is zero): the graph
-// sees the tilt only through the motions' scale, a second-order effect for small tilt errors.
+// The graph's motions were tracked with stage 1's tilt, so its error moves them all alike: given
+// J = d(x, y, scale, yaw) / d(roll, pitch) (calib/tilt_propagation.h), the graph's block gets
+// J C_rp J^T more and the cross-covariance with roll and pitch is J C_rp; without it the stages
+// are taken as independent.
 #pragma once
 #include <array>
 
@@ -32,9 +34,14 @@ struct ExtrinsicsEstimate {
   std::array<bool, 6> observable{};  // estimated and determined by the data
 };
 
+// The tracker's extrinsics in stage 2 (eq. 14): the camera's tilt, at the robot's origin, one
+// unit above the ground, no yaw; its motions are the camera's ground frame's in units of height.
+inline Extrinsics stage2_extrinsics(double roll, double pitch) { return Extrinsics{0.0, 0.0, 1.0, roll, pitch, 0.0}; }
+
 // The graph's (x, y, scale, yaw) as x, y, z, yaw; its fixed scale (a height given by hand) as z,
 // not estimated. Roll and pitch as given, estimated when `roll_pitch_estimated`.
 ExtrinsicsEstimate compose_extrinsics(double roll, double pitch, const Eigen::Matrix2d& roll_pitch_covariance,
-                                      bool roll_pitch_estimated, const graph::CalibrationResult& graph);
+                                      bool roll_pitch_estimated, const graph::CalibrationResult& graph,
+                                      const Eigen::Matrix<double, 4, 2>* tilt_jacobian = nullptr);
 
 }  // namespace planarvo::calib

@@ -18,6 +18,7 @@ void MotionSampler::add(const track::FrameResult& r, double t, const std::option
     }
     s.direction = direction;
     samples_.push_back(s);
+    tilt_jacobians_.push_back(r.motion_tilt_jacobian);
   }
   has_previous_ = true;
   previous_t_ = t;

@@ -23,11 +23,15 @@ class MotionSampler {
   void clear();
 
   const std::vector<graph::MotionSample>& samples() const { return samples_; }
+  // Per sample, its motion's d / d (roll, pitch) (FrameResult::motion_tilt_jacobian; zero unless
+  // the tracker made them).
+  const std::vector<Eigen::Matrix<double, 3, 2>>& tilt_jacobians() const { return tilt_jacobians_; }
   int lost() const { return lost_; }                    // intervals not sampled: tracking lost
   int without_odometry() const { return no_odometry_; } // samples whose odometry is missing
 
  private:
   std::vector<graph::MotionSample> samples_;
+  std::vector<Eigen::Matrix<double, 3, 2>> tilt_jacobians_;
   bool has_previous_ = false;
   double previous_t_ = 0.0;
   std::optional<SE2> previous_odometry_;

@@ -7,6 +7,7 @@
 #include <opencv2/core.hpp>
 
 #include "calib/motion_samples.h"
+#include "calib/tilt_propagation.h"
 #include "core/error.h"
 #include "io/dataset.h"
 
@@ -17,10 +18,6 @@ namespace {
 using Clock = std::chrono::steady_clock;
 
 double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
-
-// The tracker's frame for stage 2 (eq. 14): the camera's tilt, at the robot's origin, one unit
-// above the ground, no yaw.
-Extrinsics camera_frame(double roll, double pitch) { return Extrinsics{0.0, 0.0, 1.0, roll, pitch, 0.0}; }
 
 struct HeldFrame {
   cv::Mat gray;
@@ -96,10 +93,15 @@ struct CameraCalibrator::Impl {
     }
   }
 
+  // The tilt's uncertainty is carried into stage 3 when stage 1 estimated it.
+  bool propagate_tilt() const { return opt.propagate_tilt && opt.estimate_roll_pitch; }
+
   void start_tracking() {
     report.readout_used = camera.rolling_shutter_readout;
-    tracker = std::make_unique<track::Tracker>(rt, camera, camera_frame(report.roll_pitch.roll, report.roll_pitch.pitch),
-                                               opt.tracker);
+    track::TrackerOptions to = opt.tracker;
+    to.tilt_jacobian = to.tilt_jacobian || propagate_tilt();
+    tracker = std::make_unique<track::Tracker>(rt, camera, stage2_extrinsics(report.roll_pitch.roll, report.roll_pitch.pitch),
+                                               to);
     stage = Stage::Tracking;
   }
 
@@ -154,7 +156,7 @@ struct CameraCalibrator::Impl {
     ReadoutEstimateOptions ro = opt.readout_estimate;
     ro.tracker = opt.tracker;
     if (opt.progress) ro.progress = [this](double f) { return opt.progress(f, "readout time"); };
-    report.readout = calib::estimate_readout(rt, camera, camera_frame(report.roll_pitch.roll, report.roll_pitch.pitch),
+    report.readout = calib::estimate_readout(rt, camera, stage2_extrinsics(report.roll_pitch.roll, report.roll_pitch.pitch),
                                              frames, stamps, ro);
     report.time.readout = seconds_since(t0);
     if (!report.readout.ok) return true;  // the camera's readout stays; the report says why
@@ -171,7 +173,7 @@ struct CameraCalibrator::Impl {
     const auto t2 = Clock::now();
     ro.guess = report.readout.estimate;
     const ReadoutEstimate again = calib::estimate_readout(
-        rt, camera, camera_frame(report.roll_pitch.roll, report.roll_pitch.pitch), frames, stamps, ro);
+        rt, camera, stage2_extrinsics(report.roll_pitch.roll, report.roll_pitch.pitch), frames, stamps, ro);
     report.time.readout += seconds_since(t2);
     if (!again.ok) return true;
     const int evaluations = report.readout.evaluations + again.evaluations;
@@ -224,10 +226,13 @@ struct CameraCalibrator::Impl {
     const auto t0 = Clock::now();
     graph::CalibrationOptions go = opt.graph;
     if (opt.initial) go.initial = std::array<double, 4>{opt.initial->x, opt.initial->y, opt.initial->z, opt.initial->yaw};
-    std::vector<graph::MotionSample> samples = sampler.samples();
-    if (go.method == graph::CalibrationMethod::Odometry)
-      samples.erase(std::remove_if(samples.begin(), samples.end(), [](const graph::MotionSample& s) { return !s.odometry; }),
-                    samples.end());
+    std::vector<graph::MotionSample> samples;
+    std::vector<Eigen::Matrix<double, 3, 2>> tilt_jacobians;
+    for (size_t i = 0; i < sampler.samples().size(); ++i) {
+      if (go.method == graph::CalibrationMethod::Odometry && !sampler.samples()[i].odometry) continue;
+      samples.push_back(sampler.samples()[i]);
+      tilt_jacobians.push_back(sampler.tilt_jacobians()[i]);
+    }
     report.samples = samples;
     if (samples.size() < 3) {
       report.status = PipelineReport::Status::Failed;
@@ -239,7 +244,16 @@ struct CameraCalibrator::Impl {
     report.graph = graph::calibrate(samples, go);
     report.time.graph = seconds_since(t0);
     const track::RollPitchResult& rp = report.roll_pitch;
-    report.extrinsics = compose_extrinsics(rp.roll, rp.pitch, rp.covariance, opt.estimate_roll_pitch, report.graph);
+    // The tilt's error moves every tracked motion alike: carried into the graph's parameters.
+    std::optional<Eigen::Matrix<double, 4, 2>> J;
+    if (propagate_tilt() && report.graph.summary.converged()) {
+      const auto t1 = Clock::now();
+      J = graph_tilt_jacobian(samples, tilt_jacobians, go, report.graph);
+      report.time.tilt = seconds_since(t1);
+    }
+    report.tilt_jacobian = J;
+    report.extrinsics =
+        compose_extrinsics(rp.roll, rp.pitch, rp.covariance, opt.estimate_roll_pitch, report.graph, J ? &*J : nullptr);
     if (report.graph.ok()) {
       report.status = PipelineReport::Status::Ok;
       report.reason.clear();

@@ -18,6 +18,7 @@
 
 #include "calib/extrinsics_estimate.h"
 #include "calib/readout_estimate.h"
+#include "calib/tilt_propagation.h"
 #include "core/se2.h"
 #include "graph/calibration.h"
 #include "image/camera.h"
@@ -63,6 +64,11 @@ struct PipelineOptions {
   Readout readout = Readout::Off;
   int readout_frames = 300;
   ReadoutEstimateOptions readout_estimate;
+  // The tilt's uncertainty carried into x, y, height and yaw and their cross-covariance with roll
+  // and pitch (calib/tilt_propagation.h: the tracker's tilt Jacobians, 0.6-1.2 ms a frame at
+  // 640x480, and four more graph solves; a 20-s calibration takes 7-14 % longer). false: the
+  // stages' errors are taken as independent.
+  bool propagate_tilt = true;
   // Progress: fraction of the frames fed so far (calibrate_dataset; a stream's total is unknown)
   // and the stage; return false to cancel (Error(Cancelled)).
   std::function<bool(double fraction, const char* stage)> progress;
@@ -87,6 +93,9 @@ struct PipelineReport {
   ReadoutEstimate readout;
   double readout_used = 0.0;  // the readout time stages 1 and 2 used, seconds
   graph::CalibrationResult graph;     // stage 3 (when it ran)
+  // d(x, y, scale, yaw) / d(roll, pitch) through stages 2 and 3 (calib/tilt_propagation.h); none
+  // when not propagated.
+  std::optional<Eigen::Matrix<double, 4, 2>> tilt_jacobian;
   std::vector<graph::MotionSample> samples;  // stage 2's output, stage 3's input
   struct Tracking {
     int frames = 0, ok = 0, degraded = 0, lost = 0, keyframes = 0;
@@ -99,6 +108,7 @@ struct PipelineReport {
     double readout = 0.0;     // the readout time's estimate
     double tracking = 0.0;    // stage 2
     double graph = 0.0;       // stage 3
+    double tilt = 0.0;        // the tilt's uncertainty carried into stage 3 (propagate_tilt)
     double total = 0.0;
   } time;
   bool ok() const { return status == Status::Ok; }

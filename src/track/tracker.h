@@ -124,6 +124,12 @@ struct TrackerOptions : AlignerOptions {
   bool search_motion = true;
   MotionSearchOptions search;
 
+  // Fill FrameResult::motion_tilt_jacobian: after the alignment, one pass of the roll/pitch
+  // estimator's (NPARAM 5) at half resolution (level 0 on a 320x240 camera) at the estimate; the
+  // implicit function theorem on its normal equations gives d pose / d tilt (0.6-1.2 ms a frame at
+  // 640x480 here). For the calibration (calib/tilt_propagation.h); off for tracking.
+  bool tilt_jacobian = false;
+
   static WarpReduceOptions default_kernel_options();
 };
 
@@ -172,6 +178,10 @@ struct FrameResult {
   // max_misalignment_px).
   double misalignment = 0;
   bool keyframe = false;       // this frame became the keyframe
+  // With TrackerOptions::tilt_jacobian: d motion / d (roll, pitch) of the extrinsics the tracker
+  // was given, in the right perturbation of motion.value (the covariance's coordinates) per
+  // radian: how this motion would move had the tilt been different (zero otherwise, and Lost).
+  Eigen::Matrix<double, 3, 2> motion_tilt_jacobian = Eigen::Matrix<double, 3, 2>::Zero();
   double ms = 0;               // wall time of track(), milliseconds
   double pipeline_ms = 0;      // of which the image pipeline (camera-frame API only)
 };

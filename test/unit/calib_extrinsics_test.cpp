@@ -63,5 +63,36 @@ TEST(ComposeExtrinsics, GivenParametersAreMarkedAndHaveNoCovariance) {
   EXPECT_DOUBLE_EQ(e.value.z, 0.15);
 }
 
+// With the tilt's share (calib/tilt_propagation.h): the graph's parameters are the tilt-free
+// estimate g0 plus J (roll, pitch) error, so the joint covariance of (g, roll, pitch) is
+// A blockdiag(G, C) A^T with A = [[I, J], [0, I]], put where the six parameters are. A parameter
+// the graph did not estimate (y here) stays without covariance.
+TEST(ComposeExtrinsics, TheTiltsShareIsTheLinearMapsCovariance) {
+  graph::CalibrationResult g;
+  g.value = {0.2, 0.0, 0.15, 0.1};
+  g.estimated = {true, false, true, true};
+  g.observable = {true, false, true, true};
+  g.covariance = Eigen::Vector4d(4e-6, 0.0, 2e-6, 1e-6).asDiagonal();
+  g.covariance(0, 3) = g.covariance(3, 0) = 5e-7;
+  Eigen::Matrix2d C;
+  C << 4e-8, 1e-8, 1e-8, 9e-8;
+  Eigen::Matrix<double, 4, 2> J;
+  J << 0.3, -0.1, 7.0, 2.0, 0.05, 0.2, -0.8, 0.6;  // the y row is not used: y is not estimated
+  const ExtrinsicsEstimate e = compose_extrinsics(0.1, 0.2, C, true, g, &J);
+
+  Eigen::Matrix<double, 6, 6> A = Eigen::Matrix<double, 6, 6>::Identity();
+  A.topRightCorner<4, 2>() = J;
+  Eigen::Matrix<double, 6, 6> B = Eigen::Matrix<double, 6, 6>::Zero();
+  B.topLeftCorner<4, 4>() = g.covariance;
+  B.bottomRightCorner<2, 2>() = C;
+  const Eigen::Matrix<double, 6, 6> joint = A * B * A.transpose();  // order x y scale yaw roll pitch
+  const int at[6] = {0, 1, 2, 5, 3, 4};
+  for (int i = 0; i < 6; ++i)
+    for (int j = 0; j < 6; ++j) {
+      const bool zero = at[i] == 1 || at[j] == 1;
+      EXPECT_NEAR(e.covariance(at[i], at[j]), zero ? 0.0 : joint(i, j), 1e-18) << i << " " << j;
+    }
+}
+
 }  // namespace
 }  // namespace planarvo::calib
