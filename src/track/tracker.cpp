@@ -7,13 +7,13 @@
 
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
-#include <Eigen/Geometry>
 
 #include "core/error.h"
 #include "core/extrinsics.h"
 #include "image/pipeline.h"
 #include "ocl/runtime.h"
 #include "track/readout_twist.h"
+#include "track/tilt_jacobian.h"
 #include "track/warp_model.h"
 
 namespace planarvo::track {
@@ -206,8 +206,8 @@ struct Tracker::Impl {
   const char* missing = nullptr;
   std::unique_ptr<ResidualImager> imager;
   std::unique_ptr<MotionSearch> search;  // made when first needed
-  // TrackerOptions::tilt_jacobian: the pass with the tilt, and d prev.T / d (roll, pitch).
-  std::unique_ptr<WarpReduce> tilt_pass;
+  // TrackerOptions::tilt_jacobian: made when first needed, and d prev.T / d (roll, pitch).
+  std::unique_ptr<TiltJacobian> tilt_jacobian;
   Eigen::Matrix<double, 3, 2> prev_tilt = Eigen::Matrix<double, 3, 2>::Zero();
   ResidualImage cached;
   Pyramid spare;
@@ -652,56 +652,6 @@ struct Tracker::Impl {
     return true;
   }
 
-  // d est.T / d (roll, pitch), right perturbation: at the alignment's optimum the gradient in the
-  // local parameters (motion, brightness) is zero for every tilt, so d local / d y = -A_ll^-1 A_ly
-  // (A: J^T W J of the pass with the tilt y, warp_model.h's rotation about the camera centre),
-  // then per radian of roll and pitch through d (roll, pitch) / d y.
-  Eigen::Matrix<double, 3, 2> pose_tilt_jacobian(const Pyramid& live, const Estimate& e) {
-    const int level = std::min(1, std::min(keyframe.num_levels(), live.num_levels()) - 1);
-    const PyramidLevel& r = keyframe.levels[static_cast<size_t>(level)];
-    const PyramidLevel& l = live.levels[static_cast<size_t>(level)];
-    if (!tilt_pass) {
-      WarpReduceOptions k = opt.kernel;
-      k.stats = k.debug_output = false;
-      k.select_block = 0;
-      tilt_pass = std::make_unique<WarpReduce>(rt, kMotionParams + kOrientationParams, k);
-    }
-    const MotionHomography mh = motion_homography(level_camera_matrix(camera.K(), level), ext, e.T, true);
-    WarpInputs in;
-    in.H = mh.H;
-    in.nparam = mh.nparam;
-    for (int i = 0; i < mh.nparam; ++i) in.G[static_cast<size_t>(i)] = mh.G[static_cast<size_t>(i)];
-    in.gain = std::exp(e.a);
-    in.bias = e.b;
-    in.huber_k = e.huber_k > 0.0 ? e.huber_k : 1e30;
-    ReduceSums s;
-    tilt_pass->run(r.data, r.width, r.height, l.data, l.width, l.height, in, &s);
-    // Local parameters: the motion, then the brightness (a, b) when estimated; the tilt at 3, 4.
-    std::vector<int> local = {0, 1, 2};
-    if (opt.estimate_brightness) local.insert(local.end(), {5, 6});
-    const int n = static_cast<int>(local.size());
-    Eigen::MatrixXd All(n, n), Aly(n, 2);
-    for (int i = 0; i < n; ++i) {
-      for (int j = 0; j < n; ++j) All(i, j) = s.JtWJ(local[static_cast<size_t>(i)], local[static_cast<size_t>(j)]);
-      for (int j = 0; j < 2; ++j) Aly(i, j) = s.JtWJ(local[static_cast<size_t>(i)], 3 + j);
-    }
-    const Eigen::MatrixXd dy = -All.ldlt().solve(Aly);
-    // A change of roll or pitch turns the camera about an axis with a vertical part too (roll turns
-    // about the pitched x axis): w = log(R_vc(angle + h) R_vc^T) / h in the robot frame. Its
-    // horizontal part is the tilt y above; its vertical part turns the camera's ground frame,
-    // which the pose is expressed in: P becomes Rz(w_z) P Rz(-w_z) (the frame turned by -w_z).
-    Eigen::Matrix<double, 3, 2> out;
-    const double h = 1e-6;
-    for (int c = 0; c < 2; ++c) {
-      Extrinsics moved = ext;
-      (c == 0 ? moved.roll : moved.pitch) += h;
-      const Eigen::AngleAxisd w(moved.R_vc() * ext.R_vc().transpose());
-      const Eigen::Vector3d omega = w.angle() * w.axis() / h;
-      const Eigen::Vector3d turn = (e.T.inverse() * SE2(0, 0, h) * e.T * SE2(0, 0, -h)).log() / h;
-      out.col(c) = dy.topRows(3) * omega.head<2>() + turn * omega.z();
-    }    return out.allFinite() ? out : Eigen::Matrix<double, 3, 2>::Zero();
-  }
-
   // The motion searched for on the coarsest level around the previous frame's pose
   // (motion_search.h) and the frame aligned from the search's peaks, best first: true with the
   // first result that is not Lost.
@@ -917,7 +867,8 @@ struct Tracker::Impl {
     // Its tilt Jacobian the same way: xi_e's and Ad(m^-1) xi_p's (before a new keyframe).
     Eigen::Matrix<double, 3, 2> tilt = Eigen::Matrix<double, 3, 2>::Zero();
     if (opt.tilt_jacobian) {
-      tilt = pose_tilt_jacobian(live, est);
+      if (!tilt_jacobian) tilt_jacobian = std::make_unique<TiltJacobian>(rt, opt.kernel);
+      tilt = (*tilt_jacobian)(keyframe, live, camera.K(), ext, est.T, est.a, est.b, est.huber_k, opt.estimate_brightness);
       res.motion_tilt_jacobian = tilt - ad * prev_tilt;
     }
     if (!res.motion.covariance.allFinite()) res.motion.covariance = lost_covariance();
