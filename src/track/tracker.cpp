@@ -56,9 +56,9 @@ constexpr const char* kNotAligned = "not aligned";
 constexpr const char* kShutterUnknown =
     "rolling shutter at speed with no twist measured before: the keyframe's shear is taken as the mean velocity's";
 
-// The first motion after a keyframe whose rolling-shutter twist was not measured (the first
-// frame, one after a Lost frame) is Degraded when the velocity's shift over the readout exceeds
-// this many pixels: the two frames' shears are taken as equal, and a robot that accelerates by
+// The motions against a keyframe whose rolling-shutter twist was not measured (the first frame,
+// one after a Lost frame) are Degraded, until the next keyframe, when the velocity's shift over
+// the readout exceeds this many pixels: the two frames' shears are taken as equal, and a robot that accelerates by
 // 1.5 m/s^2 puts about 4 % of that shift into the motion (0.4 px here, 0.2 mm on a robot camera
 // at 0.2 m; 1.1 mm measured at 1.1 m/s with a 25 ms readout).
 constexpr double kShutterUnknownPx = 10.0;
@@ -176,6 +176,10 @@ struct Tracker::Impl {
   Eigen::Vector3d live_twist = Eigen::Vector3d::Zero();
   bool keyframe_twist_measured = false;
   bool shutter_unknown = false;  // this frame's motion took the keyframe's twist as its own (kShutterUnknownPx)
+  // ... and the keyframe's shear is still that assumption (the first keyframe re-undistorted with
+  // it, or that frame itself become the keyframe): the motions of the frames aligned with it share
+  // its error (0.35-0.45 mm measured on the second), until a keyframe with a measured twist.
+  bool keyframe_shear_assumed = false;
   // Frames Lost in a row against the keyframe (keyframe hygiene: one failed frame never becomes
   // the keyframe; the second in a row does, as the keyframe is then what no longer matches).
   int lost_in_a_row = 0;
@@ -248,6 +252,7 @@ struct Tracker::Impl {
     prev_predicted = false;
     prev_covariance.setZero();
     prev_tilt.setZero();
+    keyframe_shear_assumed = false;
     velocity.setZero();
     readout_twist.reset();
     lost_in_a_row = 0;
@@ -481,6 +486,8 @@ struct Tracker::Impl {
     prev_predicted = false;
     prev_covariance.setZero();
     prev_tilt.setZero();
+    // A frame whose own twist was taken as the interval's mean velocity passes that on.
+    keyframe_shear_assumed = shutter_unknown;
   }
 
   bool rolling() const { return camera.rolling_shutter_readout > 0.0; }
@@ -524,7 +531,7 @@ struct Tracker::Impl {
         live_c = v;
         live_tc = t - 0.5 * dt;
         twist = v;
-        shutter_unknown = shutter_shift(Eigen::Vector3d::Zero(), v) > kShutterUnknownPx;
+        shutter_unknown = keyframe_shear_assumed = shutter_shift(Eigen::Vector3d::Zero(), v) > kShutterUnknownPx;
       } else {
         twist = readout_twist.measure(t, dt, v, live_twist, &live_c, &live_tc);
       }
@@ -716,6 +723,7 @@ struct Tracker::Impl {
     forget_alignment(kNotAligned);
     FrameResult res;
     res.motion.covariance = lost_covariance();
+    shutter_unknown = false;
 
     // Time: the interval, gaps, and the constant-velocity prediction. A timestamp that is not
     // finite or not after the last one is not used (the usual interval is assumed).
@@ -846,7 +854,7 @@ struct Tracker::Impl {
       res.status = Status::Degraded;
       res.reason = time_problem;
     }
-    if (shutter_unknown && res.status == Status::Ok) {
+    if ((shutter_unknown || keyframe_shear_assumed) && res.status == Status::Ok) {
       res.status = Status::Degraded;
       res.reason = kShutterUnknown;
     }

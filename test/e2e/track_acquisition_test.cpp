@@ -23,8 +23,9 @@ namespace {
 
 struct Drive {
   double speed = 0;      // m/s at the first frame (after a gap: at the frame after it)
-  double max_error = 0;  // metres, over the tracked motions
-  int lost = 0;
+  double max_error = 0;     // metres, over the tracked motions
+  double max_ok_error = 0;  // over those whose status is Ok
+  int lost = 0, degraded = 0;
 };
 
 // n frames of a drive from its fastest frame after the first third (rendered only those),
@@ -73,7 +74,10 @@ Drive start_at_speed(ocl::Runtime& rt, const std::string& texture, uint64_t seed
     // The motion after a gap is the tracker's prediction (a Lost frame's): not counted.
     if (frames[i] != frames[i - 1] + 1) continue;
     const SE2 m = traj.pose[frames[i - 1]].inverse() * traj.pose[k];
-    run.max_error = std::max(run.max_error, std::hypot(r.motion.value.x - m.x, r.motion.value.y - m.y));
+    const double error = std::hypot(r.motion.value.x - m.x, r.motion.value.y - m.y);
+    run.max_error = std::max(run.max_error, error);
+    if (r.status == FrameResult::Status::Ok) run.max_ok_error = std::max(run.max_ok_error, error);
+    run.degraded += r.status == FrameResult::Status::Degraded;
   }
   return run;
 }
@@ -96,15 +100,20 @@ TEST(Acquisition, TrackingStartsAtSpeed) {
   }
 }
 
-// A 25 ms rolling shutter at speed: the first motion's frames carry an unknown shear (taken as
-// the mean velocity over the interval, readout_twist.h), which bounds the first motions' error.
+// A 25 ms rolling shutter at speed: the first keyframe's shear is unknown (taken as the mean
+// velocity over the first interval, readout_twist.h), which the motions against it share (0.8 and
+// 0.35 mm measured): they are Degraded, and every motion that is Ok is within the 0.2 mm.
 TEST(Acquisition, ARollingShutterStartsAtSpeed) {
   ocl::Runtime rt;
   const Drive r = start_at_speed(rt, "brick_floor.png", 5, 0.025, true);
   EXPECT_GT(r.speed, 0.9);
   EXPECT_EQ(r.lost, 0);
   EXPECT_LT(r.max_error, 1.0e-3);
+  EXPECT_GE(r.degraded, 1);
+  EXPECT_LE(r.degraded, 3);
+  EXPECT_LT(r.max_ok_error, 0.2e-3);
   RecordProperty("max_error_mm", std::to_string(r.max_error * 1e3));
+  RecordProperty("max_ok_error_mm", std::to_string(r.max_ok_error * 1e3));
 }
 
 // A gap of 20 frames (0.67 s, longer than max_gap_seconds: the prediction is dropped) at speed:
