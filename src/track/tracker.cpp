@@ -57,10 +57,11 @@ constexpr const char* kShutterUnknown =
     "rolling shutter at speed with no twist measured before: the keyframe's shear is taken as the mean velocity's";
 
 // The motions against a keyframe whose rolling-shutter twist was not measured (the first frame,
-// one after a Lost frame) are Degraded, until the next keyframe, when the velocity's shift over
-// the readout exceeds this many pixels: the two frames' shears are taken as equal, and a robot that accelerates by
-// 1.5 m/s^2 puts about 4 % of that shift into the motion (0.4 px here, 0.2 mm on a robot camera
-// at 0.2 m; 1.1 mm measured at 1.1 m/s with a 25 ms readout).
+// one after a Lost frame) are Degraded, until a keyframe with a measured twist, when the
+// velocity's shift over the readout exceeds this many pixels: the keyframe's shear is taken as the
+// first interval's mean, and a robot that accelerates by 1.5 m/s^2 puts about 4 % of that shift
+// into the motions (0.4 px here, 0.2 mm on a robot camera at 0.2 m; 1.1 mm and 0.45 mm measured on
+// the first two motions at 1.1 m/s with a 25 ms readout).
 constexpr double kShutterUnknownPx = 10.0;
 
 // Mean squared gradient (grey levels^2 per pixel^2) a frame needs at the coarsest level to
