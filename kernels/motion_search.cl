@@ -2,7 +2,7 @@
 // is unknown and the alignment from a guess fails (the first frames, a robot already at speed,
 // a kick), many motion hypotheses are scored at once on one pyramid level by the zero-mean
 // normalised cross-correlation of the reference and the live level warped through each
-// hypothesis's homography. This pass only sums; the host forms the correlation in double.
+// hypothesis's homography. This pass only sums; the host forms the correlation in 64-bit precision.
 //
 // Per hypothesis h (a work-group) and per reference pixel p = (u, v) on a grid of every STEP-th
 // column and row (an argument) with a valid reference sample R = ref(p):

@@ -50,6 +50,13 @@ struct SE2 {
     return m;
   }
   Eigen::Vector3d vector() const { return {x, y, theta}; }
+  // The adjoint on se(2) = (vx, vy, omega): T exp(xi) T^-1 = exp(Ad_T xi).
+  Eigen::Matrix3d adjoint() const {
+    const double c = std::cos(theta), s = std::sin(theta);
+    Eigen::Matrix3d A;
+    A << c, -s, y, s, c, -x, 0, 0, 1;
+    return A;
+  }
 
   // Exponential map of se(2): (vx, vy, omega) integrated for unit time, i.e. the constant-
   // velocity arc. exp(log(T)) == T.

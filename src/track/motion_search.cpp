@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <numeric>
-#include <sstream>
 
 #include <Eigen/LU>
 
@@ -154,13 +153,6 @@ void MotionSearch::run(const cl::Buffer& ref, int ref_w, int ref_h, const cl::Bu
     const float* r = &sums_host_[kSums * k];
     (*out)[k] = {r[0], r[1], r[2], r[3], r[4], r[5]};
   }
-}
-
-std::vector<SE2> MotionSearch::grid(const Eigen::Matrix3d& K_level, const Extrinsics& extrinsics, const SE2& centre,
-                                    int w, int h, const MotionSearchOptions& options) {
-  std::vector<SE2> out;
-  for (const GridPoint& g : make_grid(K_level, extrinsics, centre, w, h, options)) out.push_back(g.motion);
-  return out;
 }
 
 std::vector<SE2> MotionSearch::candidates(const Pyramid& reference, const Pyramid& live, int level,

@@ -60,12 +60,6 @@ class MotionSearch {
   void run(const cl::Buffer& ref, int ref_w, int ref_h, const cl::Buffer& live, int live_w, int live_h,
            const std::vector<Eigen::Matrix3d>& homographies, int step, std::vector<SearchSums>* out);
 
-  // The grid's motions around `centre` (live robot poses in the reference robot frame) for a
-  // level of camera matrix K_level and size w x h; empty when the camera does not see the ground
-  // move (a singular image Jacobian).
-  static std::vector<SE2> grid(const Eigen::Matrix3d& K_level, const Extrinsics& extrinsics, const SE2& centre,
-                               int w, int h, const MotionSearchOptions& options);
-
   // The best separate peaks of the grid around `centre` at `level` of the pyramids (K: level 0's
   // camera matrix), best first; at most options.max_candidates, none when no hypothesis overlaps.
   std::vector<SE2> candidates(const Pyramid& reference, const Pyramid& live, int level, const Eigen::Matrix3d& K,

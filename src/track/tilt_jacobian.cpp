@@ -58,12 +58,13 @@ Eigen::Matrix<double, 3, 2> TiltJacobian::operator()(const Pyramid& reference, c
   // in, so the pose P becomes Rz(w_z) P Rz(-w_z).
   Eigen::Matrix<double, 3, 2> out;
   const double h = 1e-6;
+  // Rz(a) P Rz(-a) = P exp(a (Ad_{P^-1} - 1) e_theta).
+  const Eigen::Vector3d turn = motion.inverse().adjoint().col(2) - Eigen::Vector3d::UnitZ();
   for (int c = 0; c < 2; ++c) {
     Extrinsics moved = e;
     (c == 0 ? moved.roll : moved.pitch) += h;
     const Eigen::AngleAxisd w(moved.R_vc() * e.R_vc().transpose());
     const Eigen::Vector3d omega = w.angle() * w.axis() / h;
-    const Eigen::Vector3d turn = (motion.inverse() * SE2(0, 0, h) * motion * SE2(0, 0, -h)).log() / h;
     out.col(c) = dy.topRows(3) * omega.head<2>() + turn * omega.z();
   }
   return out.allFinite() ? out : Eigen::Matrix<double, 3, 2>::Zero();

@@ -12,8 +12,10 @@
 #include "core/extrinsics.h"
 #include "image/pipeline.h"
 #include "ocl/runtime.h"
+#include "track/alignment_covariance.h"
 #include "track/readout_twist.h"
 #include "track/tilt_jacobian.h"
+#include "track/tracker_validation.h"
 #include "track/warp_model.h"
 
 namespace planarvo::track {
@@ -33,14 +35,6 @@ struct Estimate {
 };
 
 Eigen::Matrix3d lost_covariance() { return Eigen::Matrix3d::Identity(); }
-
-// The adjoint of an SE(2) element on se(2) = (vx, vy, omega): T exp(xi) T^-1 = exp(Ad_T xi).
-Eigen::Matrix3d adjoint(const SE2& T) {
-  const double c = std::cos(T.theta), s = std::sin(T.theta);
-  Eigen::Matrix3d A;
-  A << c, -s, T.y, s, c, -T.x, 0, 0, 1;
-  return A;
-}
 
 // Reasons (compared by address).
 constexpr const char* kNoTexture = "no texture";
@@ -71,64 +65,6 @@ constexpr double kShutterUnknownPx = 10.0;
 // camera (1.1 m, 55 degrees from vertical, 60 degree field of view) anti_skid_tiles keeps only
 // 0.17 at level 3 (its grout lines are finer than 8 pixels) while it tracks at every frame.
 constexpr double kMinSelfTexture = 0.1;
-
-// Some of the image (a 9 x 9 grid of undistorted pixels) looks at least 0.5 degrees below the
-// horizon: the ground plane is in view. A camera pitched to look up sees none of it, and every
-// frame would be Lost (or, with a sky texture, Ok and meaningless).
-// The fewest pixels on a side of the coarsest pyramid level the tracker accepts.
-constexpr int kMinCoarsestSide = 4;
-
-bool sees_the_ground(const CameraModel& c, const Extrinsics& e) {
-  const Eigen::Vector3d n = e.plane_normal_camera();  // ground points X: n.X = -z
-  const Eigen::Matrix3d Kinv = c.K().inverse();
-  for (int i = 0; i <= 8; ++i)
-    for (int j = 0; j <= 8; ++j) {
-      const Eigen::Vector3d d = (Kinv * Eigen::Vector3d(c.width * i / 8.0, c.height * j / 8.0, 1.0)).normalized();
-      if (n.dot(d) < -std::sin(0.5 * M_PI / 180.0)) return true;
-    }
-  return false;
-}
-
-CameraModel validated(const CameraModel& c, const Extrinsics& e, const TrackerOptions& o) {
-  if (o.levels < 1 || o.levels > kMaxLevels)
-    throw_invalid_argument("TrackerOptions::levels must be 1.." + std::to_string(kMaxLevels));
-  if (!(e.z > 0.0)) throw_invalid_argument("Tracker: the camera height z must be positive");
-  if (!e.finite())
-    throw_invalid_argument("Tracker: the extrinsics must be finite numbers");
-  if (!sees_the_ground(c, e))
-    throw_invalid_argument("Tracker: with these extrinsics (roll " + std::to_string(e.roll) + ", pitch " +
-                           std::to_string(e.pitch) + " rad) no part of the image looks below the horizon: the "
-                           "camera does not see the ground (angles in radians, not degrees?)");
-  for (int b : o.select_blocks)
-    if (b < 0 || b > 16) throw_invalid_argument("TrackerOptions::select_blocks must be 0..16");
-  if (o.auto_finer_block < 0 || o.auto_finer_block > 16)
-    throw_invalid_argument("TrackerOptions::auto_finer_block must be 0..16");
-  if (!(o.rolling_shutter_tolerance_px > 0.0))
-    throw_invalid_argument("TrackerOptions::rolling_shutter_tolerance_px must be positive");
-  if (!(o.keyframe_scale_change > 0.0))
-    throw_invalid_argument("TrackerOptions::keyframe_scale_change must be positive");
-  if (!(o.covariance_step_fraction >= 0.0))
-    throw_invalid_argument("the tracker's covariance step fraction must be 0 or more");
-  if (!(o.consecutive_alignment_correlation >= 0.0 && o.consecutive_alignment_correlation <= 0.5))
-    throw_invalid_argument("the tracker's consecutive alignment correlation must be within [0, 0.5]");
-  const MotionSearchOptions& so = o.search;
-  if (!(so.max_shift >= 0.0 && so.max_shift <= 1.0) || !(so.grid_px >= 0.25) ||
-      !(so.max_rotation >= 0.0 && so.max_rotation <= 0.5) || so.max_pixels < 16 || so.max_candidates < 1 ||
-      !(so.min_overlap >= 0.0 && so.min_overlap <= 1.0))
-    throw_invalid_argument("TrackerOptions::search: max_shift in [0, 1], grid_px >= 0.25, max_rotation in [0, 0.5] rad, "
-                           "max_pixels >= 16, max_candidates >= 1, min_overlap in [0, 1]");
-  c.validate("Tracker camera");
-  // The coarsest level must hold a few pixels for the alignment to work on (issue 27: a 1x1
-  // camera failed inside the aligner with an internal message).
-  const int coarsest_w = level_size(c.width, o.levels - 1), coarsest_h = level_size(c.height, o.levels - 1);
-  if (coarsest_w < kMinCoarsestSide || coarsest_h < kMinCoarsestSide)
-    throw_invalid_argument("Tracker: a " + std::to_string(c.width) + "x" + std::to_string(c.height) +
-                           " image is too small for " + std::to_string(o.levels) +
-                           " pyramid levels: the coarsest would be " + std::to_string(coarsest_w) + "x" +
-                           std::to_string(coarsest_h) + " pixels, and the tracker needs " +
-                           std::to_string(kMinCoarsestSide) + " on a side (fewer levels, or a larger image)");
-  return c;
-}
 
 }  // namespace
 
@@ -218,7 +154,7 @@ struct Tracker::Impl {
   Pyramid spare;
 
   Impl(ocl::Runtime& r, const CameraModel& c, const Extrinsics& e, const TrackerOptions& o)
-      : rt(r), camera(validated(c, e, o)), ext(e), opt(o), aligner(r, c.K(), o, false), selector(r) {
+      : rt(r), camera(validated_tracker_camera(c, e, o)), ext(e), opt(o), aligner(r, c.K(), o, false), selector(r) {
     readout_twist = ReadoutTwist(camera.rolling_shutter_readout);
     // The flat field is read now, so that a bad file fails at once rather than at the first frame.
     if (!opt.flat_field.empty() && opt.photometric.enabled) {
@@ -311,30 +247,6 @@ struct Tracker::Impl {
     return true;
   }
 
-  // How much the ground's scale in the image has changed from the keyframe to the live frame:
-  // the largest |log| of the warp's linear scale (the square root of its Jacobian's determinant)
-  // at the centre and the corners of the region of interest. Moving along a perspective
-  // camera's viewing direction keeps the overlap high while the fine texture's appearance changes.
-  double scale_change(const SE2& motion) const {
-    const Eigen::Matrix3d H = ground_homography(camera.K(), ext, motion.matrix3d());
-    const PixelRegion r = camera.region();
-    double worst = 0.0;
-    const double xs[3] = {static_cast<double>(r.x), r.x + 0.5 * (r.width - 1), static_cast<double>(r.x + r.width - 1)};
-    const double ys[3] = {static_cast<double>(r.y), r.y + 0.5 * (r.height - 1), static_cast<double>(r.y + r.height - 1)};
-    for (double u : xs)
-      for (double v : ys) {
-        const Eigen::Vector3d q = H * Eigen::Vector3d(u, v, 1.0);
-        if (!(q.z() > 0.0)) return HUGE_VAL;
-        const double wu = q.x() / q.z(), wv = q.y() / q.z();
-        const double d00 = (H(0, 0) - wu * H(2, 0)) / q.z(), d01 = (H(0, 1) - wu * H(2, 1)) / q.z();
-        const double d10 = (H(1, 0) - wv * H(2, 0)) / q.z(), d11 = (H(1, 1) - wv * H(2, 1)) / q.z();
-        const double det = d00 * d11 - d01 * d10;
-        if (!(det > 0.0)) return HUGE_VAL;
-        worst = std::max(worst, std::abs(0.5 * std::log(det)));
-      }
-    return worst;
-  }
-
   // The position covariance too large, or much longer along one axis than the other (texture
   // that constrains the motion in one direction only), or the heading too uncertain.
   bool weakly_constrained(const Eigen::Matrix3d& cov) const {
@@ -342,38 +254,6 @@ struct Tracker::Impl {
         Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(cov.topLeftCorner<2, 2>()).eigenvalues();
     return !(std::sqrt(ev(1)) <= opt.max_position_std) || !(ev(1) <= opt.max_std_ratio * opt.max_std_ratio * ev(0)) ||
            !(std::sqrt(cov(2, 2)) <= opt.max_heading_std);
-  }
-
-  // The alignment's covariance from the finest level's sums (TrackerOptions::
-  // covariance_step_fraction, README.md "Covariance"): s is the last pass at the estimate, st
-  // the STATS pass that opened the level (the same pass when the level took one). n = 3 or 5
-  // parameters, brightness marginalised by taking the motion block; A = s's J^T W J (n x n) and
-  // ldlt its factorisation.
-  Eigen::Matrix3d alignment_covariance(const ReduceSums& s, const ReduceSums& st, int n, double floor_s2,
-                                       const MatrixJ& A, const Eigen::LDLT<MatrixJ>& ldlt) const {
-    // Bread: the Huber cost's Hessian, J^T J over the inliers (J^T W J also counts the pixels
-    // beyond the threshold, with weight k / |r|, and would understate the spread).
-    const ReduceSums& hs = s.has_stats ? s : st;
-    MatrixJ B = hs.JtJ_inlier.rows() >= n ? MatrixJ(hs.JtJ_inlier.topLeftCorner(n, n)) : A;
-    Eigen::LDLT<MatrixJ> bread(B);
-    if (bread.info() != Eigen::Success || !(bread.vectorD().minCoeff() > 0.0)) bread.compute(A);
-    const MatrixJ Binv = bread.solve(MatrixJ::Identity(n, n));
-    // Meat: the scores' outer product over G clusters of neighbouring pixels, scaled by
-    // G / (G - 1): the scores are taken at the fitted solution, which removes one cluster's worth
-    // of their spread along any direction (E = (1 - 1/G) of the true one for alike clusters).
-    // With too few clusters, the independent-pixel sigma^2 J^T W J. At least the floor's worth
-    // of independent noise.
-    const double dof = std::max(1.0, s.valid - n);
-    MatrixJ M = s.clusters > 2.0 * n ? MatrixJ(s.score_outer.topLeftCorner(n, n) * (s.clusters / (s.clusters - 1.0)))
-                                     : MatrixJ(std::max(s.wrr / dof, floor_s2) * A);
-    M += std::max(0.0, floor_s2 - s.wrr / dof) * A;
-    Eigen::Matrix3d C = (Binv * M * Binv.transpose()).topLeftCorner(3, 3);
-    C = 0.5 * (C + C.transpose());
-    // The last step, applied unchecked (or left over): the estimate is off by a fraction of it.
-    const VectorJ step = -ldlt.solve(VectorJ(s.JtWr.head(n)));
-    const Eigen::Vector3d d = opt.covariance_step_fraction * step.head(3);
-    if (d.allFinite()) C += d * d.transpose();
-    return C;
   }
 
   // Fills the alignment's covariance, cost, inliers, overlap and the status from the finest
@@ -399,7 +279,8 @@ struct Tracker::Impl {
     Eigen::Matrix3d independent = s2 * inv.topLeftCorner(3, 3);
     if (!independent.allFinite()) independent = lost_covariance();
     // The motion's covariance is composed from this one by the caller (track_gray).
-    res->alignment_covariance = alignment_covariance(s, report.finest_stats[0], n, floor_s2, A, ldlt);
+    res->alignment_covariance =
+        alignment_covariance(s, report.finest_stats[0], n, floor_s2, A, ldlt, opt.covariance_step_fraction);
     if (!res->alignment_covariance.allFinite()) res->alignment_covariance = lost_covariance();
 
     // The images' match from the half-resolution level (or the finest, when coarser): at full
@@ -517,7 +398,6 @@ struct Tracker::Impl {
   // offset the remaining twist error puts in the pose, to be taken out of est (after remember()).
   SE2 take_out_shutter(const Pyramid& live, double t, double dt, FrameResult* res, Estimate* est) {
     live_offset.setZero();
-    shutter_unknown = false;
     if (!rolling() || !(dt > 0.0) || &live != &slots[live_slot] || !keyframe_kept) return SE2();
     for (int round = 0;; ++round) {
       const Eigen::Vector3d v = (prev.T.inverse() * est->T).log() / dt;
@@ -871,7 +751,7 @@ struct Tracker::Impl {
     // prev.T = P exp(xi_p) and est.T = E exp(xi_e), the motion is m exp(xi_e - Ad(m^-1) xi_p);
     // prev_covariance already holds xi_p's covariance less the part shared with xi_e.
     res.motion.value = prev.T.inverse() * est.T;
-    const Eigen::Matrix3d ad = adjoint(res.motion.value.inverse());
+    const Eigen::Matrix3d ad = res.motion.value.inverse().adjoint();
     res.motion.covariance = res.alignment_covariance + ad * prev_covariance * ad.transpose();
     // Its tilt Jacobian the same way: xi_e's and Ad(m^-1) xi_p's (before a new keyframe).
     Eigen::Matrix<double, 3, 2> tilt = Eigen::Matrix<double, 3, 2>::Zero();
@@ -886,7 +766,7 @@ struct Tracker::Impl {
     if (has_live_c) readout_twist.commit(live_c, live_tc);
     since_good = 0.0;
     lost_in_a_row = 0;
-    if (res.overlap < opt.keyframe_overlap || scale_change(est.T) > opt.keyframe_scale_change) {
+    if (res.overlap < opt.keyframe_overlap || log_scale_change(camera.K(), ext, est.T, camera.region()) > opt.keyframe_scale_change) {
       make_keyframe(live);
       keyframe_twist_measured = true;
       // Frames aligned with it carry its own shutter offset, which the motions from it must not.

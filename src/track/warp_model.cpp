@@ -109,4 +109,24 @@ double max_pixel_displacement(const Eigen::Matrix3d& K, const Extrinsics& ea, co
   return worst;
 }
 
+double log_scale_change(const Eigen::Matrix3d& K, const Extrinsics& extrinsics, const SE2& motion,
+                        const PixelRegion& r) {
+  const Eigen::Matrix3d H = ground_homography(K, extrinsics, motion.matrix3d());
+  double worst = 0.0;
+  const double xs[3] = {static_cast<double>(r.x), r.x + 0.5 * (r.width - 1), static_cast<double>(r.x + r.width - 1)};
+  const double ys[3] = {static_cast<double>(r.y), r.y + 0.5 * (r.height - 1), static_cast<double>(r.y + r.height - 1)};
+  for (double u : xs)
+    for (double v : ys) {
+      const Eigen::Vector3d q = H * Eigen::Vector3d(u, v, 1.0);
+      if (!(q.z() > 0.0)) return HUGE_VAL;
+      const double wu = q.x() / q.z(), wv = q.y() / q.z();
+      const double d00 = (H(0, 0) - wu * H(2, 0)) / q.z(), d01 = (H(0, 1) - wu * H(2, 1)) / q.z();
+      const double d10 = (H(1, 0) - wv * H(2, 0)) / q.z(), d11 = (H(1, 1) - wv * H(2, 1)) / q.z();
+      const double det = d00 * d11 - d01 * d10;
+      if (!(det > 0.0)) return HUGE_VAL;
+      worst = std::max(worst, std::abs(0.5 * std::log(det)));
+    }
+  return worst;
+}
+
 }  // namespace planarvo::track

@@ -44,6 +44,7 @@
 
 #include "core/extrinsics.h"
 #include "core/se2.h"
+#include "image/camera.h"
 
 namespace planarvo::track {
 
@@ -76,5 +77,13 @@ double max_pixel_displacement(const Eigen::Matrix3d& K, const Extrinsics& extrin
 // The same between the homographies of (extrinsics a, motion a) and (extrinsics b, motion b).
 double max_pixel_displacement(const Eigen::Matrix3d& K, const Extrinsics& ea, const SE2& a,
                               const Extrinsics& eb, const SE2& b, int width, int height);
+
+// How much the ground's scale in the image changes under `motion` (the live pose in the
+// reference's robot frame): the largest |log| of the warp's linear scale (the square root of its
+// Jacobian's determinant) at the centre and the corners of `region`; HUGE_VAL where the warp
+// folds or leaves the plane in front. Moving along a perspective camera's viewing direction keeps
+// the overlap high while the fine texture's appearance changes (the tracker's keyframe rule).
+double log_scale_change(const Eigen::Matrix3d& K, const Extrinsics& extrinsics, const SE2& motion,
+                        const PixelRegion& region);
 
 }  // namespace planarvo::track
