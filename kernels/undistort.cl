@@ -157,14 +157,14 @@ void undistort_rolling(__global const uchar* src, __global const float* map, __g
   // Eight pixels span at most two cells of a grid with a step of 8 or more, so the grid is read at
   // three node columns from the first lane's, interpolated between the two rows first.
   const float8 gx = convert_float8((int8)(x) + (int8)(0, 1, 2, 3, 4, 5, 6, 7)) * inv_step;
-  const int8 i = min(convert_int8(gx), (int8)(nodes_x - 2));
-  const float8 ax = gx - convert_float8(i);
-  const int i0 = i.s0, i2 = min(i0 + 2, nodes_x - 1);
+  const int8 cell = min(convert_int8(gx), (int8)(nodes_x - 2));
+  const float8 ax = gx - convert_float8(cell);
+  const int i0 = cell.s0, i2 = min(i0 + 2, nodes_x - 1);
   const int g0 = j * nodes_x, g1 = g0 + nodes_x;
   const float2 c0 = grid[g0 + i0] + ay * (grid[g1 + i0] - grid[g0 + i0]);
   const float2 c1 = grid[g0 + i0 + 1] + ay * (grid[g1 + i0 + 1] - grid[g0 + i0 + 1]);
   const float2 c2 = grid[g0 + i2] + ay * (grid[g1 + i2] - grid[g0 + i2]);
-  const int8 second = i > (int8)(i0);  // the lane lies in the next cell
+  const int8 second = cell > (int8)(i0);  // the lane lies in the next cell
   const float8 lx = select((float8)(c0.x), (float8)(c1.x), second), rx = select((float8)(c1.x), (float8)(c2.x), second);
   const float8 ly = select((float8)(c0.y), (float8)(c1.y), second), ry = select((float8)(c1.y), (float8)(c2.y), second);
   // The map's eight (x, y) pairs (the last work-item of a row may read into the next row: the
@@ -173,18 +173,21 @@ void undistort_rolling(__global const uchar* src, __global const float* map, __g
   const float8 sx = m.even + (lx + ax * (rx - lx));
   const float8 sy = m.odd + (ly + ax * (ry - ly));
   const int8 valid = (sx >= (float8)(roi.x)) & (sx <= (float8)(roi.z)) & (sy >= (float8)(roi.y)) & (sy <= (float8)(roi.w));
-  // Invalid lanes sample pixel (0, 0), and are then overwritten.
-  const int8 x0 = select((int8)(0), convert_int8(sx), valid), y0 = select((int8)(0), convert_int8(sy), valid);
-  const int8 x1 = min(x0 + 1, (int8)(width - 1)), y1 = min(y0 + 1, (int8)(height - 1));
+  // The top-left tap clamped to the second-last column and row, where the weight of the right or
+  // lower tap is then 1 (exactly the last pixel's value, as the reference's clamped taps give),
+  // so that the four taps are base, base + 1, base + width and base + width + 1 as `undistort`'s
+  // (the frame is padded for the last row's). Invalid lanes sample pixel (0, 0), then overwritten.
+  const int8 x0 = min(convert_int8(select((float8)(0.0f), sx, valid)), (int8)(max(width - 2, 0)));
+  const int8 y0 = min(convert_int8(select((float8)(0.0f), sy, valid)), (int8)(max(height - 2, 0)));
   const float8 fx = select((float8)(0.0f), sx - convert_float8(x0), valid);
   const float8 fy = select((float8)(0.0f), sy - convert_float8(y0), valid);
-  const int8 r0 = y0 * width, r1 = y1 * width;
+  const int8 i = y0 * width + x0;
   float8 p00, p01, p10, p11;
-#define UR_GATHER(k)                       \
-  p00.s##k = src[r0.s##k + x0.s##k];       \
-  p01.s##k = src[r0.s##k + x1.s##k];       \
-  p10.s##k = src[r1.s##k + x0.s##k];       \
-  p11.s##k = src[r1.s##k + x1.s##k];
+#define UR_GATHER(k)                 \
+  p00.s##k = src[i.s##k];            \
+  p01.s##k = src[i.s##k + 1];        \
+  p10.s##k = src[i.s##k + width];    \
+  p11.s##k = src[i.s##k + width + 1];
   UR_GATHER(0) UR_GATHER(1) UR_GATHER(2) UR_GATHER(3) UR_GATHER(4) UR_GATHER(5) UR_GATHER(6) UR_GATHER(7)
 #undef UR_GATHER
   const float8 top = (1.0f - fx) * p00 + fx * p01;

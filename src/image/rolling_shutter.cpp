@@ -141,23 +141,56 @@ RowWarp rolling_shutter_warp(const CameraModel& camera, const Extrinsics& extrin
   RowWarp w = identity_row_warp(camera.width, camera.height, step);
   if (!(camera.rolling_shutter_readout > 0.0) || twist.isZero(0.0)) return w;
   const RowHomographies H(camera, extrinsics, twist);
-  // Each node starts from its two left neighbours' rows extrapolated (the first two of a row
-  // from the node above): mostly one evaluation, else one Aitken step.
+  // Solved exactly at every second node column and row and at the outermost ones (those without
+  // three nodes on both sides); the rest filled in by the cubic through the four nearest solved
+  // nodes of its row or column, whose error is the field's fourth derivative over 32 px: within
+  // 0.0034 px of the exact nodes at a 75 px shear (RollingShutter.GridMatchesThePerPixelSolution),
+  // a tenth of the bilinear interpolation's between nodes, for about a third of the solves.
+  auto solved = [](int i, int n) { return i % 2 == 0 || i < 3 || i + 3 > n - 1; };
+  const size_t nx = static_cast<size_t>(w.nodes_x);
+  auto at = [&](int i, int j) { return 2 * (static_cast<size_t>(j) * nx + static_cast<size_t>(i)); };
+  // Each solved node starts from its two left neighbours' rows extrapolated (the first two of a
+  // row from the node above): mostly one evaluation, else one Aitken step.
   double above = std::numeric_limits<double>::quiet_NaN();
   for (int j = 0; j < w.nodes_y; ++j) {
+    if (!solved(j, w.nodes_y)) continue;
     double left = above, before_left = std::numeric_limits<double>::quiet_NaN();
+    int left_i = -1, before_i = -1;
     for (int i = 0; i < w.nodes_x; ++i) {
+      if (!solved(i, w.nodes_x)) continue;
       const Eigen::Vector2d p(i * step, j * step);
-      const double start = std::isfinite(before_left) ? 2.0 * left - before_left : left;
+      // The extrapolation by the solved nodes' own spacing (1 or 2 columns).
+      const double start =
+          std::isfinite(before_left) ? left + (left - before_left) * (i - left_i) / (left_i - before_i) : left;
       const Eigen::Vector2d s = solve_source(camera, H, p, start);
-      before_left = i > 0 ? left : std::numeric_limits<double>::quiet_NaN();
+      before_left = left_i >= 0 ? left : std::numeric_limits<double>::quiet_NaN();
+      before_i = left_i;
       left = s.y();
+      left_i = i;
       if (i == 0) above = s.y();
       const Eigen::Vector2d d = s - distorted_pixel(camera, p);
-      const size_t n = 2 * (static_cast<size_t>(j) * static_cast<size_t>(w.nodes_x) + static_cast<size_t>(i));
-      w.delta[n] = d.allFinite() ? static_cast<float>(d.x()) : 0.0f;
-      w.delta[n + 1] = d.allFinite() ? static_cast<float>(d.y()) : 0.0f;
+      w.delta[at(i, j)] = d.allFinite() ? static_cast<float>(d.x()) : 0.0f;
+      w.delta[at(i, j) + 1] = d.allFinite() ? static_cast<float>(d.y()) : 0.0f;
     }
+  }
+  // The cubic through nodes -3, -1, +1, +3 (in the fine grid's steps) at 0: (-1, 9, 9, -1) / 16.
+  // Every node not solved has them solved (odd, with three nodes on both sides).
+  auto cubic = [](float a, float b, float c, float d) { return (9.0f * (b + c) - (a + d)) * (1.0f / 16.0f); };
+  for (int j = 0; j < w.nodes_y; ++j) {
+    if (!solved(j, w.nodes_y)) continue;
+    for (int i = 0; i < w.nodes_x; ++i) {
+      if (solved(i, w.nodes_x)) continue;
+      for (size_t c = 0; c < 2; ++c)
+        w.delta[at(i, j) + c] = cubic(w.delta[at(i - 3, j) + c], w.delta[at(i - 1, j) + c],
+                                      w.delta[at(i + 1, j) + c], w.delta[at(i + 3, j) + c]);
+    }
+  }
+  for (int j = 0; j < w.nodes_y; ++j) {
+    if (solved(j, w.nodes_y)) continue;
+    for (int i = 0; i < w.nodes_x; ++i)
+      for (size_t c = 0; c < 2; ++c)
+        w.delta[at(i, j) + c] = cubic(w.delta[at(i, j - 3) + c], w.delta[at(i, j - 1) + c],
+                                      w.delta[at(i, j + 1) + c], w.delta[at(i, j + 3) + c]);
   }
   return w;
 }
