@@ -90,6 +90,7 @@ bool read_params(const ros::NodeHandle& nh, NodeParams* p) {
             get_int(nh, "levels", 1, 8, &levels) && get_int(nh, "finest_level", -1, levels - 1, &finest) &&
             get_int(nh, "level0_subsample", 0, 8, &subsample) && get_text(nh, "flat_field", &p->flat_field) &&
             get_double(nh, "readout_time", -1.0, 1.0, &p->readout_time) &&
+            get_double(nh, "exposure_time", -1.0, 1.0, &p->exposure_time) &&
             get_int(nh, "max_iterations", 0, 1000, &iterations) &&
             get_double(nh, "keyframe_overlap", 0.0, 1.0, &t.keyframe_overlap) &&
             get_int(nh, "queue_size", 1, 100000, &p->queue_size) &&

@@ -29,6 +29,9 @@ struct NodeParams {
   // last's), overriding the camera's (~camera's rolling_shutter_readout; camera_info has none, so
   // 0); -1 = the camera's.
   double readout_time = -1;
+  // ~exposure_time: the camera's exposure in seconds, overriding the camera's (~camera's
+  // exposure_time; camera_info has none, so 0); -1 = the camera's.
+  double exposure_time = -1;
   int queue_size = 100;    // ~queue_size: the image subscriber's roscpp queue
   int max_pending = 300;   // ~max_pending: frames waiting for the tracker before the oldest is dropped
   double drain_seconds = 10;  // ~drain_seconds: on shutdown, time to finish the frames still queued

@@ -178,6 +178,7 @@ class Node {
     started_ = true;
     planarvo_camera camera = given;
     if (params_.readout_time >= 0) camera.rolling_shutter_readout = params_.readout_time;
+    if (params_.exposure_time >= 0) camera.exposure_time = params_.exposure_time;
     if (extrinsics_) create_tracker(camera, *extrinsics_);
     if (params_.calibrate) {
       std::lock_guard<std::mutex> lock(odometry_mutex_);

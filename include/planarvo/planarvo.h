@@ -99,8 +99,8 @@ typedef struct planarvo_region {
 } planarvo_region;
 
 /* Pinhole camera with OpenCV's radial-tangential distortion (k1 k2 p1 p2 k3), pixel (0,0) the
- * centre of the top-left pixel. Zero-initialise it before filling it in (roi and
- * rolling_shutter_readout were added in 0.2). */
+ * centre of the top-left pixel. Zero-initialise it before filling it in (roi,
+ * rolling_shutter_readout and exposure_time were added in 0.2). */
 typedef struct planarvo_camera {
   int32_t width, height;
   double fx, fy, cx, cy;
@@ -115,6 +115,10 @@ typedef struct planarvo_camera {
    * its first row is read; row r of H rows is read at stamp + r / (H - 1) * readout. Negative or
    * not finite: PLANARVO_ERROR_INVALID_INPUT. */
   double rolling_shutter_readout;
+  /* Exposure (camera.yaml's exposure_time): seconds each row integrates before it is read; the
+   * engine takes each row's image as the sharp one of half the exposure before its read. 0 = not
+   * modelled. Negative or not finite: PLANARVO_ERROR_INVALID_INPUT. */
+  double exposure_time;
 } planarvo_camera;
 
 /* Camera pose on the robot: centre (x, y, z) in metres, z the height above the ground;

@@ -19,7 +19,8 @@ class Camera:
     """Pinhole camera with OpenCV's radial-tangential distortion (k1 k2 p1 p2 k3); roi
     (x, y, width, height) the only pixels used, all zero for the whole image;
     rolling_shutter_readout the seconds from reading the first row to the last (0: global
-    shutter; a frame's stamp is its first row's read time)."""
+    shutter; a frame's stamp is its first row's read time); exposure_time the seconds each row
+    integrates before it is read (0: not modelled)."""
     width: int
     height: int
     fx: float
@@ -33,6 +34,7 @@ class Camera:
     k3: float = 0.0
     roi: Tuple[int, int, int, int] = (0, 0, 0, 0)
     rolling_shutter_readout: float = 0.0
+    exposure_time: float = 0.0
 
     @classmethod
     def load(cls, path: PathLike) -> "Camera":
@@ -55,11 +57,11 @@ class Camera:
     @classmethod
     def _from_c(cls, c: N.Camera) -> "Camera":
         return cls(c.width, c.height, c.fx, c.fy, c.cx, c.cy, c.k1, c.k2, c.p1, c.p2, c.k3,
-                   (c.roi.x, c.roi.y, c.roi.width, c.roi.height), c.rolling_shutter_readout)
+                   (c.roi.x, c.roi.y, c.roi.width, c.roi.height), c.rolling_shutter_readout, c.exposure_time)
 
     def _to_c(self) -> N.Camera:
         return N.Camera(self.width, self.height, self.fx, self.fy, self.cx, self.cy, self.k1, self.k2, self.p1,
-                        self.p2, self.k3, N.Region(*self.roi), self.rolling_shutter_readout)
+                        self.p2, self.k3, N.Region(*self.roi), self.rolling_shutter_readout, self.exposure_time)
 
 
 EXTRINSICS_NAMES = ("x", "y", "z", "roll", "pitch", "yaw")

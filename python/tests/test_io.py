@@ -16,7 +16,8 @@ def test_camera_round_trip(tmp_path):
 
 
 def test_rolling_shutter_readout_round_trip_and_simulated(context, tmp_path):
-    cam = planarvo.Camera(640, 480, 501.25, 499.5, 319.75, 241.125, rolling_shutter_readout=0.0271)
+    cam = planarvo.Camera(640, 480, 501.25, 499.5, 319.75, 241.125, rolling_shutter_readout=0.0271,
+                          exposure_time=0.0043)
     cam.save(tmp_path / "camera.yaml")
     assert planarvo.Camera.load(tmp_path / "camera.yaml") == cam
     assert planarvo.Camera.simulator_default(96, 64, 80.0).rolling_shutter_readout == 0.0
@@ -24,6 +25,7 @@ def test_rolling_shutter_readout_round_trip_and_simulated(context, tmp_path):
                                   readout_time=0.02, exposure_time=0.004)
     planarvo.simulate(context, tmp_path / "rs", options)
     assert planarvo.Camera.load(tmp_path / "rs" / "camera.yaml").rolling_shutter_readout == 0.02
+    assert planarvo.Camera.load(tmp_path / "rs" / "camera.yaml").exposure_time == 0.004
     with pytest.raises(planarvo.Error):
         planarvo.simulate(context, tmp_path / "bad", planarvo.SimOptions(seconds=0.2, readout_time=-1.0))
     # A data set's readout replaced for one run; refused when negative or longer than a frame.

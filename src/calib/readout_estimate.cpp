@@ -49,18 +49,19 @@ class Evaluator {
     return size;
   }
 
-  // Frame i's twist over a readout r: the first pass's velocities (each at the middle of its
-  // interval) interpolated to the middle of the readout, t_i + r/2, which lies between the
-  // interval ending at frame i and the one starting there. Offline, so the next frame is known:
+  // Frame i's twist over a readout: the first pass's velocities (each at the middle of its
+  // interval) interpolated to the frame's mean row time, t_i + m (m = (readout - exposure) / 2,
+  // CameraModel::mean_row_time), which lies between the interval ending at frame i and the one
+  // starting there. Offline, so the next frame is known:
   // no extrapolation, unlike the tracker's (track/readout_twist.h), whose errors in the twists'
   // differences would read as a readout error.
-  Eigen::Vector3d twist(size_t i, double r) const {
+  Eigen::Vector3d twist(size_t i, double m) const {
     const Eigen::Vector3d& before = velocity_[i];
     const Eigen::Vector3d& after = i + 1 < velocity_.size() ? velocity_[i + 1] : velocity_[i];
     if (!before.allFinite()) return after.allFinite() ? after : Eigen::Vector3d::Zero();
     if (!after.allFinite()) return before;
     const double t0 = 0.5 * (stamps_[i - 1] + stamps_[i]), t1 = 0.5 * (stamps_[i] + stamps_[i + 1]);
-    const double w = std::clamp((stamps_[i] + 0.5 * r - t0) / (t1 - t0), 0.0, 1.0);
+    const double w = std::clamp((stamps_[i] + m - t0) / (t1 - t0), 0.0, 1.0);
     return (1.0 - w) * before + w * after;
   }
 
@@ -80,7 +81,7 @@ class Evaluator {
     for (const Window& w : windows) {
       tracker.reset();
       for (size_t i = w.begin; i < w.end; ++i) {
-        pipeline.set_row_warp(rolling_shutter_warp(c, ext_, twist(i, r)));
+        pipeline.set_row_warp(rolling_shutter_warp(c, ext_, twist(i, c.mean_row_time())));
         pipeline.process(frames_[i], pyramid);
         const track::FrameResult res = tracker.track(pyramid, stamps_[i]);
         variance.push_back(tracked_status(res) && std::isfinite(res.sigma) ? res.sigma * res.sigma : kNaN);
@@ -93,9 +94,10 @@ class Evaluator {
   static bool tracked_status(const track::FrameResult& r) {
     return r.status == track::FrameResult::Status::Ok || r.status == track::FrameResult::Status::Degraded;
   }
+  // The tracker of the pyramids undistorted here: they stand for their stamps.
   CameraModel camera_global() const {
     CameraModel c = camera_;
-    c.rolling_shutter_readout = 0.0;
+    c.rolling_shutter_readout = c.exposure_time = 0.0;
     return c;
   }
 

@@ -40,11 +40,12 @@ inline CameraModel to_cpp(const planarvo_camera& c) {
   m.k1 = c.k1; m.k2 = c.k2; m.p1 = c.p1; m.p2 = c.p2; m.k3 = c.k3;
   m.roi = PixelRegion{c.roi.x, c.roi.y, c.roi.width, c.roi.height};
   m.rolling_shutter_readout = c.rolling_shutter_readout;
+  m.exposure_time = c.exposure_time;
   return m;
 }
 inline planarvo_camera to_c(const CameraModel& m) {
   return {m.width, m.height, m.fx, m.fy, m.cx, m.cy, m.k1, m.k2, m.p1, m.p2, m.k3,
-          {m.roi.x, m.roi.y, m.roi.width, m.roi.height}, m.rolling_shutter_readout};
+          {m.roi.x, m.roi.y, m.roi.width, m.roi.height}, m.rolling_shutter_readout, m.exposure_time};
 }
 inline Extrinsics to_cpp(const planarvo_extrinsics& e) { return {e.x, e.y, e.z, e.roll, e.pitch, e.yaw}; }
 inline planarvo_extrinsics to_c(const Extrinsics& e) { return {e.x, e.y, e.z, e.roll, e.pitch, e.yaw}; }

@@ -54,7 +54,7 @@ std::vector<OptionSpec> simulate_options() {
       {"readout-time", "SECONDS", "rolling shutter: first row's read to last row's, at most 1/fps; written to "
        "camera.yaml as rolling_shutter_readout (0: global shutter)", "0"},
       {"exposure", "SECONDS", "exposure time: each row averages the moving ground over this long before it is read "
-       "(motion blur), at most 1/fps", "0"},
+       "(motion blur), at most 1/fps; written to camera.yaml as exposure_time", "0"},
       {"lamp", "F", "a camera-mounted lamp: the darkest corner gets 1 - F of the light (0..0.95)", "0 (even light)"},
       {"reflection", "GREY", "the lamp's reflection on a glossy floor: peak grey levels added (saturates)", "0"},
       {"shadow", "F", "the robot's shadow over the image's bottom: fraction of light taken (0..0.95)", "0"},
@@ -208,6 +208,7 @@ void print_dataset(planarvo_dataset* ds, const std::string& dir) {
   if (c.rolling_shutter_readout > 0)
     std::printf("  shutter     rolling, %.3f ms from the first row's read to the last's\n",
                 c.rolling_shutter_readout * 1e3);
+  if (c.exposure_time > 0) std::printf("  exposure    %.3f ms\n", c.exposure_time * 1e3);
   std::printf("  odometry    %s\n  direction   %s\n  groundtruth %s\n", info.has_odometry ? "yes" : "no",
               info.has_direction ? "yes" : "no", info.has_groundtruth ? "yes" : "no");
   auto ext = [](const char* label, int has, const planarvo_extrinsics& e) {

@@ -56,6 +56,11 @@ Eigen::Vector2d CameraModel::unproject(const Eigen::Vector2d& pixel) const {
   return undistort(Eigen::Vector2d((pixel.x() - cx) / fx, (pixel.y() - cy) / fy));
 }
 
+double CameraModel::row_time(double r) const {
+  const double read = height > 1 ? r / (height - 1) * rolling_shutter_readout : 0.0;
+  return read - 0.5 * exposure_time;
+}
+
 void CameraModel::validate(const char* what) const {
   const std::string where(what);
   if (width <= 0 || height <= 0)
@@ -70,6 +75,11 @@ void CameraModel::validate(const char* what) const {
     std::snprintf(got, sizeof got, "%g", rolling_shutter_readout);
     throw_invalid_input(where + ": rolling_shutter_readout must be a finite number of seconds >= 0 (got " +
                         got + ")");
+  }
+  if (!std::isfinite(exposure_time) || exposure_time < 0) {
+    char got[32];
+    std::snprintf(got, sizeof got, "%g", exposure_time);
+    throw_invalid_input(where + ": exposure_time must be a finite number of seconds >= 0 (got " + got + ")");
   }
   if (roi.width != 0 || roi.height != 0) {
     const std::string r = "region of interest [" + std::to_string(roi.x) + ", " + std::to_string(roi.y) + ", " +

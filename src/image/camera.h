@@ -46,6 +46,17 @@ struct CameraModel {
   // rolling_shutter_readout); 0 = global shutter. A frame's stamp is when its first row is read:
   // row r of H is read at stamp + r / (H - 1) * rolling_shutter_readout (docs/conventions.md).
   double rolling_shutter_readout = 0;
+  // Exposure: seconds each row integrates the scene before it is read (camera.yaml's
+  // exposure_time); 0 = not modelled. At constant velocity a row exposed over [t_r - E, t_r] is,
+  // blurred, the sharp image of t_r - E / 2: what the engine models (row_time).
+  double exposure_time = 0;
+  // The time row r's image stands for, relative to the frame's stamp: its read time less half
+  // the exposure, r / (H - 1) * rolling_shutter_readout - exposure_time / 2 (r may be fractional).
+  double row_time(double r) const;
+  // The mean of row_time over the rows: (rolling_shutter_readout - exposure_time) / 2.
+  double mean_row_time() const { return 0.5 * (rolling_shutter_readout - exposure_time); }
+  // Not every row's image stands for the stamp: a rolling shutter, or an exposure.
+  bool timed_rows() const { return rolling_shutter_readout > 0 || exposure_time > 0; }
   // The region of interest, or the whole image when none is given.
   PixelRegion region() const { return roi.empty() ? PixelRegion{0, 0, width, height} : roi; }
 
@@ -64,8 +75,9 @@ struct CameraModel {
   Eigen::Vector2d unproject(const Eigen::Vector2d& pixel) const;
 
   // Throws InvalidInput (naming `what`, e.g. the file) when sizes or focal lengths are not
-  // positive or a value is not finite, the rolling shutter readout is negative, or the region
-  // of interest is not inside the image or is smaller than kMinRegionSide pixels on a side.
+  // positive or a value is not finite, the rolling shutter readout or the exposure is negative,
+  // or the region of interest is not inside the image or is smaller than kMinRegionSide pixels on
+  // a side.
   void validate(const char* what) const;
 };
 

@@ -13,7 +13,8 @@ namespace planarvo {
 
 namespace {
 
-// Ground homographies H(tau) at kSamples read times evenly spaced over the readout, interpolated
+// Ground homographies H(tau) at kSamples row times (CameraModel::row_time: the read times less
+// half the exposure) evenly spaced over the readout, interpolated
 // between them by Catmull-Rom splines (smooth across the samples, so that the field the grid
 // interpolates has no kinks; under 1e-5 px from the exact H over 30 ms at 1.5 m/s and 1.2 rad/s)
 // and extrapolated linearly beyond the first and last rows.
@@ -24,7 +25,7 @@ class RowHomographies {
       : rows_(camera.height) {
     const Eigen::Matrix3d K = camera.K();
     for (int k = 0; k < kSamples; ++k) {
-      const double tau = static_cast<double>(k) / (kSamples - 1) * camera.rolling_shutter_readout;
+      const double tau = camera.row_time(static_cast<double>(k) / (kSamples - 1) * (camera.height - 1));
       H_[k] = ground_homography(K, e, SE2::exp(tau * twist).matrix3d());
       H_[k] /= H_[k](2, 2);
     }
@@ -139,7 +140,7 @@ RowWarp rolling_shutter_warp(const CameraModel& camera, const Extrinsics& extrin
                              int step) {
   if (!twist.allFinite()) throw_invalid_argument("rolling_shutter_warp: the twist must be finite");
   RowWarp w = identity_row_warp(camera.width, camera.height, step);
-  if (!(camera.rolling_shutter_readout > 0.0) || twist.isZero(0.0)) return w;
+  if (!camera.timed_rows() || twist.isZero(0.0)) return w;
   const RowHomographies H(camera, extrinsics, twist);
   // Solved exactly at every second node column and row and at the outermost ones (those without
   // three nodes on both sides); the rest filled in by the cubic through the four nearest solved

@@ -1,12 +1,15 @@
 // The rolling shutter's geometry: a CMOS sensor reads its rows one after another, row r of H at
 // stamp + r / (H - 1) * CameraModel::rolling_shutter_readout (docs/conventions.md), so a camera
-// in motion sees each row from another pose. The image pipeline takes it out before anything
-// else looks at the frame: it resamples the camera frame into the undistorted image a global
-// shutter would have taken at the stamp (what the tracker, the pyramid and everything after
-// them assume), given the robot's velocity over the readout.
+// in motion sees each row from another pose; an exposure E integrates each row over the E before
+// its read, which at constant velocity is the sharp image of E / 2 earlier (blurred). The image
+// pipeline takes both out before anything else looks at the frame: it resamples the camera
+// frame into the undistorted image an instantaneous global shutter would have taken at the
+// stamp (what the tracker, the pyramid and everything after them assume), given the robot's
+// velocity over the frame.
 //
-// The model (constant velocity within a frame, on SE(2)): the robot pose at row r's read time
-// is T(stamp) exp(tau_r xi), tau_r = r / (H - 1) * readout, xi = (vx, vy, omega) the robot's
+// The model (constant velocity within a frame, on SE(2)): the robot pose of row r's image is
+// T(stamp) exp(tau_r xi), tau_r = CameraModel::row_time(r) = r / (H - 1) * readout - E / 2 (an
+// exposure alone: every row at -E / 2, a rigid shift of the image), xi = (vx, vy, omega) the robot's
 // twist in its own frame, per second. A ground point seen at undistorted pixel p of the
 // stamp's image is then seen by the camera of row r at q = H_r p, H_r the ground homography
 // (core/extrinsics.h) of the motion exp(tau_r xi). The sensor row that sees it is the row of
@@ -59,7 +62,8 @@ RowWarp identity_row_warp(int width, int height, int step = kRowWarpStep);
 
 // The warp of `camera` (its K, distortion, size and rolling_shutter_readout) on the robot at
 // `extrinsics`, moving with `twist` (vx, vy, omega; m/s and rad/s in the robot frame). The
-// identity for a global shutter or a zero twist. InvalidArgument when the twist is not finite.
+// identity for a camera whose rows all stand for the stamp (CameraModel::timed_rows) or a zero
+// twist. InvalidArgument when the twist is not finite.
 RowWarp rolling_shutter_warp(const CameraModel& camera, const Extrinsics& extrinsics, const Eigen::Vector3d& twist,
                              int step = kRowWarpStep);
 

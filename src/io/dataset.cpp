@@ -39,27 +39,37 @@ using detail::to_grey_checked;
 
 namespace {
 
-// A readout longer than the frame interval would read a row of the next frame before this one's
-// last: no camera does that, and it is what a readout given in milliseconds looks like.
-void check_readout(double readout, const std::vector<FrameEntry>& frames, const std::string& where) {
-  char got[64];
-  std::snprintf(got, sizeof got, "%g", readout);
-  if (!std::isfinite(readout) || readout < 0)
-    throw_invalid_input(where + ": the rolling shutter readout must be a finite number of seconds >= 0, not " + got);
+// The frames' median interval, seconds; 0 when there is none.
+double median_period(const std::vector<FrameEntry>& frames) {
   std::vector<double> dt;
   for (size_t i = 1; i < frames.size(); ++i)
     if (frames[i].t > frames[i - 1].t) dt.push_back(frames[i].t - frames[i - 1].t);
-  if (dt.empty()) return;
+  if (dt.empty()) return 0.0;
   std::nth_element(dt.begin(), dt.begin() + static_cast<std::ptrdiff_t>(dt.size() / 2), dt.end());
-  const double period = dt[dt.size() / 2];
-  if (readout > period) {
+  return dt[dt.size() / 2];
+}
+
+// A readout (or an exposure) longer than the frame interval would read a row of the next frame
+// before this one's last: no camera does that, and it is what seconds given in milliseconds look
+// like.
+void check_shutter_time(double seconds, const char* what, const std::vector<FrameEntry>& frames,
+                        const std::string& where) {
+  char got[64];
+  std::snprintf(got, sizeof got, "%g", seconds);
+  if (!std::isfinite(seconds) || seconds < 0)
+    throw_invalid_input(where + ": the " + what + " must be a finite number of seconds >= 0, not " + got);
+  const double period = median_period(frames);
+  if (period > 0 && seconds > period) {
     char msg[160];
     std::snprintf(msg, sizeof msg, "%s s is longer than the frames' interval, %g s (the median; seconds, not "
                   "milliseconds)", got, period);
-    throw_invalid_input(where + ": the rolling shutter readout " + msg);
+    throw_invalid_input(where + ": the " + what + " " + msg);
   }
 }
 
+void check_readout(double readout, const std::vector<FrameEntry>& frames, const std::string& where) {
+  check_shutter_time(readout, "rolling shutter readout", frames, where);
+}
 
 constexpr size_t kVideoCacheSize = 4;
 
@@ -371,6 +381,7 @@ Dataset::Dataset(const std::string& directory, DatasetOptions options) : impl_(s
   }
   const int64_t n = static_cast<int64_t>(d.frames.size());
   check_readout(d.camera.rolling_shutter_readout, d.frames, (d.dir / "camera.yaml").string());
+  check_shutter_time(d.camera.exposure_time, "exposure time", d.frames, (d.dir / "camera.yaml").string());
 
   d.has_odometry = read_optional(
       d.dir / "odometry.txt", d.odometry, read_tum,
@@ -413,8 +424,9 @@ void Dataset::open_bag(const std::string& file, const DatasetOptions& options) {
   d.camera = d.bag->camera();
   d.readout_given = d.bag->readout_given();
   d.frames = d.bag->frames();
-  check_readout(d.camera.rolling_shutter_readout, d.frames,
-                options.bag.camera_yaml.empty() ? file + ": the camera" : options.bag.camera_yaml);
+  const std::string camera_source = options.bag.camera_yaml.empty() ? file + ": the camera" : options.bag.camera_yaml;
+  check_readout(d.camera.rolling_shutter_readout, d.frames, camera_source);
+  check_shutter_time(d.camera.exposure_time, "exposure time", d.frames, camera_source);
   d.odometry = d.bag->odometry();
   d.groundtruth = d.bag->groundtruth();
   const int64_t n = static_cast<int64_t>(d.frames.size());

@@ -23,8 +23,9 @@ namespace planarvo::io {
 // 4x1 or 5x1: k1 k2 p1 p2 [k3]; 8, 12 or 14 are accepted when the coefficients past k3 are all
 // zero). Other keys (OpenCV's sample writes many) are ignored. Written as the sample does, with
 // a 5x1 distortion vector.
-// readout_given (when not null): whether the file has rolling_shutter_readout (absent: 0, a
-// global shutter, which `calibrate` may estimate instead).
+// planarvo's own keys, optional: region_of_interest, rolling_shutter_readout and exposure_time
+// (seconds; absent: 0, not modelled). readout_given (when not null): whether the file has
+// rolling_shutter_readout (absent: 0, a global shutter, which `calibrate` may estimate instead).
 CameraModel read_camera_yaml(const std::string& path, bool* readout_given = nullptr);
 void write_camera_yaml(const std::string& path, const CameraModel& camera);
 

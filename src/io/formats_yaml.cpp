@@ -459,6 +459,8 @@ CameraModel read_camera_yaml(const std::string& path, bool* readout_given) {
     const bool given = !readout.empty() && !readout.isNone();
     if (given) cam.rolling_shutter_readout = read_real(readout, path, "rolling_shutter_readout");
     if (readout_given) *readout_given = given;
+    const cv::FileNode exposure = fs["exposure_time"];
+    if (!exposure.empty() && !exposure.isNone()) cam.exposure_time = read_real(exposure, path, "exposure_time");
     cam.validate(path.c_str());
     return cam;
   });
@@ -481,6 +483,7 @@ void write_camera_yaml(const std::string& path, const CameraModel& camera) {
   if (!camera.roi.empty())
     fs << "region_of_interest" << "[:" << camera.roi.x << camera.roi.y << camera.roi.width << camera.roi.height << "]";
   if (camera.rolling_shutter_readout != 0) fs << "rolling_shutter_readout" << camera.rolling_shutter_readout;
+  if (camera.exposure_time != 0) fs << "exposure_time" << camera.exposure_time;
   write_storage_text(path, fs);
 }
 

@@ -105,21 +105,24 @@ Box frame_box(const std::vector<Eigen::Vector2d>& fp, const SE2& pose) {
   return b;
 }
 
-// The robot's poses when frame k's first, middle and last rows were read (a rolling shutter):
-// the trajectory's motion from pose k to the next held constant over the interval, an arc on
-// SE(2) (the tracker's and the simulator's model); after the last pose, the last interval's
-// velocity continued. A global shutter, or a single pose: the frame's pose three times.
+// The robot's poses of frame k's first, middle and last rows' images (a rolling shutter's reads,
+// each less half the exposure: CameraModel::row_time): the trajectory's motion from pose k to the
+// next held constant over the interval, an arc on SE(2) (the tracker's and the simulator's
+// model); after the last pose, the last interval's velocity continued. Rows that all stand for
+// the stamp, or a single pose: the frame's pose three times.
 std::array<SE2, 3> readout_poses(const std::vector<PosedFrame>& frames, const std::vector<double>& times,
-                                 size_t k, double readout) {
+                                 size_t k, const CameraModel& camera) {
   const SE2& pose = frames[k].pose;
   std::array<SE2, 3> out{pose, pose, pose};
-  if (!(readout > 0) || frames.size() < 2) return out;
+  if (!camera.timed_rows() || frames.size() < 2) return out;
   const size_t a = k + 1 < frames.size() ? k : k - 1;
   const double dt = times[a + 1] - times[a];
   if (!(dt > 0)) return out;
   const Eigen::Vector3d velocity = (frames[a].pose.inverse() * frames[a + 1].pose).log() / dt;
-  out[1] = pose * SE2::exp(velocity * (0.5 * readout));
-  out[2] = pose * SE2::exp(velocity * readout);
+  const double last = camera.height - 1.0;
+  out[0] = pose * SE2::exp(velocity * camera.row_time(0.0));
+  out[1] = pose * SE2::exp(velocity * camera.row_time(0.5 * last));
+  out[2] = pose * SE2::exp(velocity * camera.row_time(last));
   return out;
 }
 
@@ -408,7 +411,7 @@ Mosaic build_mosaic(ocl::Runtime& runtime, io::Dataset& dataset, const Extrinsic
   std::vector<Box> boxes;
   Box all;
   for (size_t k : used) {
-    row_poses.push_back(readout_poses(frames, times, k, cam.rolling_shutter_readout));
+    row_poses.push_back(readout_poses(frames, times, k, cam));
     Box b;
     for (const SE2& pose : row_poses.back()) b.add(frame_box(fp, pose));
     boxes.push_back(b);

@@ -74,7 +74,8 @@ WarpSetup make_warp_setup(const CameraModel& camera, const Extrinsics& extrinsic
 // Computed in double, stored as float.
 WarpParams warp_params(const WarpSetup& setup, const SE2& pose, const MosaicGrid& grid, const Window& window);
 // The same for a rolling-shutter camera (setup.camera.rolling_shutter_readout > 0): the robot's
-// poses when the frame's first, middle and last rows were read. Each ground point is then
+// poses of the frame's first, middle and last rows' images (CameraModel::row_time; without a
+// rolling shutter the first, which an exposure moves from the stamp). Each ground point is then
 // sampled on the row that saw it: the row r with r = v(H(r / (rows - 1))), H(s) the quadratic
 // through the three rows' homographies (exact to 1e-5 px for a turn of 0.1 rad over the
 // readout), solved in the kernel by two fixed-point steps and Aitken's extrapolation.

@@ -90,7 +90,8 @@ struct Options {
                                     // camera's rolling_shutter_readout, written into camera.yaml
                                     // (camera.rolling_shutter_readout is not used)
   double exposure_time = 0.0;       // seconds each row integrates the moving scene before it is
-                                    // read, at most 1 / fps (0: instantaneous, no motion blur)
+                                    // read, at most 1 / fps (0: instantaneous, no motion blur);
+                                    // written into camera.yaml as exposure_time (likewise)
   int supersampling = 3;            // samples per pixel along each axis (ray tables take
                                     // 8 S^2 + 24 bytes per pixel: 29 MB at 640x480, S = 3)
   bool mipmap = true;               // prefilter the texture (off only for tests/references)

@@ -91,6 +91,7 @@ void simulate(ocl::Runtime& runtime, const Options& options, const std::string& 
   t0 = Clock::now();
   CameraModel camera = options.camera;
   camera.rolling_shutter_readout = options.readout_time;
+  camera.exposure_time = options.exposure_time;
   io::write_camera_yaml((dir / "camera.yaml").string(), camera);
   io::ExtrinsicsFile gt;
   gt.value = options.extrinsics;

@@ -13,14 +13,14 @@ Eigen::Vector3d ReadoutTwist::extrapolate(double at, const Eigen::Vector3d* c, d
   return *b + (*b - *a) * ((at - tb) / (tb - ta));
 }
 
-Eigen::Vector3d ReadoutTwist::predict(double t) const { return extrapolate(t + 0.5 * readout_, nullptr, 0.0); }
+Eigen::Vector3d ReadoutTwist::predict(double t) const { return extrapolate(t + m_, nullptr, 0.0); }
 
 Eigen::Vector3d ReadoutTwist::measure(double t, double dt, const Eigen::Vector3d& v, const Eigen::Vector3d& own,
                                       Eigen::Vector3d* c, double* tc) const {
-  const double k = readout_ / (2.0 * dt);
+  const double k = m_ / dt;
   *c = (v + k * own) / (1.0 + k);
-  *tc = ((t - 0.5 * dt) + k * (t + 0.5 * readout_)) / (1.0 + k);
-  return extrapolate(t + 0.5 * readout_, c, *tc);
+  *tc = ((t - 0.5 * dt) + k * (t + m_)) / (1.0 + k);
+  return extrapolate(t + m_, c, *tc);
 }
 
 void ReadoutTwist::commit(const Eigen::Vector3d& c, double tc) {

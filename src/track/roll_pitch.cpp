@@ -172,6 +172,8 @@ struct RollPitchEstimator::Impl {
     since_keyframe = SE2();
   }
 
+  // Only for a rolling shutter: an exposure alone puts every keyframe's image the same time
+  // before its stamp, which the keyframes' relative motions, and so roll and pitch, do not see.
   void keep_current() {
     if (!(camera.rolling_shutter_readout > 0.0)) return;
     keyframe_gray.push_back(current.clone());
@@ -243,7 +245,7 @@ struct RollPitchEstimator::Impl {
   // A rolling shutter: the keyframes were undistorted as a global shutter's (the tracker here runs
   // at the initial orientation, whose motions are too rough for the row warp); with the joint
   // alignment's orientation and keyframe-to-keyframe motions, each keyframe is undistorted again
-  // with the robot's twist at its readout's middle (the pairs' velocities, at the middles of their
+  // with the robot's twist at its mean row time (the pairs' velocities, at the middles of their
   // intervals, interpolated linearly and extrapolated at the ends), for the alignment to run again.
   // False when there is nothing to do.
   bool unroll_keyframes(const Run& run) {
@@ -259,7 +261,8 @@ struct RollPitchEstimator::Impl {
     }
     if (v.empty()) return false;
     for (size_t k = 0; k < K; ++k) {
-      const double at = keyframe_t[k] + 0.5 * camera.rolling_shutter_readout;
+      // (With an exposure too, the row warp also takes the image back by half of it to the stamp.)
+      const double at = keyframe_t[k] + camera.mean_row_time();
       size_t i = 0;
       while (i + 2 < v.size() && tv[i + 1] < at) ++i;
       Eigen::Vector3d twist = v[i];

@@ -155,7 +155,7 @@ struct Tracker::Impl {
 
   Impl(ocl::Runtime& r, const CameraModel& c, const Extrinsics& e, const TrackerOptions& o)
       : rt(r), camera(validated_tracker_camera(c, e, o)), ext(e), opt(o), aligner(r, c.K(), o, false), selector(r) {
-    readout_twist = ReadoutTwist(camera.rolling_shutter_readout);
+    readout_twist = ReadoutTwist(camera.mean_row_time());
     // The flat field is read now, so that a bad file fails at once rather than at the first frame.
     if (!opt.flat_field.empty() && opt.photometric.enabled) {
       const UndistortMap map = compute_undistort_map(camera);
@@ -372,7 +372,8 @@ struct Tracker::Impl {
     keyframe_shear_assumed = shutter_unknown;
   }
 
-  bool rolling() const { return camera.rolling_shutter_readout > 0.0; }
+  // A rolling shutter or a modelled exposure: frames are undistorted with the robot's twist.
+  bool rolling() const { return camera.timed_rows(); }
 
   // The frame has texture of its own (at the coarsest level the alignment uses): it can be a
   // keyframe.
@@ -384,10 +385,12 @@ struct Tracker::Impl {
     return aligner.texture(live, coarse) >= kMinSelfTexture;
   }
 
-  // How far apart two twists put the image of the last row's read: the rolling shutter's
-  // tolerance measure (level-0 pixels).
+  // How far apart two twists put the image of the row whose time is furthest from the stamp (the
+  // last row's read, or the exposure's middle): the rolling shutter's tolerance measure
+  // (level-0 pixels).
   double shutter_shift(const Eigen::Vector3d& a, const Eigen::Vector3d& b) const {
-    const double r = camera.rolling_shutter_readout;
+    const double top = camera.row_time(0.0), bottom = camera.row_time(camera.height - 1.0);
+    const double r = std::abs(bottom) >= std::abs(top) ? bottom : top;
     return max_pixel_displacement(camera.K(), ext, SE2::exp(a * r), SE2::exp(b * r), camera.width, camera.height);
   }
 
@@ -419,7 +422,7 @@ struct Tracker::Impl {
       has_live_c = twist.allFinite();
       if (!has_live_c) return SE2();
       if (round == 2 || (!keyframe_too && shutter_shift(live_twist, twist) <= opt.rolling_shutter_tolerance_px)) {
-        live_offset = 0.5 * camera.rolling_shutter_readout * (live_twist - twist);
+        live_offset = camera.mean_row_time() * (live_twist - twist);
         return SE2::exp(live_offset);
       }
       if (keyframe_too) {

@@ -104,12 +104,13 @@ struct TrackerOptions : AlignerOptions {
   // photometric.enabled is false.
   std::string flat_field;
 
-  // A rolling shutter (CameraModel::rolling_shutter_readout > 0), camera-frame path: each frame
-  // is undistorted to the global shutter's image at its stamp (image/rolling_shutter.h) with the
-  // robot's twist over its readout, predicted from the frames before (track/readout_twist.h).
-  // Its alignment then measures the twist; the mean offset the remaining twist error puts in the
-  // frame's pose (half the readout times the error) is taken out of it, and when the two twists
-  // move the image (by its last row's read) by more than rolling_shutter_tolerance_px the frame is
+  // A rolling shutter or an exposure (CameraModel::timed_rows), camera-frame path: each frame
+  // is undistorted to the instantaneous global shutter's image at its stamp
+  // (image/rolling_shutter.h) with the robot's twist over the frame, predicted from the frames
+  // before (track/readout_twist.h). Its alignment then measures the twist; the mean offset the
+  // remaining twist error puts in the frame's pose (the mean row time times the error) is taken
+  // out of it, and when the two twists move the image (by the row furthest from the stamp) by
+  // more than rolling_shutter_tolerance_px the frame is
   // undistorted again with the measured twist and aligned once more from half resolution (twice
   // at most): the first-order correction no longer holds there. A keyframe undistorted without a
   // measured twist (the first frame, one after a Lost frame) is undistorted again with the next

@@ -131,6 +131,7 @@ struct Scene {
     so.readout_time = readout;
     so.exposure_time = exposure;
     so.camera.rolling_shutter_readout = readout;
+    so.camera.exposure_time = exposure;
     return so;
   }
 

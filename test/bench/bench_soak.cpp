@@ -264,7 +264,7 @@ int main(int argc, char** argv) {
   const CameraModel& c = so.camera;
   Input in{&loop, &pixels, {}, {}};
   in.camera = {c.width, c.height, c.fx, c.fy, c.cx, c.cy, c.k1, c.k2, c.p1, c.p2, c.k3, {0, 0, 0, 0},
-               c.rolling_shutter_readout};
+               c.rolling_shutter_readout, c.exposure_time};
   const Extrinsics& e = so.extrinsics;
   in.extrinsics = {e.x, e.y, e.z, e.roll, e.pitch, e.yaw};
   std::printf("per block of %" PRId64 " frames: rss = VmRSS, d_rss its change since frame %" PRId64

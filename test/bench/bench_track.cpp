@@ -13,7 +13,7 @@
 //        levels, select=B0,B1,.. (level l on one pixel per Bl x Bl block), prior=0|1 (a
 //        subsampled level joined with the level before it), prior_chi2=X (its consistency test; 0: off),
 //        prefilter=0|1 (level 0 smoothed before the pyramid; default 1), the fused pass's lanes=1|8, pix=N,
-//        wg=XxY; scene extras ss=N (the renderer's supersampling), mip=0|1, dist=0 (no lens distortion), readout=S, exposure=S (rolling shutter, motion blur; seconds), unroll=0 (the tracker not told the readout), told_readout=S (told another), rs_tol=PX; BENCH_PREBLUR=sigma blurs each camera image first; BENCH_VERBOSE=1 adds per-level
+//        wg=XxY; scene extras ss=N (the renderer's supersampling), mip=0|1, dist=0 (no lens distortion), readout=S, exposure=S (rolling shutter, motion blur; seconds), unroll=0 (the tracker not told the readout nor the exposure), told_readout=S, told_exposure=S (told another), rs_tol=PX; BENCH_PREBLUR=sigma blurs each camera image first; BENCH_VERBOSE=1 adds per-level
 //        times, the slowest frames and the frames not tracked ok; see main())
 //   bench_track nees [key=value...]         NEES of the covariances (alignment and frame-to-frame
 //       motion) and the lag-1 correlation of the errors per texture x configuration x size x
@@ -198,10 +198,11 @@ struct SequenceReport {
   double mis_good_max = 0, mis_bad_min = HUGE_VAL;
 };
 
-// unroll=0: the tracker is not told the camera's rolling shutter (what it did before it could
-// take it out); told_readout=S: it is told S seconds (a wrong readout).
+// unroll=0: the tracker is not told the camera's rolling shutter nor its exposure (what it did
+// before it could take them out); told_readout=S, told_exposure=S: it is told S seconds (a wrong
+// readout or exposure; told_exposure=0: the readout only).
 bool g_tracker_knows_readout = true;
-double g_told_readout = -1.0;
+double g_told_readout = -1.0, g_told_exposure = -1.0;
 
 // Renders and tracks a sequence frame by frame through the camera-frame API.
 // tracker_extrinsics: what the tracker is told (so.extrinsics, the truth, when null).
@@ -212,8 +213,9 @@ SequenceReport run_sequence(ocl::Runtime& rt, const sim::Options& so, const trac
   sim::Renderer renderer(rt, cv::imread(so.texture, cv::IMREAD_GRAYSCALE), so);
   const sim::Lighting lighting = sim::camera_lighting(so);
   CameraModel tracker_camera = so.camera;
-  if (!g_tracker_knows_readout) tracker_camera.rolling_shutter_readout = 0.0;
+  if (!g_tracker_knows_readout) tracker_camera.rolling_shutter_readout = tracker_camera.exposure_time = 0.0;
   if (g_told_readout >= 0.0) tracker_camera.rolling_shutter_readout = g_told_readout;
+  if (g_told_exposure >= 0.0) tracker_camera.exposure_time = g_told_exposure;
   track::Tracker tracker(rt, tracker_camera, tracker_extrinsics ? *tracker_extrinsics : so.extrinsics, topt);
   SequenceReport rep;
   std::vector<SE2> est, truth;
@@ -674,6 +676,7 @@ int main(int argc, char** argv) {
       else if (k == "photo_min") topt.photometric.min_frames = std::atoi(v.c_str());
       else if (k == "max_mis") topt.max_misalignment_px = std::atof(v.c_str());
       else if (k == "unroll") g_tracker_knows_readout = v != "0";
+      else if (k == "told_exposure") g_told_exposure = std::atof(v.c_str());
       else if (k == "told_readout") g_told_readout = std::atof(v.c_str());
       else if (k == "rs_tol") topt.rolling_shutter_tolerance_px = std::atof(v.c_str());
       else if (k == "lanes") topt.kernel.lanes = std::atoi(v.c_str());

@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # Rolling shutters and motion blur (issue 23) over textures, camera poses and motions:
 # bench_track accuracy on drives rendered row by row (readout) and integrated over an exposure,
-# the tracker told the camera's readout (the default: each frame undistorted to the global
-# shutter's image at its stamp) and, for comparison, not told it (unroll=0: what it did before).
+# the tracker told the camera's readout and exposure (the default: each frame undistorted to the
+# instantaneous global shutter's image at its stamp) and, for comparison, not told them (unroll=0,
+# told_exposure=0: what it did before).
 # One table row per drive.
 #   bash test/bench/rolling_shutter_sweep.sh [BUILD_DIR=build] [SECONDS=10]
 set -euo pipefail
@@ -23,7 +24,9 @@ effects=(
   "global shutter||"
   "readout 25 ms, not told|readout=0.025|unroll=0"
   "readout 25 ms|readout=0.025|"
+  "exposure 4 ms, not told|exposure=0.004|told_exposure=0"
   "exposure 4 ms|exposure=0.004|"
+  "readout 25 ms + exposure 4 ms, exposure not told|readout=0.025 exposure=0.004|told_exposure=0"
   "readout 25 ms + exposure 4 ms|readout=0.025 exposure=0.004|"
 )
 echo "| scene | effect | texture | ok / deg / lost | slope v | slope w | RMS / max mm | drift % | ms/frame | passes (coarse to fine) |"

@@ -127,7 +127,7 @@ TEST(CliData, InfoPrintsTheValuesTheTestWroteAndTheCApiReads) {
   const planarvo_dataset_info info = test::api_info(ds.get());
   EXPECT_EQ(info.frame_count, 4);
   EXPECT_EQ(info.last_timestamp - info.first_timestamp, 0.75);
-  const planarvo_camera written{64, 48, 52.25, 50.75, 31.5, 23.25, -0.1, 0.0125, 0.001, -0.002, 0.0003, {0, 0, 0, 0}, 0.0};
+  const planarvo_camera written{64, 48, 52.25, 50.75, 31.5, 23.25, -0.1, 0.0125, 0.001, -0.002, 0.0003, {0, 0, 0, 0}, 0.0, 0.0};
   expect_camera_line(r.output, written);
   expect_camera_line(r.output, info.camera);
   expect_frames_line(r.output, info);

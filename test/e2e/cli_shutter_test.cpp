@@ -1,6 +1,7 @@
-// `planarvo simulate --readout-time --exposure` and camera.yaml's rolling_shutter_readout as a
-// user meets them: bad values are exit code 2 naming the option or the file; a rolling-shutter
-// data set carries its readout in camera.yaml and simulation.yaml, and `info` prints it.
+// `planarvo simulate --readout-time --exposure` and camera.yaml's rolling_shutter_readout and
+// exposure_time as a user meets them: bad values are exit code 2 naming the option or the file; a
+// rolling-shutter data set carries its readout and exposure in camera.yaml and simulation.yaml,
+// and `info` prints them.
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -9,6 +10,7 @@
 #include <gtest/gtest.h>
 
 #include "common/test_util.h"
+#include "io/formats.h"
 
 namespace planarvo {
 namespace {
@@ -50,6 +52,10 @@ TEST(CliShutter, ReadoutIsWrittenToCameraYamlAndPrintedByInfo) {
   const std::string sim = test::read_file(fs::path(out) / "simulation.yaml");
   EXPECT_THAT(sim, HasSubstr("readout_time: 2.5"));
   EXPECT_THAT(sim, HasSubstr("exposure_time: 4."));
+  // The camera file read back holds the values rendered.
+  const CameraModel cam = io::read_camera_yaml((fs::path(out) / "camera.yaml").string());
+  EXPECT_EQ(cam.rolling_shutter_readout, 0.025);
+  EXPECT_EQ(cam.exposure_time, 0.004);
   r = run_cli("info --verify " + out);
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_THAT(r.output, HasSubstr("shutter     rolling, 25.000 ms"));
@@ -109,6 +115,30 @@ TEST(CliShutter, NegativeReadoutInCameraYamlIsExitCodeTwoNamingTheFile) {
   EXPECT_EQ(r.exit_code, 2) << r.output;
   EXPECT_THAT(r.output, HasSubstr("camera.yaml"));
   EXPECT_THAT(r.output, HasSubstr("rolling_shutter_readout"));
+}
+
+// An exposure_time that is negative, not a number, or longer than the frame interval (4 for 4 ms)
+// is exit code 2 naming the file, for every command that opens the data set.
+TEST(CliShutter, BadExposureInCameraYamlIsExitCodeTwoNamingTheFile) {
+  ScratchDir d;
+  const std::string out = (d / "ds").string();
+  ASSERT_EQ(run_cli("simulate --out " + out + kSmall).exit_code, 0);
+  const fs::path camera = fs::path(out) / "camera.yaml";
+  const std::string original = test::read_file(camera);
+  for (const char* bad : {"-0.001", "fast", "4"}) {
+    {
+      std::ofstream f(camera);
+      f << original << "exposure_time: " << bad << "\n";
+    }
+    for (const char* cmd : {"info", "track"}) {
+      SCOPED_TRACE(std::string(cmd) + " with exposure_time " + bad);
+      const auto r = run_cli(std::string(cmd) + " " + out +
+                             (std::string(cmd) == "track" ? " --extrinsics " + out + "/extrinsics_gt.yaml" : std::string()));
+      EXPECT_EQ(r.exit_code, 2) << r.output;
+      EXPECT_THAT(r.output, HasSubstr("camera.yaml"));
+      EXPECT_THAT(r.output, HasSubstr("exposure"));
+    }
+  }
 }
 
 }  // namespace

@@ -60,7 +60,7 @@ ContextPtr make_context() {
 
 TrackerPtr make_tracker(planarvo_context* ctx, const sim::Options& so) {
   const CameraModel& c = so.camera;
-  const planarvo_camera camera{c.width, c.height, c.fx, c.fy, c.cx, c.cy, c.k1, c.k2, c.p1, c.p2, c.k3, {0, 0, 0, 0}, 0.0};
+  const planarvo_camera camera{c.width, c.height, c.fx, c.fy, c.cx, c.cy, c.k1, c.k2, c.p1, c.p2, c.k3, {0, 0, 0, 0}, 0.0, 0.0};
   const Extrinsics& e = so.extrinsics;
   const planarvo_extrinsics extrinsics{e.x, e.y, e.z, e.roll, e.pitch, e.yaw};
   planarvo_tracker* t = nullptr;

@@ -335,17 +335,24 @@ TEST(CApiData, RollingShutterTravelsWithTheCamera) {
   planarvo_camera cam{};
   ASSERT_EQ(planarvo_sim_default_camera(96, 64, 80.0, &cam), PLANARVO_OK);
   EXPECT_EQ(cam.rolling_shutter_readout, 0.0);
+  EXPECT_EQ(cam.exposure_time, 0.0);
   cam.rolling_shutter_readout = 0.0123456789012345;
+  cam.exposure_time = 0.00398765432109876;
   const std::string path = (dir / "camera.yaml").string();
   ASSERT_EQ(planarvo_camera_save(path.c_str(), &cam), PLANARVO_OK) << planarvo_last_error();
   planarvo_camera back{};
   ASSERT_EQ(planarvo_camera_load(path.c_str(), &back), PLANARVO_OK) << planarvo_last_error();
   EXPECT_EQ(back.rolling_shutter_readout, cam.rolling_shutter_readout);
+  EXPECT_EQ(back.exposure_time, cam.exposure_time);
   EXPECT_EQ(back.fx, cam.fx);
   EXPECT_EQ(back.width, cam.width);
   cam.rolling_shutter_readout = -0.01;
   EXPECT_NE(planarvo_camera_save((dir / "bad.yaml").c_str(), &cam), PLANARVO_OK);
   EXPECT_NE(std::string(planarvo_last_error()).find("rolling_shutter_readout"), std::string::npos);
+  cam.rolling_shutter_readout = 0.0;
+  cam.exposure_time = std::nan("");
+  EXPECT_NE(planarvo_camera_save((dir / "bad.yaml").c_str(), &cam), PLANARVO_OK);
+  EXPECT_NE(std::string(planarvo_last_error()).find("exposure_time"), std::string::npos);
 
   planarvo_context* c = make_context();
   planarvo_sim_options o = tiny_sim(planarvo::test::texture("skimage_gravel.png").string());
@@ -356,12 +363,14 @@ TEST(CApiData, RollingShutterTravelsWithTheCamera) {
   ASSERT_EQ(planarvo_simulate(c, &o, (dir / "rs").c_str()), PLANARVO_OK) << planarvo_last_error();
   ASSERT_EQ(planarvo_camera_load((dir / "rs" / "camera.yaml").c_str(), &back), PLANARVO_OK);
   EXPECT_EQ(back.rolling_shutter_readout, 0.02);
+  EXPECT_EQ(back.exposure_time, 0.003);
   planarvo_dataset* d = nullptr;
   ASSERT_EQ(planarvo_dataset_open((dir / "rs").c_str(), nullptr, &d), PLANARVO_OK) << planarvo_last_error();
   planarvo_dataset_info info{};
   info.struct_size = sizeof info;
   ASSERT_EQ(planarvo_dataset_info_get(d, &info), PLANARVO_OK);
   EXPECT_EQ(info.camera.rolling_shutter_readout, 0.02);
+  EXPECT_EQ(info.camera.exposure_time, 0.003);
   planarvo_dataset_destroy(d);
 
   const auto refused = [&](double readout, double exposure, const char* says) {
