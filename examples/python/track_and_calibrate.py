@@ -35,7 +35,7 @@ class Region(ctypes.Structure):
 class Camera(ctypes.Structure):
     _fields_ = [("width", c_int32), ("height", c_int32)] + [
         (n, c_double) for n in ("fx", "fy", "cx", "cy", "k1", "k2", "p1", "p2", "k3")] + [
-        ("roi", Region), ("rolling_shutter_readout", c_double)]
+        ("roi", Region), ("rolling_shutter_readout", c_double), ("exposure_time", c_double)]
 
 
 class Extrinsics(ctypes.Structure):
