@@ -12,7 +12,7 @@
 //        of config), fov=deg, motion=...|car, speed=m/s, turn=rad/s, radius=m (car), noise=grey
 //        levels, select=B0,B1,.. (level l on one pixel per Bl x Bl block), prior=0|1 (a
 //        subsampled level joined with the level before it), prior_chi2=X (its consistency test; 0: off),
-//        prefilter=0|1 (level 0 smoothed before the pyramid; default 1), the fused pass's lanes=1|8, pix=N,
+//        prefilter=0|1 (level 0 smoothed before the pyramid; default 1), search=0 (no motion search for frames that would be Lost), the fused pass's lanes=1|8, pix=N,
 //        wg=XxY; scene extras ss=N (the renderer's supersampling), mip=0|1, dist=0 (no lens distortion), readout=S, exposure=S (rolling shutter, motion blur; seconds), unroll=0 (the tracker not told the readout nor the exposure), told_readout=S, told_exposure=S (told another), rs_tol=PX; BENCH_PREBLUR=sigma blurs each camera image first; BENCH_VERBOSE=1 adds per-level
 //        times, the slowest frames and the frames not tracked ok; see main())
 //   bench_track nees [key=value...]         NEES of the covariances (alignment and frame-to-frame
@@ -670,6 +670,7 @@ int main(int argc, char** argv) {
       else if (k == "prior_chi2") topt.prior_chi2 = std::atof(v.c_str());
       else if (k == "prefilter") topt.prefilter = v != "0";
       else if (k == "photometric") topt.photometric.enabled = v != "0";
+      else if (k == "search") topt.search_motion = v != "0";
       else if (k == "learn") topt.photometric.learn = v != "0";
       else if (k == "saturation") topt.photometric.saturation = std::atof(v.c_str());
       else if (k == "photo_radius") topt.photometric.radius = std::atoi(v.c_str());
