@@ -179,16 +179,21 @@ std::vector<SE2> MotionSearch::candidates(const Pyramid& reference, const Pyrami
   std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) { return score[a] > score[b]; });
   // Peaks at least three grid steps apart in the image's shift.
   std::vector<SE2> out;
+  std::vector<double> scores;
   std::vector<Eigen::Vector2d> taken;
   const double apart = 3.0 * o.grid_px;
   for (size_t k : order) {
-    if (static_cast<int>(out.size()) >= o.max_candidates || !(score[k] > -1.0)) break;
+    // (Two at least, for the ambiguity test.)
+    if (static_cast<int>(out.size()) >= std::max(o.max_candidates, 2) || !(score[k] > -1.0)) break;
     bool near = false;
     for (const Eigen::Vector2d& t : taken) near = near || (t - grid[k].shift).norm() < apart;
     if (near) continue;
     taken.push_back(grid[k].shift);
     out.push_back(grid[k].motion);
+    scores.push_back(score[k]);
   }
+  if (scores.size() >= 2 && 1.0 - scores[0] > o.max_ambiguity * (1.0 - scores[1])) return {};
+  if (static_cast<int>(out.size()) > o.max_candidates) out.resize(static_cast<size_t>(o.max_candidates));
   return out;
 }
 

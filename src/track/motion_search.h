@@ -34,6 +34,13 @@ struct MotionSearchOptions {
   int max_pixels = 1500;
   int max_candidates = 3;     // separate peaks returned, best first
   double min_overlap = 0.5;   // a hypothesis needs this share of the best-covered one's valid pixels
+  // The best peak must be distinct, as in Lowe's ratio test: its distance from a perfect match
+  // (1 - correlation) at most this share of the second peak's, else the search returns none. A
+  // floor that repeats within the search's reach scores its neighbouring periods alike (tiles
+  // under the robot's shadow: 0.9979 against 0.9973 and 0.9967, a ratio of 0.78), where a search
+  // that finds the motion scores it apart (the acquisition drives: 0.11-0.47, and 0.55 on blue
+  // tiles, whose first search was right); 1 turns the test off.
+  double max_ambiguity = 0.65;
 };
 
 // One hypothesis's sums (the kernel's row): valid pairs n and, over them, the sums of a = I_r -
@@ -61,7 +68,8 @@ class MotionSearch {
            const std::vector<Eigen::Matrix3d>& homographies, int step, std::vector<SearchSums>* out);
 
   // The best separate peaks of the grid around `centre` at `level` of the pyramids (K: level 0's
-  // camera matrix), best first; at most options.max_candidates, none when no hypothesis overlaps.
+  // camera matrix), best first; at most options.max_candidates, none when no hypothesis overlaps
+  // or the best is not distinct from the second (options.max_ambiguity).
   std::vector<SE2> candidates(const Pyramid& reference, const Pyramid& live, int level, const Eigen::Matrix3d& K,
                               const Extrinsics& extrinsics, const SE2& centre, const MotionSearchOptions& options);
 

@@ -55,9 +55,9 @@ CameraModel validated_tracker_camera(const CameraModel& c, const Extrinsics& e, 
   const MotionSearchOptions& so = o.search;
   if (!(so.max_shift >= 0.0 && so.max_shift <= 1.0) || !(so.grid_px >= 0.25) ||
       !(so.max_rotation >= 0.0 && so.max_rotation <= 0.5) || so.max_pixels < 16 || so.max_candidates < 1 ||
-      !(so.min_overlap >= 0.0 && so.min_overlap <= 1.0))
+      !(so.min_overlap >= 0.0 && so.min_overlap <= 1.0) || !(so.max_ambiguity > 0.0 && so.max_ambiguity <= 1.0))
     throw_invalid_argument("TrackerOptions::search: max_shift in [0, 1], grid_px >= 0.25, max_rotation in [0, 0.5] rad, "
-                           "max_pixels >= 16, max_candidates >= 1, min_overlap in [0, 1]");
+                           "max_pixels >= 16, max_candidates >= 1, min_overlap in [0, 1], max_ambiguity in (0, 1]");
   c.validate("Tracker camera");
   // The coarsest level must hold a few pixels for the alignment to work on (issue 27: a 1x1
   // camera failed inside the aligner with an internal message).

@@ -168,5 +168,66 @@ TEST(MotionSearchKernel, FindsAKnownMotion) {
   }
 }
 
+// A floor that repeats within the search's reach: a pattern with a period of 10 pixels of the
+// level, the live level that pattern moved and noisy (as a light or pixel noise leaves a real
+// match short of 1). Every period scores alike, so the search returns no peak rather than one
+// that may be a neighbouring period (MotionSearchOptions::max_ambiguity); with the test off it
+// returns its peaks. The same noise on a random texture leaves its peak distinct.
+TEST(MotionSearchKernel, ARepeatingFloorIsAmbiguous) {
+  ocl::Runtime rt;
+  const int w = 80, h = 60;
+  Eigen::Matrix3d K0;
+  K0 << 409.6, 0, 319.5, 0, 409.6, 239.5, 0, 0, 1;
+  Extrinsics e;  // straight down, 0.18 m
+  e.z = 0.18;
+  const Eigen::Matrix3d K = level_camera_matrix(K0, 3);
+  std::mt19937 rng(11);
+  std::normal_distribution<double> noise(0.0, 12.0);
+  std::vector<float> periodic(static_cast<size_t>(w) * h * 4, 0.0f);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      periodic[4 * (static_cast<size_t>(y) * w + x)] =
+          static_cast<float>(128.0 + 40.0 * std::sin(6.2832 * x / 10.0) + 40.0 * std::sin(6.2832 * y / 10.0));
+      periodic[4 * (static_cast<size_t>(y) * w + x) + 3] = 1.0f;
+    }
+  const std::vector<float> textured = smooth_level(rng, w, h);
+  const SE2 truth(0.012, 0.004, 0.0);
+  MotionSearch search(rt);
+  for (int kind = 0; kind < 2; ++kind) {
+    const std::vector<float>& ref = kind == 0 ? periodic : textured;
+    SCOPED_TRACE(kind == 0 ? "periodic" : "textured");
+    const Eigen::Matrix3d Hinv = motion_homography(K, e, truth).H.inverse();
+    std::vector<float> live(ref.size(), 0.0f);
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x) {
+        const Eigen::Vector3d p = Hinv * Eigen::Vector3d(x, y, 1);
+        const double u = p.x() / p.z(), v = p.y() / p.z();
+        const int iu = static_cast<int>(std::floor(u)), iv = static_cast<int>(std::floor(v));
+        if (iu < 0 || iv < 0 || iu >= w - 1 || iv >= h - 1) continue;
+        const double ax = u - iu, ay = v - iv;
+        auto at = [&](int xx, int yy) { return ref[4 * (static_cast<size_t>(yy) * w + xx)]; };
+        live[4 * (static_cast<size_t>(y) * w + x)] = static_cast<float>(
+            (1 - ax) * (1 - ay) * at(iu, iv) + ax * (1 - ay) * at(iu + 1, iv) + (1 - ax) * ay * at(iu, iv + 1) +
+            ax * ay * at(iu + 1, iv + 1) + noise(rng));
+        live[4 * (static_cast<size_t>(y) * w + x) + 3] = 1.0f;
+      }
+    Pyramid rp, lp;
+    rp.levels.resize(4);
+    lp.levels.resize(4);
+    rp.levels[3] = {w, h, upload(rt, ref)};
+    lp.levels[3] = {w, h, upload(rt, live)};
+    MotionSearchOptions o;
+    const std::vector<SE2> peaks = search.candidates(rp, lp, 3, K0, e, SE2(), o);
+    if (kind == 0) {
+      EXPECT_TRUE(peaks.empty()) << peaks.size() << " peaks";
+      o.max_ambiguity = 1.0;
+      EXPECT_FALSE(search.candidates(rp, lp, 3, K0, e, SE2(), o).empty());
+    } else {
+      ASSERT_FALSE(peaks.empty());
+      EXPECT_LT(max_pixel_displacement(K, e, peaks[0], truth, w, h), 2.0 * o.grid_px);
+    }
+  }
+}
+
 }  // namespace
 }  // namespace planarvo::track
