@@ -118,6 +118,30 @@ std::vector<float> smooth_level(std::mt19937& rng, int w, int h) {
   return d;
 }
 
+// The live level: the reference seen through a known motion's homography (inverse warp,
+// bilinear), plus noise(); pixels whose source falls outside stay invalid.
+template <typename Noise>
+std::vector<float> render_live(const std::vector<float>& ref, const Eigen::Matrix3d& K, const Extrinsics& e,
+                               const SE2& truth, int w, int h, Noise noise) {
+  // live(w(p)) = ref(p): live(q) = ref(H^-1 q).
+  const Eigen::Matrix3d Hinv = motion_homography(K, e, truth).H.inverse();
+  std::vector<float> live(ref.size(), 0.0f);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const Eigen::Vector3d p = Hinv * Eigen::Vector3d(x, y, 1);
+      const double u = p.x() / p.z(), v = p.y() / p.z();
+      const int iu = static_cast<int>(std::floor(u)), iv = static_cast<int>(std::floor(v));
+      if (iu < 0 || iv < 0 || iu >= w - 1 || iv >= h - 1) continue;
+      const double ax = u - iu, ay = v - iv;
+      auto at = [&](int xx, int yy) { return ref[4 * (static_cast<size_t>(yy) * w + xx)]; };
+      live[4 * (static_cast<size_t>(y) * w + x)] = static_cast<float>(
+          (1 - ax) * (1 - ay) * at(iu, iv) + ax * (1 - ay) * at(iu + 1, iv) + (1 - ax) * ay * at(iu, iv + 1) +
+          ax * ay * at(iu + 1, iv + 1) + noise());
+      live[4 * (static_cast<size_t>(y) * w + x) + 3] = 1.0f;
+    }
+  return live;
+}
+
 // The live level rendered from the reference through a known motion's homography (inverse warp,
 // bilinear): the search's best peak lies within one grid step (in the image's shift) of it.
 TEST(MotionSearchKernel, FindsAKnownMotion) {
@@ -140,22 +164,7 @@ TEST(MotionSearchKernel, FindsAKnownMotion) {
   MotionSearchOptions o;
   for (const SE2& truth : {SE2(0.02, 0.001, 0.01), SE2(-0.015, 0.006, -0.02), SE2(0.001, -0.012, 0.03)}) {
     SCOPED_TRACE("truth " + std::to_string(truth.x) + " " + std::to_string(truth.y) + " " + std::to_string(truth.theta));
-    // live(w(p)) = ref(p): live(q) = ref(H^-1 q).
-    const Eigen::Matrix3d Hinv = motion_homography(K, e, truth).H.inverse();
-    std::vector<float> live(ref.size(), 0.0f);
-    for (int y = 0; y < h; ++y)
-      for (int x = 0; x < w; ++x) {
-        const Eigen::Vector3d p = Hinv * Eigen::Vector3d(x, y, 1);
-        const double u = p.x() / p.z(), v = p.y() / p.z();
-        const int iu = static_cast<int>(std::floor(u)), iv = static_cast<int>(std::floor(v));
-        if (iu < 0 || iv < 0 || iu >= w - 1 || iv >= h - 1) continue;
-        const double ax = u - iu, ay = v - iv;
-        auto at = [&](int xx, int yy) { return ref[4 * (static_cast<size_t>(yy) * w + xx)]; };
-        live[4 * (static_cast<size_t>(y) * w + x)] = static_cast<float>(
-            (1 - ax) * (1 - ay) * at(iu, iv) + ax * (1 - ay) * at(iu + 1, iv) + (1 - ax) * ay * at(iu, iv + 1) +
-            ax * ay * at(iu + 1, iv + 1));
-        live[4 * (static_cast<size_t>(y) * w + x) + 3] = 1.0f;
-      }
+    const std::vector<float> live = render_live(ref, K, e, truth, w, h, [] { return 0.0; });
     Pyramid rp, lp;
     rp.levels.resize(4);
     lp.levels.resize(4);
@@ -196,21 +205,7 @@ TEST(MotionSearchKernel, ARepeatingFloorIsAmbiguous) {
   for (int kind = 0; kind < 2; ++kind) {
     const std::vector<float>& ref = kind == 0 ? periodic : textured;
     SCOPED_TRACE(kind == 0 ? "periodic" : "textured");
-    const Eigen::Matrix3d Hinv = motion_homography(K, e, truth).H.inverse();
-    std::vector<float> live(ref.size(), 0.0f);
-    for (int y = 0; y < h; ++y)
-      for (int x = 0; x < w; ++x) {
-        const Eigen::Vector3d p = Hinv * Eigen::Vector3d(x, y, 1);
-        const double u = p.x() / p.z(), v = p.y() / p.z();
-        const int iu = static_cast<int>(std::floor(u)), iv = static_cast<int>(std::floor(v));
-        if (iu < 0 || iv < 0 || iu >= w - 1 || iv >= h - 1) continue;
-        const double ax = u - iu, ay = v - iv;
-        auto at = [&](int xx, int yy) { return ref[4 * (static_cast<size_t>(yy) * w + xx)]; };
-        live[4 * (static_cast<size_t>(y) * w + x)] = static_cast<float>(
-            (1 - ax) * (1 - ay) * at(iu, iv) + ax * (1 - ay) * at(iu + 1, iv) + (1 - ax) * ay * at(iu, iv + 1) +
-            ax * ay * at(iu + 1, iv + 1) + noise(rng));
-        live[4 * (static_cast<size_t>(y) * w + x) + 3] = 1.0f;
-      }
+    const std::vector<float> live = render_live(ref, K, e, truth, w, h, [&] { return noise(rng); });
     Pyramid rp, lp;
     rp.levels.resize(4);
     lp.levels.resize(4);
