@@ -174,25 +174,21 @@ RowWarp rolling_shutter_warp(const CameraModel& camera, const Extrinsics& extrin
       w.delta[at(i, j) + 1] = d.allFinite() ? static_cast<float>(d.y()) : 0.0f;
     }
   }
-  // The cubic through nodes -3, -1, +1, +3 (in the fine grid's steps) at 0: (-1, 9, 9, -1) / 16.
-  // Every node not solved has them solved (odd, with three nodes on both sides).
-  auto cubic = [](float a, float b, float c, float d) { return (9.0f * (b + c) - (a + d)) * (1.0f / 16.0f); };
-  for (int j = 0; j < w.nodes_y; ++j) {
-    if (!solved(j, w.nodes_y)) continue;
-    for (int i = 0; i < w.nodes_x; ++i) {
-      if (solved(i, w.nodes_x)) continue;
-      for (size_t c = 0; c < 2; ++c)
-        w.delta[at(i, j) + c] = cubic(w.delta[at(i - 3, j) + c], w.delta[at(i - 1, j) + c],
-                                      w.delta[at(i + 1, j) + c], w.delta[at(i + 3, j) + c]);
+  // The cubic through nodes -3, -1, +1, +3 (in the fine grid's steps) at 0: (-1, 9, 9, -1) / 16,
+  // along (di, dj). Every node not solved has them solved (odd, with three nodes on both sides):
+  // the solved rows first, along x; then the other rows, along y, from the rows now complete.
+  auto fill = [&](int i, int j, int di, int dj) {
+    for (size_t c = 0; c < 2; ++c) {
+      auto g = [&](int k) { return w.delta[at(i + k * di, j + k * dj) + c]; };
+      w.delta[at(i, j) + c] = (9.0f * (g(-1) + g(1)) - (g(-3) + g(3))) * (1.0f / 16.0f);
     }
-  }
-  for (int j = 0; j < w.nodes_y; ++j) {
-    if (solved(j, w.nodes_y)) continue;
+  };
+  for (int j = 0; j < w.nodes_y; ++j)
     for (int i = 0; i < w.nodes_x; ++i)
-      for (size_t c = 0; c < 2; ++c)
-        w.delta[at(i, j) + c] = cubic(w.delta[at(i, j - 3) + c], w.delta[at(i, j - 1) + c],
-                                      w.delta[at(i, j + 1) + c], w.delta[at(i, j + 3) + c]);
-  }
+      if (solved(j, w.nodes_y) && !solved(i, w.nodes_x)) fill(i, j, 1, 0);
+  for (int j = 0; j < w.nodes_y; ++j)
+    for (int i = 0; i < w.nodes_x; ++i)
+      if (!solved(j, w.nodes_y)) fill(i, j, 0, 1);
   return w;
 }
 

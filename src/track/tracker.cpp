@@ -337,7 +337,7 @@ struct Tracker::Impl {
       }
       // Its frame stays on the device, so that a model made at a later frame can correct the
       // keyframe again (correct_again), or a measured twist undistort it again (take_out_shutter).
-      if (photometric || rolling()) {
+      if (photometric || camera.timed_rows()) {
         pipeline->keep();
         keyframe_kept = true;
       }
@@ -372,9 +372,6 @@ struct Tracker::Impl {
     keyframe_shear_assumed = shutter_unknown;
   }
 
-  // A rolling shutter or a modelled exposure: frames are undistorted with the robot's twist.
-  bool rolling() const { return camera.timed_rows(); }
-
   // The frame has texture of its own (at the coarsest level the alignment uses): it can be a
   // keyframe.
   bool has_own_texture(const Pyramid& live) {
@@ -401,7 +398,7 @@ struct Tracker::Impl {
   // offset the remaining twist error puts in the pose, to be taken out of est (after remember()).
   SE2 take_out_shutter(const Pyramid& live, double t, double dt, FrameResult* res, Estimate* est) {
     live_offset.setZero();
-    if (!rolling() || !(dt > 0.0) || &live != &slots[live_slot] || !keyframe_kept) return SE2();
+    if (!camera.timed_rows() || !(dt > 0.0) || &live != &slots[live_slot] || !keyframe_kept) return SE2();
     for (int round = 0;; ++round) {
       const Eigen::Vector3d v = (prev.T.inverse() * est->T).log() / dt;
       const bool keyframe_too = !keyframe_twist_measured;
@@ -574,7 +571,7 @@ struct Tracker::Impl {
       pipeline = std::make_unique<ImagePipeline>(rt, camera, opt.levels, po);
       if (known_photometric && pipeline->photometric()) pipeline->photometric()->set(*known_photometric);
     }
-    if (rolling()) {
+    if (camera.timed_rows()) {  // a rolling shutter or an exposure: undistorted with the twist
       // Undistorted with the constant-velocity prediction's twist (track() measures it).
       live_twist = has_keyframe ? readout_twist.predict(t) : Eigen::Vector3d::Zero();
       pipeline->set_row_warp(rolling_shutter_warp(camera, ext, live_twist));
