@@ -19,6 +19,20 @@ WarpReduceOptions ResidualImager::kernel_options(const WarpReduceOptions& tracke
   return k;
 }
 
+namespace {
+
+// The pass with the default kernel options, registered before main() so that exported kernel
+// binaries hold it: the tracker measures every frame's texture residual with it (the honest-status
+// check, texture_residual.h), and the calibration tracks its drives.
+const bool kDefaultVariantRegistered = [] {
+  ocl::Runtime::register_build_options(
+      "warp_reduce", WarpReduce::build_options(kMotionParams, ResidualImager::kernel_options(WarpReduceOptions())),
+      {ocl::kUseTrack, ocl::kUseCalibrate});
+  return true;
+}();
+
+}  // namespace
+
 ResidualImager::ResidualImager(ocl::Runtime& runtime, const Eigen::Matrix3d& K, const WarpReduceOptions& kernel)
     : runtime_(runtime), K_(K), pass_(runtime, kMotionParams, kernel_options(kernel)) {}
 

@@ -90,7 +90,7 @@ struct RollPitchEstimator::Impl {
     t.degraded_residual_ratio = 2.0;
     t.min_inlier_fraction = 0.0;
     t.max_log_gain = 3.0;
-    t.max_misalignment_px = HUGE_VAL;  // a wrong tilt misaligns the texture too
+    t.max_texture_residual = HUGE_VAL;  // a wrong tilt misaligns the texture too
     return t;
   }
 

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <optional>
 
 #include <Eigen/Cholesky>
@@ -15,6 +16,7 @@
 #include "track/alignment_covariance.h"
 #include "track/readout_twist.h"
 #include "track/tilt_jacobian.h"
+#include "track/texture_residual.h"
 #include "track/tracker_validation.h"
 #include "track/warp_model.h"
 
@@ -151,6 +153,7 @@ struct Tracker::Impl {
   std::unique_ptr<TiltJacobian> tilt_jacobian;
   Eigen::Matrix<double, 3, 2> prev_tilt = Eigen::Matrix<double, 3, 2>::Zero();
   ResidualImage cached;
+  ResidualImage check_image;  // the honest-status check's (measure_texture_residual)
   Pyramid spare;
 
   Impl(ocl::Runtime& r, const CameraModel& c, const Extrinsics& e, const TrackerOptions& o)
@@ -256,9 +259,37 @@ struct Tracker::Impl {
            !(std::sqrt(cov(2, 2)) <= opt.max_heading_std);
   }
 
+  // The level the honest-status check measures on: the finest of about 160 x 120 pixels (at most
+  // 200 wide), where the images' noise counts little against the floor's texture
+  // (texture_residual.h); the coarsest the pyramid has, when none is that small.
+  int texture_check_level() const {
+    int l = 0;
+    while (l + 1 < opt.levels && level_size(camera.width, l) > 200) ++l;
+    return l;
+  }
+
+  // FrameResult::texture_residual of an alignment of `live` with the keyframe: one pass of the
+  // residual image's kernel at texture_check_level() (NaN when not measured).
+  double measure_texture_residual(const Pyramid& live, const Estimate& e) {
+    const int level = texture_check_level();
+    if (!std::isfinite(opt.max_texture_residual) || level >= live.num_levels() || level >= keyframe.num_levels())
+      return std::numeric_limits<double>::quiet_NaN();
+    if (!imager) imager = std::make_unique<ResidualImager>(rt, camera.K(), opt.kernel);
+    AlignmentRecord a;
+    a.reference = keyframe;
+    a.live = live;
+    a.motion = e.T;
+    a.log_gain = e.a;
+    a.bias = e.b;
+    a.huber_k = e.huber_k;
+    a.finest_level = e.finest;
+    imager->compute(a, ext, level, &check_image);
+    return texture_residual(check_image);
+  }
+
   // Fills the alignment's covariance, cost, inliers, overlap and the status from the finest
-  // level's sums.
-  void finish(FrameResult* res, const Estimate& e) {
+  // level's sums, and the honest-status check (measure_texture_residual) from `live`.
+  void finish(FrameResult* res, const Estimate& e, const Pyramid& live) {
     const ReduceSums& s = report.finest[0];
     res->final_cost = s.valid > 0 ? s.cost / s.valid : HUGE_VAL;
     res->inlier_fraction = s.valid > 0 ? s.inlier / s.valid : 0.0;
@@ -288,19 +319,17 @@ struct Tracker::Impl {
     const ReduceSums& st = report.match_stats[0];
     const double var_ref = st.valid > 0 ? st.iref2 / st.valid - std::pow(st.iref / st.valid, 2) : 0.0;
     const double ratio = st.valid > 0 && var_ref > 0 ? (st.rr / st.valid) / var_ref : HUGE_VAL;
-    // Robust: the residual's scale from its median, so that an occluder or a few bad pixels do
-    // not count as misalignment.
-    const double grad2 = st.valid > 0 ? 0.5 * (st.gref + st.glive) / st.valid : 0.0;
-    res->misalignment = grad2 > 0 ? 1.4826 * st.median_abs_residual() / std::sqrt(grad2) : HUGE_VAL;
-    // The light holds an alignment whose images match as a whole but not in their detail; images
-    // that do not match at all (a frame with nothing in common with the keyframe, as after a gap
-    // at speed) say nothing about the light, and forced a model learnt from a few frames into use.
-    light_holds = res->misalignment > opt.max_misalignment_px && std::isfinite(res->misalignment) &&
-                  ratio <= opt.lost_residual_ratio;
+    // The floor's texture left in the residual: an alignment that something fixed to the camera
+    // holds while the floor moves leaves it there. Images that do not match at all (a frame with
+    // nothing in common with the keyframe, as after a gap at speed) say nothing about the light,
+    // and forced a model learnt from a few frames into use.
+    res->texture_residual = measure_texture_residual(live, e);
+    const bool misaligned = res->texture_residual > opt.max_texture_residual;
+    light_holds = misaligned && ratio <= opt.lost_residual_ratio;
     if (!(ratio <= opt.lost_residual_ratio)) {
       res->status = Status::Lost;
       res->reason = kMismatch;
-    } else if (!(res->misalignment <= opt.max_misalignment_px)) {
+    } else if (misaligned) {
       res->status = Status::Lost;
       res->reason = kMisaligned;
     } else if (!(std::abs(e.a) <= opt.max_log_gain)) {
@@ -500,7 +529,7 @@ struct Tracker::Impl {
     if (tracked) since_learnt = since_learnt * r.motion.value;
     const bool moved = tracked && max_pixel_displacement(camera.K(), ext, SE2(), since_learnt, camera.width,
                                                          camera.height) >= opt.learn_motion_px;
-    const bool changed = r.misalignment > opt.max_misalignment_px && std::isfinite(r.misalignment);
+    const bool changed = r.texture_residual > opt.max_texture_residual;
     if (moved || changed) {
       pipeline->learn();
       since_learnt = SE2();
@@ -514,7 +543,7 @@ struct Tracker::Impl {
     *again = before;
     const char* reason = "";
     if (!align(live, from, est, again, &reason, refine)) return false;
-    finish(again, *est);
+    finish(again, *est, live);
     for (size_t l = 0; l < before.iterations.size(); ++l) {
       again->iterations[l] += before.iterations[l];
       again->level_ms[l] += before.level_ms[l];
@@ -693,7 +722,7 @@ struct Tracker::Impl {
     Estimate est;
     const char* reason = "";
     bool ok = align(live, init, &est, &res, &reason);
-    if (ok) finish(&res, est);
+    if (ok) finish(&res, est, live);
     if ((!ok || res.status == Status::Lost) && reason != kAlignNoLiveTexture &&
         !(predicted.x == 0 && predicted.y == 0 && predicted.theta == 0)) {
       FrameResult retry;

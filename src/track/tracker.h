@@ -65,12 +65,13 @@ struct TrackerOptions : AlignerOptions {
   double max_position_std = 1e-4;  // metres
   double max_std_ratio = 10.0;
   double max_heading_std = 1e-3;   // radians
-  // Lost when FrameResult::misalignment (the residual as an equivalent shift of the images, at
-  // the half-resolution level, in its pixels) exceeds this: the images do not match as aligned,
-  // whatever else agreed with the alignment (a pattern fixed to the camera, such as a lamp's
-  // falloff or reflection, holds an alignment while the floor moves). Aligned frames measure
-  // 0.2-0.4 on the simulator, frames held by the camera's light 1-2.
-  double max_misalignment_px = 0.8;
+  // Lost when FrameResult::texture_residual (how much of the two images' texture the residual
+  // still holds, texture_residual.h) exceeds this: the images do not match as aligned, whatever
+  // else agreed with the alignment (a pattern fixed to the camera, such as a lamp's falloff, its
+  // reflection or the robot's shadow, holds an alignment while the floor moves). Aligned frames
+  // measure 0.2-0.55 on the simulator, frames held by the light 0.85-1.1 (src/track/README.md,
+  // "Honest status under the camera's own light"). Infinite: not measured (no cost).
+  double max_texture_residual = 0.7;
   // Covariance (src/track/README.md, "Covariance"). The alignment's is the M-estimator's
   // sandwich B^-1 M B^-1 (B: J^T J over the Huber inliers, M: the scores' outer product over
   // clusters of neighbouring pixels, ReduceSums::score_outer) plus (f delta)(f delta)^T, delta
@@ -172,12 +173,12 @@ struct FrameResult {
   double overlap = 0;          // valid keyframe pixels landing on valid live pixels
   double sigma = 0;            // robust residual scale at the finest level, grey levels
   double log_gain = 0, bias = 0;  // brightness relative to the keyframe
-  // The residual as a misalignment: the residual's robust scale (1.4826 median |r|) over the
-  // root mean square gradient (both images') at the match level, in that level's pixels. A residual this large is
-  // what shifting the images by this much would leave; an alignment held by a pattern fixed to
-  // the camera while the floor moved leaves the floor's texture misaligned (TrackerOptions::
-  // max_misalignment_px).
-  double misalignment = 0;
+  // How much of the two images' texture the residual at the final alignment still holds
+  // (texture_residual.h), measured on the pyramid level of about 160 x 120 pixels: near 0 for
+  // aligned images, 1 for unrelated ones. An alignment held by a pattern fixed to the camera
+  // while the floor moved leaves the floor's texture in the residual
+  // (TrackerOptions::max_texture_residual). NaN when not measured.
+  double texture_residual = 0;
   bool keyframe = false;       // this frame became the keyframe
   // With TrackerOptions::tilt_jacobian: d motion / d (roll, pitch) of the extrinsics the tracker
   // was given, in the right perturbation of motion.value (the covariance's coordinates) per

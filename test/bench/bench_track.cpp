@@ -193,9 +193,9 @@ struct SequenceReport {
   // The honest status: frames reported Ok whose motion is more than 1 mm off (missed), frames
   // reported Degraded or Lost whose motion is within 1 mm (false alarms).
   int missed = 0, false_alarms = 0;
-  // FrameResult::misalignment: the largest over frames within 0.2 mm, the smallest over frames
-  // more than 1 mm off (the honest-status check's margin).
-  double mis_good_max = 0, mis_bad_min = HUGE_VAL;
+  // FrameResult::texture_residual: the largest over frames within 0.2 mm, the smallest over
+  // frames more than 1 mm off (the honest-status check's margin).
+  double tex_good_max = 0, tex_bad_min = HUGE_VAL;
 };
 
 // unroll=0: the tracker is not told the camera's rolling shutter nor its exposure (what it did
@@ -256,8 +256,9 @@ SequenceReport run_sequence(ocl::Runtime& rt, const sim::Options& so, const trac
     dts.push_back(traj.t[k] - traj.t[k - 1]);
     const double e = std::hypot(r.motion.value.x - t.x, r.motion.value.y - t.y);
     rep.missed += r.status == track::FrameResult::Status::Ok && e > 1e-3;
-    if (e <= 2e-4 && std::isfinite(r.misalignment)) rep.mis_good_max = std::max(rep.mis_good_max, r.misalignment);
-    if (e > 1e-3 && r.misalignment > 0) rep.mis_bad_min = std::min(rep.mis_bad_min, r.misalignment);
+    if (e <= 2e-4 && std::isfinite(r.texture_residual))
+      rep.tex_good_max = std::max(rep.tex_good_max, r.texture_residual);
+    if (e > 1e-3 && r.texture_residual > 0) rep.tex_bad_min = std::min(rep.tex_bad_min, r.texture_residual);
     rep.false_alarms += r.status != track::FrameResult::Status::Ok && e <= 1e-3;
     since_kf = r.keyframe ? 0 : since_kf + 1;
     if (verbose)
@@ -275,9 +276,9 @@ SequenceReport run_sequence(ocl::Runtime& rt, const sim::Options& so, const trac
       ++nees_n;
     }
     if (verbose && (e > 1e-3 || r.status != track::FrameResult::Status::Ok))
-      std::printf("  frame %zu: %s %s err %.3f mm, truth (%.4f %.4f %.4f) est (%.4f %.4f %.4f) overlap %.2f\n", k,
-                  track::status_name(r.status), r.reason, e * 1e3, t.x, t.y, t.theta, r.motion.value.x, r.motion.value.y,
-                  r.motion.value.theta, r.overlap);
+      std::printf("  frame %zu: %s %s err %.3f mm, truth (%.4f %.4f %.4f) est (%.4f %.4f %.4f) overlap %.2f texture "
+                  "residual %.3f\n", k, track::status_name(r.status), r.reason, e * 1e3, t.x, t.y, t.theta,
+                  r.motion.value.x, r.motion.value.y, r.motion.value.theta, r.overlap, r.texture_residual);
   }
   rep.acc = track::evaluate_motions(est, truth, dts);
   rep.std_pos_median = median(std_pos);
@@ -327,8 +328,8 @@ int bench_accuracy(const std::vector<std::string>& textures, double seconds, int
     std::printf("%6.2f %6.2f %6.2f ", t.median, t.p99_over_median, t.max_over_median);
     for (int l = topt.levels - 1; l >= 0; --l) std::printf(" %.2f", r.passes[l] / n);
     std::printf("\n");
-    std::printf("  misalignment (px at half resolution): largest of frames within 0.2 mm %.3f, smallest of frames "
-                "over 1 mm %.3f\n", r.mis_good_max, r.mis_bad_min);
+    std::printf("  texture residual (the honest-status check): largest of frames within 0.2 mm %.3f, smallest of "
+                "frames over 1 mm %.3f\n", r.tex_good_max, r.tex_bad_min);
     if (verbose)
       std::printf("  covariance: position std median %.2g m (max %.2g), heading std median %.2g rad; "
                   "mean NEES %.1f (3 if calibrated); largest std ratio of the position axes %.1f\n", r.std_pos_median,
@@ -675,7 +676,7 @@ int main(int argc, char** argv) {
       else if (k == "saturation") topt.photometric.saturation = std::atof(v.c_str());
       else if (k == "photo_radius") topt.photometric.radius = std::atoi(v.c_str());
       else if (k == "photo_min") topt.photometric.min_frames = std::atoi(v.c_str());
-      else if (k == "max_mis") topt.max_misalignment_px = std::atof(v.c_str());
+      else if (k == "max_tex") topt.max_texture_residual = std::atof(v.c_str());
       else if (k == "unroll") g_tracker_knows_readout = v != "0";
       else if (k == "told_exposure") g_told_exposure = std::atof(v.c_str());
       else if (k == "told_readout") g_told_readout = std::atof(v.c_str());

@@ -1,0 +1,42 @@
+#include "track/texture_residual.h"
+
+#include <cmath>
+#include <cstddef>
+#include <limits>
+
+namespace planarvo::track {
+
+double texture_residual(const ResidualImage& im) {
+  const int w = im.width, h = im.height;
+  // Sums of |N*r| and |N*I_r| over the pixels whose neighbourhood is valid.
+  double sr = 0.0, si = 0.0;
+  size_t n = 0;
+  for (int y = 1; y + 1 < h; ++y) {
+    for (int x = 1; x + 1 < w; ++x) {
+      double nr = 0.0, ni = 0.0;
+      bool valid = true;
+      for (int dy = -1; dy <= 1 && valid; ++dy) {
+        const size_t row = static_cast<size_t>(y + dy) * static_cast<size_t>(w);
+        for (int dx = -1; dx <= 1; ++dx) {
+          const size_t q = row + static_cast<size_t>(x + dx);
+          if (!(im.weight[q] > 0.0f)) {
+            valid = false;
+            break;
+          }
+          // N's weights: 4 at the centre, -2 at the four sides, 1 at the four corners.
+          const double c = dx == 0 && dy == 0 ? 4.0 : (dx == 0 || dy == 0 ? -2.0 : 1.0);
+          nr += c * im.residual[q];
+          ni += c * im.intensity[q];
+        }
+      }
+      if (!valid) continue;
+      sr += std::abs(nr);
+      si += std::abs(ni);
+      ++n;
+    }
+  }
+  if (n < 16 || !(si > 0.0)) return std::numeric_limits<double>::quiet_NaN();
+  return sr / (std::sqrt(2.0) * si);
+}
+
+}  // namespace planarvo::track

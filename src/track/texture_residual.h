@@ -1,0 +1,30 @@
+// The honest-status check's measure (src/track/README.md, "Honest status under the camera's own
+// light"): how much of the two images' texture the residual at an alignment still holds.
+//
+// Immerkaer's noise operator N = [1 -2 1; -2 4 -2; 1 -2 1] (Immerkaer, "Fast noise variance
+// estimation", CVIU 1996) is blind to what is smooth (a lamp's falloff, a brightness offset) and
+// answers to texture and noise. With r = g I_l(w) + b - I_r the residual image of an alignment
+// (residual_image.h):
+//
+//   texture_residual = mean |N*r| / (sqrt(2) mean |N*I_r|)
+//
+// over the pixels whose 3 x 3 neighbourhood is valid. Texture that the alignment matched cancels
+// in r, so an aligned pair leaves only the two frames' noise and the interpolation's error
+// (0.36-0.6 at 160 x 120 pixels on the simulator); two unrelated images of like texture give
+// about 1 (their N responses add in quadrature). A pattern fixed to the camera that holds an
+// alignment while the floor moves cancels in r, but the floor's texture does not: 0.85-1.1
+// measured on such frames. The keyframe alone scales it (the warped live frame's N response is
+// lowered by the bilinear interpolation, by how much depends on the shift's fraction); a brightness
+// fit that drove the live frame out (r = b - I_r) gives 0.71, and is Lost for its gain anyway.
+// The images' noise counts less at a coarse level (the tracker measures at a level of about
+// 160 x 120 pixels; TrackerOptions::max_texture_residual).
+#pragma once
+#include "track/residual_image.h"
+
+namespace planarvo::track {
+
+// The measure above; NaN when fewer than 16 pixels have a valid 3 x 3 neighbourhood or the images
+// have no texture at all.
+double texture_residual(const ResidualImage& image);
+
+}  // namespace planarvo::track
