@@ -71,7 +71,7 @@ void validate(const PhotometricOptions& o) {
   require(std::isfinite(o.saturation) && o.saturation > 0, "saturation must be a positive grey level");
   require(o.min_frames >= 1, "min_frames must be >= 1");
   require(o.memory_frames >= o.min_frames, "memory_frames must be >= min_frames");
-  require(o.radius >= 0 && o.radius <= 256, "radius must be 0..256 pixels");
+  require(o.radius >= 0 && o.radius <= 256, "radius must be 0..256 pixels (0: the image's width / 40)");
   require(std::isfinite(o.min_contrast) && o.min_contrast >= 0 && o.min_contrast < 1,
           "min_contrast must be in [0, 1)");
 }
@@ -96,11 +96,12 @@ PhotometricFit fit_photometric(const cv::Mat& mean, const cv::Mat& square, const
   // Multiplicative: its gain is the mean's ratio to the reference. (The floor's contrast is not
   // used for the gain: on a tilted camera it changes over the image with the ground's scale in
   // it, which no correction should undo.)
-  const cv::Mat m = masked_box(mean, valid01, o.radius);
+  const int radius = o.radius > 0 ? o.radius : std::max(1, (mean.cols + 20) / 40);
+  const cv::Mat m = masked_box(mean, valid01, radius);
   // The floor's contrast as the pixel sees it: the spread of the values over the box and the
   // frames together (the texture within the box varies from the first frame on).
   cv::Mat own_var = cv::max(square - mean.mul(mean), 0.0f);
-  const cv::Mat q = masked_box(square, valid01, o.radius);
+  const cv::Mat q = masked_box(square, valid01, radius);
   cv::Mat sd;
   cv::sqrt(cv::max(q - m.mul(m), 0.0f), sd);
   cv::Mat rel(mean.size(), CV_32FC1, cv::Scalar(0.0f));

@@ -44,8 +44,11 @@ struct PhotometricOptions {
   // The statistics' memory: the n-th frame has weight 1/n up to n = memory_frames, then
   // 1/memory_frames (an exponential moving average, so a lamp that changes is followed).
   int memory_frames = 300;
-  // Half-width of the box over which the means and variances are smoothed, level-0 pixels.
-  int radius = 16;
+  // Half-width of the box over which the means and variances are smoothed, level-0 pixels; 0:
+  // the image's width / 40 (16 at 640 pixels, 8 at 320): the light is smooth relative to the
+  // image, not to its pixels (a 33-pixel box on a 320 x 240 camera marked a band twice as wide
+  // around the shadow's edge and the reflection's rim, and the coarse levels emptied).
+  int radius = 0;
   // No value where the smoothed contrast, or after 30 frames a pixel's own, is below
   // this fraction of the median contrast (saturated spots, deep shadow, static structure).
   double min_contrast = 0.3;
