@@ -275,6 +275,12 @@ struct Tracker::Impl {
     if (!std::isfinite(opt.max_texture_residual) || level >= live.num_levels() || level >= keyframe.num_levels())
       return std::numeric_limits<double>::quiet_NaN();
     if (!imager) imager = std::make_unique<ResidualImager>(rt, camera.K(), opt.kernel);
+    imager->compute(record(live, e), ext, level, &check_image);
+    return texture_residual(check_image);
+  }
+
+  // An alignment of `live` with the keyframe, as residual_image.h takes it.
+  AlignmentRecord record(const Pyramid& live, const Estimate& e) const {
     AlignmentRecord a;
     a.reference = keyframe;
     a.live = live;
@@ -283,8 +289,7 @@ struct Tracker::Impl {
     a.bias = e.b;
     a.huber_k = e.huber_k;
     a.finest_level = e.finest;
-    imager->compute(a, ext, level, &check_image);
-    return texture_residual(check_image);
+    return a;
   }
 
   // Fills the alignment's covariance, cost, inliers, overlap and the status from the finest
@@ -489,13 +494,7 @@ struct Tracker::Impl {
   }
 
   void remember(const Pyramid& live, const Estimate& est) {
-    last.reference = keyframe;
-    last.live = live;
-    last.motion = est.T;
-    last.log_gain = est.a;
-    last.bias = est.b;
-    last.huber_k = est.huber_k;
-    last.finest_level = est.finest;
+    last = record(live, est);
     has_last = true;
   }
 
