@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
@@ -11,6 +12,7 @@
 #include "core/error.h"
 #include "image/pipeline.h"
 #include "track/tracker.h"
+#include "track/warp_model.h"
 
 namespace planarvo::track {
 
@@ -60,6 +62,7 @@ struct RollPitchEstimator::Impl {
   CameraModel camera;
   RollPitchOptions opt;
   ImagePipeline pipeline;
+  Extrinsics tracker_extrinsics;  // the initial orientation, which the tracker here tracks with
   Tracker tracker;
   Aligner aligner;
 
@@ -74,6 +77,8 @@ struct RollPitchEstimator::Impl {
   std::vector<SE2> motions;  // between consecutive keyframes, from the tracker
   std::vector<int> keyframe_frames;
   SE2 since_keyframe;
+  SE2 since_learnt;           // the motion since the last frame the photometric model learnt from
+  bool light_fitted = false;  // the photometric model was fitted (learn_light)
   bool moved = false, done = false;
   int frames = 0, frames_moving = 0, untextured = 0, restarts = 0;
   double track_ms = 0.0;
@@ -90,8 +95,42 @@ struct RollPitchEstimator::Impl {
     t.degraded_residual_ratio = 2.0;
     t.min_inlier_fraction = 0.0;
     t.max_log_gain = 3.0;
-    t.max_texture_residual = HUGE_VAL;  // a wrong tilt misaligns the texture too
+    // A wrong tilt misaligns the texture too: measured (for the photometric model's learning,
+    // learn_light) but never Lost for it.
+    t.max_texture_residual = std::numeric_limits<double>::max();
     return t;
+  }
+
+  static ImagePipelineOptions pipeline_options(const RollPitchOptions& o) {
+    ImagePipelineOptions p;
+    p.photometric = o.photometric;
+    return p;
+  }
+
+  // The photometric model learns from the frame just tracked when the floor moved since the last
+  // frame it learnt from: by learn_motion_px (the tracked motions, at the initial orientation) or,
+  // whatever the tracker says, by the texture its alignment leaves in the residual (a light fixed
+  // to the camera holds this tracker at "no motion", and a wrong tilt leaves texture too; a
+  // robot standing still leaves none). True when a model other than the identity was fitted now.
+  bool learn_light(const FrameResult& r) {
+    PhotometricModel* model = pipeline.photometric();
+    if (!model || !model->learning() || light_fitted) return false;
+    if (r.status == FrameResult::Status::First) {
+      pipeline.learn();
+      since_learnt = SE2();
+      return false;
+    }
+    if (r.status != FrameResult::Status::Lost) since_learnt = since_learnt * r.motion.value;
+    const bool floor_moved = max_pixel_displacement(camera.K(), tracker_extrinsics, SE2(), since_learnt, camera.width,
+                                                    camera.height) >= TrackerOptions().learn_motion_px;
+    if (floor_moved || r.texture_residual > TrackerOptions().max_texture_residual) {
+      pipeline.learn();
+      since_learnt = SE2();
+    }
+    if (!model->refit_due()) return false;
+    model->refit();
+    light_fitted = true;
+    return !model->fit().uniform;
   }
 
   static const RollPitchOptions& validated(const RollPitchOptions& o) {
@@ -106,8 +145,9 @@ struct RollPitchEstimator::Impl {
   }
 
   Impl(ocl::Runtime& r, const CameraModel& c, const RollPitchOptions& o)
-      : rt(r), camera(c), opt(validated(o)), pipeline(r, c, o.align.levels),
-        tracker(r, c, camera_frame(o.initial_roll, o.initial_pitch), tracker_options(o)),
+      : rt(r), camera(c), opt(validated(o)), pipeline(r, c, o.align.levels, pipeline_options(o)),
+        tracker_extrinsics(camera_frame(o.initial_roll, o.initial_pitch)),
+        tracker(r, c, tracker_extrinsics, tracker_options(o)),
         aligner(r, c.K(), o.align, true) {}
 
   bool add_frame(const uint8_t* gray, int width, int height, size_t stride, double t) {
@@ -123,6 +163,15 @@ struct RollPitchEstimator::Impl {
     current = cv::Mat(height, width, CV_8UC1, const_cast<uint8_t*>(gray), stride);
     current_t = t;
     const FrameResult r = tracker.track(spare, t);
+    if (learn_light(r)) {
+      // The light is taken out from the next frame on: the map starts again there, so that its
+      // keyframes are all corrected alike.
+      tracker.reset();
+      keyframes.clear();
+      motions.clear();
+      ++restarts;
+      return finish_frame(t0);
+    }
     if (r.status == FrameResult::Status::First) {
       start_map();
       return finish_frame(t0);

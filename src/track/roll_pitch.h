@@ -31,6 +31,7 @@
 
 #include "core/se2.h"
 #include "image/camera.h"
+#include "image/photometric.h"
 #include "track/aligner.h"
 
 namespace planarvo::ocl {
@@ -45,6 +46,12 @@ struct RollPitchOptions {
   AlignerOptions align = default_align();
   // Start of the estimate: a camera looking straight down unless given (radians).
   double initial_roll = 0.0, initial_pitch = 0.0;
+  // The light fixed to the camera (image/photometric.h): learnt from the frames in which the floor
+  // moved (by the tracked motions, or by the texture left in the residual: track/texture_residual.h,
+  // which a lamp holding the tracker at "no motion" leaves), fitted once when a refit is first due
+  // (30 frames), and, when it is not the identity, the map started again with it. An evenly lit
+  // camera keeps the identity, and its frames are what they were without the model.
+  PhotometricOptions photometric;
   // The map: a frame becomes a keyframe when its overlap with the last one falls below this
   // (0.9: pairs a tenth of the view apart; at 0.7, a tilted camera's pairs span more than a camera
   // height, near and far field swap resolution between the two views and the pairs stop aligning,

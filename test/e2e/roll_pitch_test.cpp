@@ -1,7 +1,7 @@
 // Roll and pitch from images (track/roll_pitch.h, paper section 5.1) against the simulator's true
 // extrinsics: convergence from a camera looking straight down and from starts 30 degrees off in
-// both angles, a camera that only turns about its own vertical axis, and the refusals (standing
-// still, no texture) with their statuses.
+// both angles, a rolling shutter, the camera's own light, a camera that only turns about its own
+// vertical axis, and the refusals (standing still, no texture) with their statuses.
 #include <cmath>
 #include <vector>
 
@@ -43,11 +43,13 @@ RollPitchResult estimate(ocl::Runtime& rt, const Drive& d, const RollPitchOption
   const cv::Mat texture = cv::imread(d.options.texture, cv::IMREAD_GRAYSCALE);
   sim::Renderer renderer(rt, texture, d.options);
   const auto exposure = sim::exposure_series(d.options, d.trajectory.t);
+  const sim::Lighting lighting = sim::camera_lighting(d.options);
   RollPitchEstimator est(rt, d.options.camera, o);
   for (size_t k = 0; k < d.trajectory.t.size(); ++k) {
     const SE2& pose = stand_still ? d.trajectory.pose[0] : d.trajectory.pose[k];
-    const cv::Mat clean = d.options.readout_time > 0 && !stand_still ? sim::render_frame(renderer, d.options, d.trajectory, k)
-                                                                     : renderer.render_float(pose);
+    cv::Mat clean = d.options.readout_time > 0 && !stand_still ? sim::render_frame(renderer, d.options, d.trajectory, k)
+                                                               : renderer.render_float(pose);
+    sim::apply_lighting(lighting, clean);
     const cv::Mat img = sim::apply_camera(clean, exposure[k], d.options.pixel_noise,
                                           sim::derive_seed(d.options.seed, 1000 + k));
     if (est.add_frame(img.data, img.cols, img.rows, img.step, d.trajectory.t[k])) break;
@@ -112,6 +114,25 @@ TEST(RollPitch, RollingShutterToldTheReadout) {
   EXPECT_GT(not_told_error, 2.0 * told_error);
   RecordProperty("error_deg_told", std::to_string(told_error / kDeg));
   RecordProperty("error_deg_not_told", std::to_string(not_told_error / kDeg));
+}
+
+// A lamp beside the lens (the darkest corner at 0.2 of the light), its reflection on a glossy floor
+// and the robot's shadow hold the tracker that builds the map at "no motion": the map never grew
+// past its first keyframe ("moved too little"). The photometric model learns the light from the
+// frames whose residual keeps the floor's texture, and the map starts again with it.
+TEST(RollPitch, TheCamerasOwnLightIsLearntFirst) {
+  ocl::Runtime rt;
+  const Extrinsics truth = sim::default_extrinsics();
+  Drive d = drive(truth, sim::MotionProfile::Mixed, "asphalt_01.png", 5);
+  d.options.seconds = 6.0;
+  d.options.lamp_falloff = 0.8;
+  d.options.reflection = 150.0;
+  d.options.shadow = 0.5;
+  d.trajectory = sim::generate_trajectory(d.options);
+  expect_close(estimate(rt, d, RollPitchOptions()), truth, "lamp, reflection and shadow");
+  RollPitchOptions without;
+  without.photometric.enabled = false;
+  EXPECT_FALSE(estimate(rt, d, without).ok());
 }
 
 TEST(RollPitch, StandingStillIsTooLittleMotion) {
