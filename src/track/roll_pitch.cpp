@@ -12,7 +12,7 @@
 #include "core/error.h"
 #include "image/pipeline.h"
 #include "track/tracker.h"
-#include "track/warp_model.h"
+#include "track/light_learning.h"
 
 namespace planarvo::track {
 
@@ -62,7 +62,6 @@ struct RollPitchEstimator::Impl {
   CameraModel camera;
   RollPitchOptions opt;
   ImagePipeline pipeline;
-  Extrinsics tracker_extrinsics;  // the initial orientation, which the tracker here tracks with
   Tracker tracker;
   Aligner aligner;
 
@@ -77,7 +76,7 @@ struct RollPitchEstimator::Impl {
   std::vector<SE2> motions;  // between consecutive keyframes, from the tracker
   std::vector<int> keyframe_frames;
   SE2 since_keyframe;
-  SE2 since_learnt;           // the motion since the last frame the photometric model learnt from
+  LightLearningGate light_gate;  // when the photometric model learns from a frame
   bool light_fitted = false;  // the photometric model was fitted (learn_light)
   bool moved = false, done = false;
   int frames = 0, frames_moving = 0, untextured = 0, restarts = 0;
@@ -107,26 +106,19 @@ struct RollPitchEstimator::Impl {
     return p;
   }
 
-  // The photometric model learns from the frame just tracked when the floor moved since the last
-  // frame it learnt from: by learn_motion_px (the tracked motions, at the initial orientation) or,
-  // whatever the tracker says, by the texture its alignment leaves in the residual (a light fixed
-  // to the camera holds this tracker at "no motion", and a wrong tilt leaves texture too; a
-  // robot standing still leaves none). True when a model other than the identity was fitted now.
+  // The photometric model learns from the frame just tracked when the floor moved
+  // (light_learning.h, with the tracker's default thresholds: this tracker measures the texture
+  // residual but never judges it, and a wrong tilt leaves texture too, while the floor moved just
+  // the same). True when a model other than the identity was fitted now.
   bool learn_light(const FrameResult& r) {
     PhotometricModel* model = pipeline.photometric();
     if (!model || !model->learning() || light_fitted) return false;
     if (r.status == FrameResult::Status::First) {
       pipeline.learn();
-      since_learnt = SE2();
+      light_gate.learnt();
       return false;
     }
-    if (r.status != FrameResult::Status::Lost) since_learnt = since_learnt * r.motion.value;
-    const bool floor_moved = max_pixel_displacement(camera.K(), tracker_extrinsics, SE2(), since_learnt, camera.width,
-                                                    camera.height) >= TrackerOptions().learn_motion_px;
-    if (floor_moved || r.texture_residual > TrackerOptions().max_texture_residual) {
-      pipeline.learn();
-      since_learnt = SE2();
-    }
+    if (light_gate.learn_from(r)) pipeline.learn();
     if (!model->refit_due()) return false;
     model->refit();
     light_fitted = true;
@@ -146,9 +138,10 @@ struct RollPitchEstimator::Impl {
 
   Impl(ocl::Runtime& r, const CameraModel& c, const RollPitchOptions& o)
       : rt(r), camera(c), opt(validated(o)), pipeline(r, c, o.align.levels, pipeline_options(o)),
-        tracker_extrinsics(camera_frame(o.initial_roll, o.initial_pitch)),
-        tracker(r, c, tracker_extrinsics, tracker_options(o)),
-        aligner(r, c.K(), o.align, true) {}
+        tracker(r, c, camera_frame(o.initial_roll, o.initial_pitch), tracker_options(o)),
+        aligner(r, c.K(), o.align, true),
+        light_gate(c.K(), c.width, c.height, camera_frame(o.initial_roll, o.initial_pitch),
+                   TrackerOptions().learn_motion_px, TrackerOptions().max_texture_residual) {}
 
   bool add_frame(const uint8_t* gray, int width, int height, size_t stride, double t) {
     if (done) return true;

@@ -4,7 +4,15 @@
 #include <cstddef>
 #include <limits>
 
+#include "image/pyramid.h"
+
 namespace planarvo::track {
+
+int texture_residual_level(int width, int levels) {
+  int l = 0;
+  while (l + 1 < levels && level_size(width, l) > 200) ++l;
+  return l;
+}
 
 double texture_residual(const ResidualImage& im) {
   const int w = im.width, h = im.height;

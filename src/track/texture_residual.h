@@ -23,6 +23,11 @@
 
 namespace planarvo::track {
 
+// The pyramid level to measure it on for an image `width` pixels wide with `levels` levels: the
+// finest of about 160 x 120 pixels (at most 200 wide), where the images' noise counts little
+// against the floor's texture; the coarsest there is, when none is that small.
+int texture_residual_level(int width, int levels);
+
 // The measure above; NaN when fewer than 16 pixels have a valid 3 x 3 neighbourhood or the images
 // have no texture at all.
 double texture_residual(const ResidualImage& image);

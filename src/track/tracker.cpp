@@ -16,6 +16,7 @@
 #include "track/alignment_covariance.h"
 #include "track/readout_twist.h"
 #include "track/tilt_jacobian.h"
+#include "track/light_learning.h"
 #include "track/texture_residual.h"
 #include "track/tracker_validation.h"
 #include "track/warp_model.h"
@@ -106,7 +107,7 @@ struct Tracker::Impl {
   int live_slot = 0;
   bool keyframe_is_slot = false;
   SE2 pose;             // accumulated robot pose
-  SE2 since_learnt;     // the motion since the last frame the photometric model learnt from
+  LightLearningGate light_gate;  // when the photometric model learns from a frame
   bool light_holds = false;  // this frame was misaligned (held by the light fixed to the camera?)
   bool keyframe_kept = false;  // the keyframe's camera frame is kept in the pipeline
   bool learnt_this_frame = false;
@@ -157,7 +158,8 @@ struct Tracker::Impl {
   Pyramid spare;
 
   Impl(ocl::Runtime& r, const CameraModel& c, const Extrinsics& e, const TrackerOptions& o)
-      : rt(r), camera(validated_tracker_camera(c, e, o)), ext(e), opt(o), aligner(r, c.K(), o, false), selector(r) {
+      : rt(r), camera(validated_tracker_camera(c, e, o)), ext(e), opt(o), aligner(r, c.K(), o, false), selector(r),
+        light_gate(camera.K(), camera.width, camera.height, e, o.learn_motion_px, o.max_texture_residual) {
     readout_twist = ReadoutTwist(camera.mean_row_time());
     // The flat field is read now, so that a bad file fails at once rather than at the first frame.
     if (!opt.flat_field.empty() && opt.photometric.enabled) {
@@ -187,7 +189,7 @@ struct Tracker::Impl {
     forget_alignment(nullptr);
     has_keyframe = false;
     pose = SE2();
-    since_learnt = SE2();
+    light_gate.learnt();
     prev = Estimate();
     prev_predicted = false;
     prev_covariance.setZero();
@@ -259,19 +261,10 @@ struct Tracker::Impl {
            !(std::sqrt(cov(2, 2)) <= opt.max_heading_std);
   }
 
-  // The level the honest-status check measures on: the finest of about 160 x 120 pixels (at most
-  // 200 wide), where the images' noise counts little against the floor's texture
-  // (texture_residual.h); the coarsest the pyramid has, when none is that small.
-  int texture_check_level() const {
-    int l = 0;
-    while (l + 1 < opt.levels && level_size(camera.width, l) > 200) ++l;
-    return l;
-  }
-
   // FrameResult::texture_residual of an alignment of `live` with the keyframe: one pass of the
-  // residual image's kernel at texture_check_level() (NaN when not measured).
+  // residual image's kernel at texture_residual_level (NaN when not measured).
   double measure_texture_residual(const Pyramid& live, const Estimate& e) {
-    const int level = texture_check_level();
+    const int level = texture_residual_level(camera.width, opt.levels);
     if (!std::isfinite(opt.max_texture_residual) || level >= live.num_levels() || level >= keyframe.num_levels())
       return std::numeric_limits<double>::quiet_NaN();
     if (!imager) imager = std::make_unique<ResidualImager>(rt, camera.K(), opt.kernel);
@@ -511,28 +504,18 @@ struct Tracker::Impl {
     return cached;
   }
 
-  // The photometric model learns from frames in motion: the image has moved by learn_motion_px
-  // since the last frame it learnt from (by the motions tracked since), or the frame's content
-  // does not match its keyframe's (misaligned: the floor moved, whatever the alignment says; an
-  // alignment held by the light's own pattern must not keep the model from learning it).
+  // The photometric model learns from frames in which the floor moved (light_learning.h), from
+  // the first frame, and from a frame it already learnt from at once (correct_again).
   void learn_photometric(const FrameResult& r) {
     PhotometricModel* photometric = pipeline->photometric();
     if (!photometric || !photometric->learning()) return;
     if (learnt_this_frame || r.status == Status::First) {
       if (!learnt_this_frame) pipeline->learn();
       learnt_this_frame = false;
-      since_learnt = SE2();
+      light_gate.learnt();
       return;
     }
-    const bool tracked = r.status == Status::Ok || r.status == Status::Degraded;
-    if (tracked) since_learnt = since_learnt * r.motion.value;
-    const bool moved = tracked && max_pixel_displacement(camera.K(), ext, SE2(), since_learnt, camera.width,
-                                                         camera.height) >= opt.learn_motion_px;
-    const bool changed = r.texture_residual > opt.max_texture_residual;
-    if (moved || changed) {
-      pipeline->learn();
-      since_learnt = SE2();
-    }
+    if (light_gate.learn_from(r)) pipeline->learn();
   }
 
   // The frame aligned once more from `from` after an attempt that gave `before`: on success
