@@ -94,6 +94,56 @@ void photometric(__global const float* raw, __global const float* model, const f
   }
 }
 
+// The photometric correction of a rolling-shutter frame (plain C++ reference:
+// photometric_rolling_reference): as `photometric`, but the model is read where the light of
+// each pixel is. `undistort_rolling` reads output pixel p from camera pixel distort(H_r p), which
+// the model (per undistorted pixel of a global shutter) has at q = p + light(p); light is the
+// row warp's second field (RowWarp::light), interpolated as `undistort_rolling` interpolates its
+// first (between the node rows first). The model is sampled bilinearly at q clamped to the
+// image; a pixel has no value where any of the four taps' scale is 0.
+//
+//   raw      width x height floats (PV_INVALID where no source): undistort_rolling's output
+//   model    2 planes of width x height floats: scale, then offset
+//   grid     2 fields of nodes_x x nodes_y float2: RowWarp::delta, then RowWarp::light
+//   dst      width x height floats
+// Each work-item makes 8 consecutive pixels of a row (the launch shape of `undistort`).
+__kernel __attribute__((reqd_work_group_size(UNDISTORT_WG_X, UNDISTORT_WG_Y, 1)))
+void photometric_rolling(__global const float* raw, __global const float* model, __global const float2* grid,
+                         const int nodes_x, const int nodes_y, const float inv_step, const float saturation,
+                         const int width, const int height, __global float* dst) {
+  const int x = (int)get_global_id(0) * 8;
+  const int y = (int)get_global_id(1);
+  if (x >= width || y >= height) return;
+  const int n = width * height;
+  __global const float2* light = grid + nodes_x * nodes_y;
+  const float gy = (float)y * inv_step;
+  const int j = min((int)gy, nodes_y - 2);
+  const float ay = gy - (float)j;
+  const int g0 = j * nodes_x, g1 = g0 + nodes_x;
+  const int end = min(x + 8, width);
+  for (int u = x; u < end; ++u) {
+    const int p = y * width + u;
+    const float v = raw[p];
+    const float gx = (float)u * inv_step;
+    const int i = min((int)gx, nodes_x - 2);
+    const float ax = gx - (float)i;
+    const float2 left = light[g0 + i] + ay * (light[g1 + i] - light[g0 + i]);
+    const float2 right = light[g0 + i + 1] + ay * (light[g1 + i + 1] - light[g0 + i + 1]);
+    const float2 d = left + ax * (right - left);
+    const float qx = clamp((float)u + d.x, 0.0f, (float)(width - 1));
+    const float qy = clamp((float)y + d.y, 0.0f, (float)(height - 1));
+    const int x0 = min((int)qx, max(width - 2, 0)), y0 = min((int)qy, max(height - 2, 0));
+    const float fx = qx - (float)x0, fy = qy - (float)y0;
+    const int t = y0 * width + x0;
+    const float s00 = model[t], s01 = model[t + 1], s10 = model[t + width], s11 = model[t + width + 1];
+    const float o00 = model[n + t], o01 = model[n + t + 1], o10 = model[n + t + width], o11 = model[n + t + width + 1];
+    const float scale = (1.0f - fy) * ((1.0f - fx) * s00 + fx * s01) + fy * ((1.0f - fx) * s10 + fx * s11);
+    const float offset = (1.0f - fy) * ((1.0f - fx) * o00 + fx * o01) + fy * ((1.0f - fx) * o10 + fx * o11);
+    const bool use = v > 0.5f * PV_INVALID && v < saturation && min(min(s00, s01), min(s10, s11)) > 0.0f;
+    dst[p] = use ? v * scale + offset : PV_INVALID;
+  }
+}
+
 // The photometric model's statistics (plain C++ reference: photometric_learn_reference): from
 // a frame in motion, every valid raw value (saturated ones included: a pixel that stays
 // saturated has no contrast, which is how the model learns to leave it out) updates the

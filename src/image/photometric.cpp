@@ -341,6 +341,53 @@ cv::Mat photometric_reference(const cv::Mat& raw, const PhotometricFit& fit, dou
   return out;
 }
 
+cv::Mat photometric_rolling_reference(const cv::Mat& raw, const PhotometricFit& fit, const RowWarp& warp,
+                                      double saturation) {
+  if (raw.type() != CV_32FC1 || fit.scale.size() != raw.size() || fit.offset.size() != raw.size() ||
+      raw.cols < 2 || raw.rows < 2)
+    throw_invalid_argument("photometric_rolling_reference: raw (CV_32FC1) and the model of one size");
+  if (warp.width != raw.cols || warp.height != raw.rows || warp.nodes_x < 2 || warp.nodes_y < 2 ||
+      warp.light.size() != 2 * static_cast<size_t>(warp.nodes_x) * static_cast<size_t>(warp.nodes_y))
+    throw_invalid_argument("photometric_rolling_reference: the row warp is not for this image's size");
+  const float sat = static_cast<float>(saturation), inv_step = 1.0f / static_cast<float>(warp.step);
+  const int w = raw.cols, h = raw.rows;
+  const float* g = warp.light.data();
+  cv::Mat out(raw.size(), CV_32FC1);
+  for (int y = 0; y < h; ++y) {
+    const float gy = static_cast<float>(y) * inv_step;
+    const int j = std::min(static_cast<int>(gy), warp.nodes_y - 2);
+    const float ay = gy - static_cast<float>(j);
+    for (int x = 0; x < w; ++x) {
+      const float gx = static_cast<float>(x) * inv_step;
+      const int i = std::min(static_cast<int>(gx), warp.nodes_x - 2);
+      const float ax = gx - static_cast<float>(i);
+      const size_t n00 = 2 * (static_cast<size_t>(j) * static_cast<size_t>(warp.nodes_x) + static_cast<size_t>(i));
+      const size_t n10 = n00 + 2 * static_cast<size_t>(warp.nodes_x);
+      float d[2];
+      for (int c = 0; c < 2; ++c) {  // between the node rows first, as the kernel
+        const float left = g[n00 + c] + ay * (g[n10 + c] - g[n00 + c]);
+        const float right = g[n00 + 2 + c] + ay * (g[n10 + 2 + c] - g[n00 + 2 + c]);
+        d[c] = left + ax * (right - left);
+      }
+      const float qx = std::clamp(static_cast<float>(x) + d[0], 0.0f, static_cast<float>(w - 1));
+      const float qy = std::clamp(static_cast<float>(y) + d[1], 0.0f, static_cast<float>(h - 1));
+      const int x0 = std::min(static_cast<int>(qx), w - 2), y0 = std::min(static_cast<int>(qy), h - 2);
+      const float fx = qx - static_cast<float>(x0), fy = qy - static_cast<float>(y0);
+      auto sample = [&](const cv::Mat& m) {
+        const float* top = m.ptr<float>(y0) + x0;
+        const float* bottom = m.ptr<float>(y0 + 1) + x0;
+        return (1.0f - fy) * ((1.0f - fx) * top[0] + fx * top[1]) + fy * ((1.0f - fx) * bottom[0] + fx * bottom[1]);
+      };
+      const float* s0 = fit.scale.ptr<float>(y0) + x0;
+      const float* s1 = fit.scale.ptr<float>(y0 + 1) + x0;
+      const float v = raw.at<float>(y, x);
+      const bool use = v > 0.5f * kInvalidIntensity && v < sat && std::min({s0[0], s0[1], s1[0], s1[1]}) > 0.0f;
+      out.at<float>(y, x) = use ? v * sample(fit.scale) + sample(fit.offset) : kInvalidIntensity;
+    }
+  }
+  return out;
+}
+
 void photometric_learn_reference(const cv::Mat& raw, float alpha, cv::Mat* mean, cv::Mat* square) {
   if (raw.type() != CV_32FC1 || !mean || !square || mean->size() != raw.size() ||
       square->size() != raw.size() || mean->type() != CV_32FC1 || square->type() != CV_32FC1)

@@ -20,6 +20,7 @@
 #include <opencv2/core.hpp>
 
 #include "image/camera.h"
+#include "image/rolling_shutter.h"
 #include "image/undistort.h"
 
 namespace planarvo {
@@ -122,6 +123,13 @@ void write_flat_field(const std::string& path, const cv::Mat& gain);
 // Plain C++ reference of the `photometric` kernel (kernels/undistort.cl): raw level-0 intensity
 // (kInvalidIntensity where not valid) -> corrected.
 cv::Mat photometric_reference(const cv::Mat& raw, const PhotometricFit& fit, double saturation);
+// Plain C++ reference of the `photometric_rolling` kernel: raw is undistort_rolling_reference's
+// output for `warp`; the model is sampled bilinearly at p + the warp's light field (interpolated
+// as undistort_rolling_reference interpolates its displacement), clamped to the image, and has
+// no value where any of its four taps' scale is 0 (with the identity warp: photometric_reference
+// but for the pixels beside one without a value).
+cv::Mat photometric_rolling_reference(const cv::Mat& raw, const PhotometricFit& fit, const RowWarp& warp,
+                                      double saturation);
 // Plain C++ reference of the `photometric_learn` kernel: updates the mean and mean square
 // (CV_32FC1) in place from raw with weight alpha, in the kernel's float arithmetic.
 void photometric_learn_reference(const cv::Mat& raw, float alpha, cv::Mat* mean, cv::Mat* square);

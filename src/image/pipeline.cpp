@@ -164,6 +164,7 @@ PipelineKernels::PipelineKernels(ocl::Runtime& runtime, const ImagePipelineOptio
     undistort_rolling_ = make_kernel(undistort, "undistort_rolling", dev, undistort_wg_);
     photometric_ = make_kernel(undistort, "photometric", dev, undistort_wg_);
     photometric_learn_ = make_kernel(undistort, "photometric_learn", dev, undistort_wg_);
+    photometric_rolling_ = make_kernel(undistort, "photometric_rolling", dev, undistort_wg_);
     cl::Program& pyramid = runtime.program("pyramid", pyramid_opts);
     smooth_ = make_kernel(pyramid, "smooth", dev, pyramid_wg_);
     downsample_ = make_kernel(pyramid, "downsample", dev, pyramid_wg_);
@@ -244,6 +245,21 @@ void PipelineKernels::photometric(const cl::Buffer& raw, const cl::Buffer& model
   launch(runtime_.queue(), photometric_, undistort_wg_, width, height);
 }
 
+void PipelineKernels::photometric_rolling(const cl::Buffer& raw, const cl::Buffer& model, const cl::Buffer& grid,
+                                          const RowWarp& warp, float saturation, const cl::Buffer& dst) {
+  photometric_rolling_.setArg(0, raw);
+  photometric_rolling_.setArg(1, model);
+  photometric_rolling_.setArg(2, grid);
+  photometric_rolling_.setArg(3, static_cast<cl_int>(warp.nodes_x));
+  photometric_rolling_.setArg(4, static_cast<cl_int>(warp.nodes_y));
+  photometric_rolling_.setArg(5, 1.0f / static_cast<float>(warp.step));
+  photometric_rolling_.setArg(6, saturation);
+  photometric_rolling_.setArg(7, static_cast<cl_int>(warp.width));
+  photometric_rolling_.setArg(8, static_cast<cl_int>(warp.height));
+  photometric_rolling_.setArg(9, dst);
+  launch(runtime_.queue(), photometric_rolling_, undistort_wg_, warp.width, warp.height);
+}
+
 void PipelineKernels::photometric_learn(const cl::Buffer& raw, const cl::Buffer& stats, float alpha,
                                         int width, int height) {
   photometric_learn_.setArg(0, raw);
@@ -289,7 +305,8 @@ struct ImagePipeline::Impl {
   cl::Buffer kept;                    // a copy of `frame` (keep, reprocess_kept)
   bool has_kept = false;
   // The rolling shutter: the map as (x, y) pairs (made on the first row warp that is not the
-  // identity), and the current and the kept frame's row warps (a buffer each, when not identity).
+  // identity), and the current and the kept frame's row warps (a buffer each, when not identity:
+  // RowWarp::delta, then RowWarp::light).
   cl::Buffer map_xy;
   cl_float4 roi{};
   struct Rows {
@@ -297,6 +314,9 @@ struct ImagePipeline::Impl {
     cl::Buffer buffer;
     bool identity = true;
   } row_warp, kept_row_warp;
+  // What `uncorrected` was last made from (learn()).
+  const cl::Buffer* undistorted_source = nullptr;
+  bool undistorted_rolling = false;
   Impl(ocl::Runtime& r, const ImagePipelineOptions& o) : rt(r), kernels(r, o), prefilter(o.prefilter) {}
 
   int w(int l) const { return level_size(camera.width, l); }
@@ -337,7 +357,8 @@ struct ImagePipeline::Impl {
   void set_rows(Rows& r, const RowWarp& warp) {
     if (warp.width != camera.width || warp.height != camera.height || warp.nodes_x < 2 || warp.nodes_y < 2 ||
         warp.step < 8 ||
-        warp.delta.size() != 2 * static_cast<size_t>(warp.nodes_x) * static_cast<size_t>(warp.nodes_y))
+        warp.delta.size() != 2 * static_cast<size_t>(warp.nodes_x) * static_cast<size_t>(warp.nodes_y) ||
+        warp.light.size() != warp.delta.size())
       throw_invalid_argument("image pipeline: the row warp is for " + size_text(warp.width, warp.height) +
                              " images, the camera's are " + size_text(camera.width, camera.height));
     r.warp = warp;
@@ -356,10 +377,11 @@ struct ImagePipeline::Impl {
       roi = {{static_cast<float>(reg.x), static_cast<float>(reg.y), static_cast<float>(reg.x + reg.width - 1),
               static_cast<float>(reg.y + reg.height - 1)}};
     }
-    const size_t bytes = warp.delta.size() * sizeof(float);
+    const size_t field = warp.delta.size() * sizeof(float), bytes = 2 * field;
     if (!r.buffer() || r.buffer.getInfo<CL_MEM_SIZE>() != bytes) r.buffer = cl::Buffer(ctx, CL_MEM_READ_WRITE, bytes);
     // Blocking: the next call may change r.warp before a non-blocking write had read it.
-    rt.queue().enqueueWriteBuffer(r.buffer, CL_TRUE, 0, bytes, r.warp.delta.data());
+    rt.queue().enqueueWriteBuffer(r.buffer, CL_TRUE, 0, field, r.warp.delta.data());
+    rt.queue().enqueueWriteBuffer(r.buffer, CL_TRUE, field, field, r.warp.light.data());
   }
 
   void undistort() { undistort(frame, row_warp); }
@@ -370,9 +392,16 @@ struct ImagePipeline::Impl {
       kernels.undistort(source, map_index, map_weights, w(0), h(0), undistorted);
     else
       kernels.undistort_rolling(source, map_xy, r.buffer, r.warp, roi, undistorted);
-    if (photometric)
-      kernels.photometric(uncorrected, photometric->model(),
-                          static_cast<float>(photometric->options().saturation), w(0), h(0), level0);
+    undistorted_source = &source;
+    undistorted_rolling = !r.identity;
+    if (photometric) {
+      // The light is fixed to the camera's pixels, which the row warp moves (RowWarp::light).
+      const float saturation = static_cast<float>(photometric->options().saturation);
+      if (r.identity)
+        kernels.photometric(uncorrected, photometric->model(), saturation, w(0), h(0), level0);
+      else
+        kernels.photometric_rolling(uncorrected, photometric->model(), r.buffer, r.warp, saturation, level0);
+    }
     if (prefilter) kernels.smooth(raw, w(0), h(0), intensity[0]);
   }
   // Undistortion (with the rolling shutter's row warp r and the photometric correction), pyramid
@@ -461,7 +490,11 @@ void ImagePipeline::learn() {
   Impl& m = *impl_;
   if (!m.photometric || !m.photometric->learning() || !m.has_frame) return;
   try {
-    // The undistorted frame is still in `uncorrected` (until the next process or reprocess).
+    // The undistorted frame is still in `uncorrected` (until the next process or reprocess). The
+    // model is per pixel of the global shutter's undistortion (a fixed map of the camera's
+    // pixels), so a frame undistorted with a row warp is undistorted again without it.
+    if (m.undistorted_rolling)
+      m.kernels.undistort(*m.undistorted_source, m.map_index, m.map_weights, m.w(0), m.h(0), m.uncorrected);
     m.kernels.photometric_learn(m.uncorrected, m.photometric->statistics(), m.photometric->next_alpha(),
                                 m.w(0), m.h(0));
   } catch (const cl::Error& e) {
@@ -491,7 +524,7 @@ void ImagePipeline::keep() {
     m.kept_row_warp.warp = m.row_warp.warp;
     m.kept_row_warp.identity = m.row_warp.identity;
     if (!m.row_warp.identity) {
-      const size_t rb = m.row_warp.warp.delta.size() * sizeof(float);
+      const size_t rb = 2 * m.row_warp.warp.delta.size() * sizeof(float);
       if (!m.kept_row_warp.buffer() || m.kept_row_warp.buffer.getInfo<CL_MEM_SIZE>() != rb)
         m.kept_row_warp.buffer = cl::Buffer(m.rt.context(), CL_MEM_READ_WRITE, rb);
       m.rt.queue().enqueueCopyBuffer(m.row_warp.buffer, m.kept_row_warp.buffer, 0, 0, rb);

@@ -140,14 +140,18 @@ class PipelineKernels {
                  int width, int height, const cl::Buffer& dst);
   // The rolling-shutter undistortion (rolling_shutter.h): frame as undistort's; map: width *
   // height float2, the UndistortMap's (map_x, map_y) interleaved, then 8 pairs outside any image
-  // (-1e6); grid: RowWarp::delta of a warp
-  // of this size; roi: the region of interest's (min x, min y, max x, max y).
+  // (-1e6); grid: RowWarp::delta of a warp of this size (the light field may follow it); roi:
+  // the region of interest's (min x, min y, max x, max y).
   void undistort_rolling(const cl::Buffer& frame, const cl::Buffer& map, const cl::Buffer& grid,
                          const RowWarp& warp, const cl_float4& roi, const cl::Buffer& dst);
   // The photometric correction: raw -> dst (intensity images of width x height, not the same
   // buffer), model PhotometricModel's planes.
   void photometric(const cl::Buffer& raw, const cl::Buffer& model, float saturation, int width,
                    int height, const cl::Buffer& dst);
+  // The photometric correction of undistort_rolling's output (kernel `photometric_rolling`):
+  // grid: the warp's buffer, RowWarp::delta then RowWarp::light.
+  void photometric_rolling(const cl::Buffer& raw, const cl::Buffer& model, const cl::Buffer& grid,
+                           const RowWarp& warp, float saturation, const cl::Buffer& dst);
   // The photometric statistics' update from raw (PhotometricModel's planes) with weight alpha.
   void photometric_learn(const cl::Buffer& raw, const cl::Buffer& stats, float alpha, int width,
                          int height);
@@ -161,7 +165,7 @@ class PipelineKernels {
 
  private:
   ocl::Runtime& runtime_;
-  cl::Kernel undistort_, undistort_rolling_, photometric_, photometric_learn_, smooth_, downsample_, gradient_;
+  cl::Kernel undistort_, undistort_rolling_, photometric_, photometric_learn_, photometric_rolling_, smooth_, downsample_, gradient_;
   size_t undistort_wg_[2] = {1, 1}, pyramid_wg_[2] = {1, 1};
 };
 

@@ -84,19 +84,24 @@ Eigen::Vector2d distorted_pixel(const CameraModel& c, const Eigen::Vector2d& p) 
 // sample anyway, and the grid's nodes there keep the field smooth for the pixels inside); held
 // within a frame's height beyond them so that nothing diverges.
 // start: a first row (a neighbouring node's solution), or NaN for the global shutter's row.
-Eigen::Vector2d solve_source(const CameraModel& c, const RowHomographies& H, const Eigen::Vector2d& p,
-                             double start = std::numeric_limits<double>::quiet_NaN()) {
+// The source s = distort(q) and q = H_r p, the undistorted pixel of a global shutter that reads s.
+struct Source {
+  Eigen::Vector2d s, q;
+};
+Source solve_source(const CameraModel& c, const RowHomographies& H, const Eigen::Vector2d& p,
+                    double start = std::numeric_limits<double>::quiet_NaN()) {
   const double first = -(c.height - 1.0), last = 2.0 * (c.height - 1);
   auto source = [&](double r) {
-    const Eigen::Vector3d q = H.apply(r, p);
-    return distorted_pixel(c, q.head<2>() / q.z());
+    const Eigen::Vector3d h = H.apply(r, p);
+    const Eigen::Vector2d q = h.head<2>() / h.z();
+    return Source{distorted_pixel(c, q), q};
   };
-  auto row = [&](const Eigen::Vector2d& s) { return std::isfinite(s.y()) ? std::clamp(s.y(), first, last) : 0.0; };
-  double r = std::isfinite(start) ? std::clamp(start, first, last) : row(distorted_pixel(c, p));
+  auto row = [&](const Source& s) { return std::isfinite(s.s.y()) ? std::clamp(s.s.y(), first, last) : 0.0; };
+  double r = std::isfinite(start) ? std::clamp(start, first, last) : row(Source{distorted_pixel(c, p), p});
   for (int it = 0; it < 8; ++it) {
     // A start this close (a neighbour's row, extrapolated) is taken as it is: the source found
     // from it is within the contraction times 1e-4 rows of the fixed point's.
-    const Eigen::Vector2d s = source(r);
+    const Source s = source(r);
     const double r1 = row(s);
     if (std::abs(r1 - r) < 1e-4) return s;
     const double r2 = row(source(r1));
@@ -114,7 +119,8 @@ Eigen::Vector2d solve_source(const CameraModel& c, const RowHomographies& H, con
 }  // namespace
 
 bool RowWarp::identity() const {
-  return std::all_of(delta.begin(), delta.end(), [](float d) { return d == 0.0f; });
+  auto zero = [](float d) { return d == 0.0f; };
+  return std::all_of(delta.begin(), delta.end(), zero) && std::all_of(light.begin(), light.end(), zero);
 }
 
 RowWarp identity_row_warp(int width, int height, int step) {
@@ -127,13 +133,14 @@ RowWarp identity_row_warp(int width, int height, int step) {
   w.nodes_x = (width - 1) / step + 2;
   w.nodes_y = (height - 1) / step + 2;
   w.delta.assign(2 * static_cast<size_t>(w.nodes_x) * static_cast<size_t>(w.nodes_y), 0.0f);
+  w.light = w.delta;
   return w;
 }
 
 Eigen::Vector2d rolling_shutter_source(const CameraModel& camera, const Extrinsics& extrinsics,
                                        const Eigen::Vector3d& twist, double u, double v) {
   const RowHomographies H(camera, extrinsics, twist);
-  return solve_source(camera, H, Eigen::Vector2d(u, v));
+  return solve_source(camera, H, Eigen::Vector2d(u, v)).s;
 }
 
 RowWarp rolling_shutter_warp(const CameraModel& camera, const Extrinsics& extrinsics, const Eigen::Vector3d& twist,
@@ -163,25 +170,29 @@ RowWarp rolling_shutter_warp(const CameraModel& camera, const Extrinsics& extrin
       // The extrapolation by the solved nodes' own spacing (1 or 2 columns).
       const double start =
           std::isfinite(before_left) ? left + (left - before_left) * (i - left_i) / (left_i - before_i) : left;
-      const Eigen::Vector2d s = solve_source(camera, H, p, start);
+      const Source s = solve_source(camera, H, p, start);
       before_left = left_i >= 0 ? left : std::numeric_limits<double>::quiet_NaN();
       before_i = left_i;
-      left = s.y();
+      left = s.s.y();
       left_i = i;
-      if (i == 0) above = s.y();
-      const Eigen::Vector2d d = s - distorted_pixel(camera, p);
-      w.delta[at(i, j)] = d.allFinite() ? static_cast<float>(d.x()) : 0.0f;
-      w.delta[at(i, j) + 1] = d.allFinite() ? static_cast<float>(d.y()) : 0.0f;
+      if (i == 0) above = s.s.y();
+      const Eigen::Vector2d d = s.s - distorted_pixel(camera, p), l = s.q - p;
+      const bool finite = d.allFinite() && l.allFinite();
+      w.delta[at(i, j)] = finite ? static_cast<float>(d.x()) : 0.0f;
+      w.delta[at(i, j) + 1] = finite ? static_cast<float>(d.y()) : 0.0f;
+      w.light[at(i, j)] = finite ? static_cast<float>(l.x()) : 0.0f;
+      w.light[at(i, j) + 1] = finite ? static_cast<float>(l.y()) : 0.0f;
     }
   }
   // The cubic through nodes -3, -1, +1, +3 (in the fine grid's steps) at 0: (-1, 9, 9, -1) / 16,
   // along (di, dj). Every node not solved has them solved (odd, with three nodes on both sides):
   // the solved rows first, along x; then the other rows, along y, from the rows now complete.
   auto fill = [&](int i, int j, int di, int dj) {
-    for (size_t c = 0; c < 2; ++c) {
-      auto g = [&](int k) { return w.delta[at(i + k * di, j + k * dj) + c]; };
-      w.delta[at(i, j) + c] = (9.0f * (g(-1) + g(1)) - (g(-3) + g(3))) * (1.0f / 16.0f);
-    }
+    for (std::vector<float>* field : {&w.delta, &w.light})
+      for (size_t c = 0; c < 2; ++c) {
+        auto g = [&](int k) { return (*field)[at(i + k * di, j + k * dj) + c]; };
+        (*field)[at(i, j) + c] = (9.0f * (g(-1) + g(1)) - (g(-3) + g(3))) * (1.0f / 16.0f);
+      }
   };
   for (int j = 0; j < w.nodes_y; ++j)
     for (int i = 0; i < w.nodes_x; ++i)

@@ -52,6 +52,11 @@ struct RowWarp {
   int step = kRowWarpStep;
   int nodes_x = 0, nodes_y = 0;
   std::vector<float> delta;  // 2 * nodes_x * nodes_y
+  // Where the light fixed to the camera is, on the same grid: pixel p's value is read from camera
+  // pixel distort(H_r p), the pixel that the global shutter's undistortion puts at q = H_r p, so
+  // the photometric model (photometric.h, per undistorted pixel of a global shutter) has that
+  // pixel's light at q. light = q - p (undistorted pixels), (dx, dy) interleaved, as delta.
+  std::vector<float> light;  // 2 * nodes_x * nodes_y
 
   // Every node's displacement zero: a global shutter, or a camera at rest.
   bool identity() const;
