@@ -21,7 +21,7 @@ namespace planarvo {
 namespace {
 
 // Frames in motion after which a pixel's own variance over time says whether it sees the floor.
-constexpr int kOwnVarianceFrames = 30;
+constexpr int kOwnVarianceFrames = kPhotometricSettledFrames;
 // A box whose spread relative to its level exceeds this many times the median pixel's holds an
 // edge of the light.
 constexpr double kMaxRelativeSpread = 2.0;
@@ -80,6 +80,7 @@ PhotometricFit identity_photometric(int width, int height) {
   PhotometricFit f;
   f.scale = cv::Mat(height, width, CV_32FC1, cv::Scalar(1.0f));
   f.offset = cv::Mat(height, width, CV_32FC1, cv::Scalar(0.0f));
+  f.identity = true;
   return f;
 }
 
@@ -167,11 +168,19 @@ PhotometricFit fit_photometric(const cv::Mat& mean, const cv::Mat& square, const
   // level varies over the image by less than uniform_spread (10th to 90th percentile, relative
   // to the median), and no pixel lacks a value. The correction would only add its own noise (a
   // faint pattern fixed to the camera); the identity is used.
+  // Before kPhotometricSettledFrames frames the statistics' own noise spreads the mean level by
+  // about 0.26 / sqrt(frames) (brick_floor's large bricks, the noisiest floor measured: 0.084 at
+  // 10 frames, 0.032 at 29) and leaves up to 3 % of the pixels without a value (anti_skid_tiles
+  // at 10-15 frames): the spread allowed grows as sqrt(40 / frames), and the pixels without a
+  // value do not count. A lamp's falloff or a shadow spreads it by 0.3-0.7.
   const double m_spread = masked_quantile(m, valid, 0.9) - masked_quantile(m, valid, 0.1);
-  f.uniform = m_spread < o.uniform_spread * mean_ref && f.unusable < 0.005;
+  const bool settled = frames >= kPhotometricSettledFrames;
+  const double allowed = o.uniform_spread * (settled ? 1.0 : std::sqrt(40.0 / std::max(frames, 1)));
+  f.uniform = m_spread < allowed * mean_ref && (!settled || f.unusable < 0.005);
   if (f.uniform && !needed) {
     f.scale.setTo(1.0f, valid);
     f.offset.setTo(0.0f);
+    f.identity = true;
   }
   return f;
 }
@@ -465,7 +474,7 @@ float PhotometricModel::next_alpha() {
 
 bool PhotometricModel::refit_due(bool needed) const {
   const Impl& m = *impl_;
-  if (!learning() || m.frames < (needed ? m.options.min_frames : kOwnVarianceFrames)) return false;
+  if (!learning() || m.frames < (needed ? m.options.min_frames : kPhotometricFirstFitFrames)) return false;
   const int since = m.frames - m.frames_at_fit;
   return m.frames_at_fit == 0 || since >= (needed ? 1 : std::max(4, m.frames_at_fit / 4));
 }

@@ -39,8 +39,8 @@ struct PhotometricOptions {
   // (above 255: never).
   double saturation = 250.0;
   // Frames in motion accumulated before a learnt model replaces the identity when the tracker
-  // sees the light hold its alignments (otherwise 30, and only a model that differs from the
-  // identity by more than the statistics' noise: uniform_spread).
+  // sees the light hold its alignments (otherwise kPhotometricFirstFitFrames, and only a model
+  // that differs from the identity by more than the statistics' noise: uniform_spread).
   int min_frames = 2;
   // The statistics' memory: the n-th frame has weight 1/n up to n = memory_frames, then
   // 1/memory_frames (an exponential moving average, so a lamp that changes is followed).
@@ -55,7 +55,9 @@ struct PhotometricOptions {
   double min_contrast = 0.3;
   // The identity is kept while the learnt mean level varies over the image by less than this
   // (10th to 90th percentile, relative to the median) and every pixel has a value: an evenly lit
-  // camera tracks exactly as without the model.
+  // camera tracks exactly as without the model. Before kPhotometricSettledFrames frames, n, the
+  // statistics' own noise is allowed for: uniform_spread * sqrt(40 / n), pixels without a value
+  // not counted.
   double uniform_spread = 0.06;
 };
 
@@ -70,8 +72,10 @@ struct PhotometricFit {
   int frames = 0;                   // frames in motion the fit is made from (0: identity)
   double unusable = 0;              // fraction of the valid pixels left without a value
   // The statistics found no light fixed to the camera beyond their own noise: the model is the
-  // identity (fit_photometric).
+  // identity (fit_photometric), unless the caller needed one.
   bool uniform = false;
+  // The model is the identity: nothing learnt yet, or nothing found (uniform, not needed).
+  bool identity = false;
 };
 
 // The identity model (scale 1, offset 0) of a width x height image.
@@ -134,6 +138,15 @@ cv::Mat photometric_rolling_reference(const cv::Mat& raw, const PhotometricFit& 
 // (CV_32FC1) in place from raw with weight alpha, in the kernel's float arithmetic.
 void photometric_learn_reference(const cv::Mat& raw, float alpha, cv::Mat* mean, cv::Mat* square);
 
+// Frames in motion after which the statistics are settled: a pixel's own variance says whether
+// it sees the floor, and a model is the identity unless the light spreads the mean level by
+// uniform_spread or leaves a pixel without a value (before: by more than the statistics' noise).
+inline constexpr int kPhotometricSettledFrames = 30;
+// Frames in motion before the first fit: a lamp's falloff or a shadow is plain after 8 (a fit
+// then is what keeps a shadow's edge from holding the first second of a drive), a faint
+// vignetting only once the statistics settle.
+inline constexpr int kPhotometricFirstFitFrames = 8;
+
 // The model on the device: its two planes (scale, offset), the statistics' two planes (mean,
 // variance), the count of frames accumulated and when to refit.
 class PhotometricModel {
@@ -153,8 +166,8 @@ class PhotometricModel {
   // frame is counted. 0 when not learning.
   float next_alpha();
   int frames() const;
-  // A refit is due: learning, at least 30 frames and a quarter more (at least 4) since the last
-  // fit; or, when the model is `needed` (the caller sees the light hold its alignments), at
+  // A refit is due: learning, at least kPhotometricFirstFitFrames frames and a quarter more (at
+  // least 4) since the last fit; or, when the model is `needed` (the caller sees the light hold its alignments), at
   // least min_frames frames and one more since the last fit.
   bool refit_due(bool needed = false) const;
   // Reads the statistics back (blocking), fits (fit_photometric) and uploads the model.

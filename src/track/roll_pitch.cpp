@@ -119,7 +119,9 @@ struct RollPitchEstimator::Impl {
       return false;
     }
     if (light_gate.learn_from(r)) pipeline.learn();
-    if (!model->refit_due()) return false;
+    // Fitted once, so from settled statistics (a model from fewer frames would stay in every
+    // keyframe of the map).
+    if (model->frames() < kPhotometricSettledFrames || !model->refit_due()) return false;
     model->refit();
     light_fitted = true;
     return !model->fit().uniform;

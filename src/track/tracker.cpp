@@ -551,6 +551,27 @@ struct Tracker::Impl {
     return true;
   }
 
+  // Until the statistics settle (kPhotometricSettledFrames), the model is refitted as soon as a
+  // fit is due and taken into use at once, not at the next keyframe (as later ones are): before
+  // it the light fixed to the camera pulls at every alignment, and at a slow start the first
+  // keyframe lasts a second or more (a shadow's edge and a lamp's falloff held frames 1-3 mm off
+  // there). A model already in use (one the light forced from a few frames, correct_again) is
+  // rough: it is refitted, as a needed one, whenever a quarter more frames (at least one) were
+  // learnt. The keyframe is corrected again with the new model, and the live frame.
+  void refit_young_model() {
+    PhotometricModel* photometric = pipeline ? pipeline->photometric() : nullptr;
+    if (!photometric || !photometric->learning() || !has_keyframe || !keyframe_kept) return;
+    const PhotometricFit& fit = photometric->fit();
+    if (fit.frames >= kPhotometricSettledFrames) return;
+    const bool rough = !fit.identity;
+    if (rough ? photometric->frames() - fit.frames < std::max(1, fit.frames / 4) : !photometric->refit_due()) return;
+    photometric->refit(rough);
+    if (!rough && photometric->fit().identity) return;
+    pipeline->reprocess_kept(keyframe);
+    pipeline->reprocess(slots[live_slot]);
+    select_keyframe_pixels();
+  }
+
   // The motion searched for on the coarsest level around the previous frame's pose
   // (motion_search.h) and the frame aligned from the search's peaks, best first: true with the
   // first result that is not Lost.
@@ -591,6 +612,7 @@ struct Tracker::Impl {
     // Waiting here costs one synchronisation (the first pass would wait anyway) and splits
     // the frame's time between the pipeline and the tracker.
     rt.queue().finish();
+    refit_young_model();
     const auto t1 = std::chrono::steady_clock::now();
     FrameResult r = track(slots[live_slot], t);
     learn_photometric(r);

@@ -103,6 +103,50 @@ TEST(Photometric, FitTakesTheLightOut) {
   EXPECT_LT(worst_level, 0.02);
 }
 
+// The first fits (8 frames on, kPhotometricFirstFitFrames): a floor whose patches a box of the
+// smoothing sees few of (about 10; brick_floor's) under even light leaves the smoothed level
+// spread by the statistics' own noise (0.07 at 8 frames, as brick_floor's 0.084 at 10), more than
+// the settled rule's 6 %: the young rule must keep the identity there, and still see a lamp's
+// falloff (a spread of 0.75) at once.
+TEST(Photometric, YoungStatisticsTellALampFromTheirNoise) {
+  auto coarse = [](std::mt19937& rng) {
+    cv::Mat a(kH, kW, CV_32FC1);
+    std::normal_distribution<float> n(0.0f, 1.0f);
+    for (int y = 0; y < kH; ++y)
+      for (int x = 0; x < kW; ++x) a.at<float>(y, x) = n(rng);
+    cv::GaussianBlur(a, a, cv::Size(0, 0), 1.5);
+    cv::Scalar mean, sd;
+    cv::meanStdDev(a, mean, sd);
+    return cv::Mat((a - mean[0]) * (35.0 / sd[0]) + 128.0);
+  };
+  cv::Mat gain, add;
+  light(&gain, &add);
+  const cv::Mat valid(kH, kW, CV_8UC1, cv::Scalar(1));
+  PhotometricOptions o;
+  o.radius = 8;  // boxes of about 10 patches: the level's spread from noise 0.07 at 8 frames
+  for (const int n : {8, 12, 20, 29}) {
+    std::mt19937 rng(40 + static_cast<uint32_t>(n));
+    Learnt even_l, lamp_l;
+    even_l.mean = cv::Mat::zeros(kH, kW, CV_32FC1);
+    even_l.var = cv::Mat::zeros(kH, kW, CV_32FC1);
+    lamp_l.mean = even_l.mean.clone();
+    lamp_l.var = even_l.var.clone();
+    for (int k = 1; k <= n; ++k) {
+      const cv::Mat a = coarse(rng);
+      photometric_learn_reference(a, 1.0f / static_cast<float>(k), &even_l.mean, &even_l.var);
+      photometric_learn_reference(cv::Mat(a.mul(gain)), 1.0f / static_cast<float>(k), &lamp_l.mean, &lamp_l.var);
+    }
+    const PhotometricFit even_fit = fit_photometric(even_l.mean, even_l.var, valid, n, o);
+    const PhotometricFit lamp_fit = fit_photometric(lamp_l.mean, lamp_l.var, valid, n, o);
+    EXPECT_TRUE(even_fit.identity) << n << " frames";
+    EXPECT_FALSE(lamp_fit.identity) << n << " frames";
+    if (n == 8) {
+      // The same statistics judged as settled ones: their noise alone passes the 6 %.
+      EXPECT_FALSE(fit_photometric(even_l.mean, even_l.var, valid, kPhotometricSettledFrames, o).identity);
+    }
+  }
+}
+
 TEST(Photometric, SaturatedAndStaticPixelsHaveNoValue) {
   std::mt19937 rng(6);
   cv::Mat gain, add;
