@@ -358,26 +358,12 @@ cv::Mat photometric_rolling_reference(const cv::Mat& raw, const PhotometricFit& 
   if (warp.width != raw.cols || warp.height != raw.rows || warp.nodes_x < 2 || warp.nodes_y < 2 ||
       warp.light.size() != 2 * static_cast<size_t>(warp.nodes_x) * static_cast<size_t>(warp.nodes_y))
     throw_invalid_argument("photometric_rolling_reference: the row warp is not for this image's size");
-  const float sat = static_cast<float>(saturation), inv_step = 1.0f / static_cast<float>(warp.step);
+  const float sat = static_cast<float>(saturation);
   const int w = raw.cols, h = raw.rows;
-  const float* g = warp.light.data();
   cv::Mat out(raw.size(), CV_32FC1);
   for (int y = 0; y < h; ++y) {
-    const float gy = static_cast<float>(y) * inv_step;
-    const int j = std::min(static_cast<int>(gy), warp.nodes_y - 2);
-    const float ay = gy - static_cast<float>(j);
     for (int x = 0; x < w; ++x) {
-      const float gx = static_cast<float>(x) * inv_step;
-      const int i = std::min(static_cast<int>(gx), warp.nodes_x - 2);
-      const float ax = gx - static_cast<float>(i);
-      const size_t n00 = 2 * (static_cast<size_t>(j) * static_cast<size_t>(warp.nodes_x) + static_cast<size_t>(i));
-      const size_t n10 = n00 + 2 * static_cast<size_t>(warp.nodes_x);
-      float d[2];
-      for (int c = 0; c < 2; ++c) {  // between the node rows first, as the kernel
-        const float left = g[n00 + c] + ay * (g[n10 + c] - g[n00 + c]);
-        const float right = g[n00 + 2 + c] + ay * (g[n10 + 2 + c] - g[n00 + 2 + c]);
-        d[c] = left + ax * (right - left);
-      }
+      const Eigen::Vector2f d = row_warp_at(warp, warp.light, x, y);
       const float qx = std::clamp(static_cast<float>(x) + d[0], 0.0f, static_cast<float>(w - 1));
       const float qy = std::clamp(static_cast<float>(y) + d[1], 0.0f, static_cast<float>(h - 1));
       const int x0 = std::min(static_cast<int>(qx), w - 2), y0 = std::min(static_cast<int>(qy), h - 2);

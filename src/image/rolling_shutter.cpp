@@ -123,6 +123,26 @@ bool RowWarp::identity() const {
   return std::all_of(delta.begin(), delta.end(), zero) && std::all_of(light.begin(), light.end(), zero);
 }
 
+Eigen::Vector2f row_warp_at(const RowWarp& warp, const std::vector<float>& field, int u, int v) {
+  const float inv_step = 1.0f / static_cast<float>(warp.step);
+  const float gy = static_cast<float>(v) * inv_step;
+  const int j = std::min(static_cast<int>(gy), warp.nodes_y - 2);
+  const float ay = gy - static_cast<float>(j);
+  const float gx = static_cast<float>(u) * inv_step;
+  const int i = std::min(static_cast<int>(gx), warp.nodes_x - 2);
+  const float ax = gx - static_cast<float>(i);
+  const size_t n00 = 2 * (static_cast<size_t>(j) * static_cast<size_t>(warp.nodes_x) + static_cast<size_t>(i));
+  const size_t n10 = n00 + 2 * static_cast<size_t>(warp.nodes_x);
+  const float* g = field.data();
+  Eigen::Vector2f d;
+  for (int c = 0; c < 2; ++c) {  // between the node rows first, as the kernels
+    const float left = g[n00 + c] + ay * (g[n10 + c] - g[n00 + c]);
+    const float right = g[n00 + 2 + c] + ay * (g[n10 + 2 + c] - g[n00 + 2 + c]);
+    d[c] = left + ax * (right - left);
+  }
+  return d;
+}
+
 RowWarp identity_row_warp(int width, int height, int step) {
   if (width < 1 || height < 1 || step < 8)
     throw_invalid_argument("identity_row_warp: the size must be positive and the step at least 8");
@@ -216,26 +236,11 @@ cv::Mat undistort_rolling_reference(const cv::Mat& gray, const CameraModel& came
   const float min_x = static_cast<float>(roi.x), min_y = static_cast<float>(roi.y);
   const float max_x = static_cast<float>(roi.x + roi.width - 1), max_y = static_cast<float>(roi.y + roi.height - 1);
   const int w = camera.width, h = camera.height;
-  const float inv_step = 1.0f / static_cast<float>(warp.step);
-  const float* g = warp.delta.data();
   cv::Mat out(h, w, CV_32FC1);
   for (int v = 0; v < h; ++v) {
     float* dst = out.ptr<float>(v);
-    const float gy = static_cast<float>(v) * inv_step;
-    const int j = std::min(static_cast<int>(gy), warp.nodes_y - 2);
-    const float ay = gy - static_cast<float>(j);
     for (int u = 0; u < w; ++u) {
-      const float gx = static_cast<float>(u) * inv_step;
-      const int i = std::min(static_cast<int>(gx), warp.nodes_x - 2);
-      const float ax = gx - static_cast<float>(i);
-      const size_t n00 = 2 * (static_cast<size_t>(j) * static_cast<size_t>(warp.nodes_x) + static_cast<size_t>(i));
-      const size_t n10 = n00 + 2 * static_cast<size_t>(warp.nodes_x);
-      float d[2];
-      for (int c = 0; c < 2; ++c) {  // between the node rows first, as the kernel
-        const float left = g[n00 + c] + ay * (g[n10 + c] - g[n00 + c]);
-        const float right = g[n00 + 2 + c] + ay * (g[n10 + 2 + c] - g[n00 + 2 + c]);
-        d[c] = left + ax * (right - left);
-      }
+      const Eigen::Vector2f d = row_warp_at(warp, warp.delta, u, v);
       const size_t p = static_cast<size_t>(v) * static_cast<size_t>(w) + static_cast<size_t>(u);
       const float sx = map.map_x[p] + d[0], sy = map.map_y[p] + d[1];
       if (!(sx >= min_x && sx <= max_x && sy >= min_y && sy <= max_y)) {

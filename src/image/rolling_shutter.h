@@ -62,6 +62,11 @@ struct RowWarp {
   bool identity() const;
 };
 
+// One of the warp's fields (RowWarp::delta or RowWarp::light) at pixel (u, v), interpolated as
+// the kernels interpolate it, in their float arithmetic: bilinearly at (u / step, v / step), the
+// cell clamped to the grid, between the node rows first.
+Eigen::Vector2f row_warp_at(const RowWarp& warp, const std::vector<float>& field, int u, int v);
+
 // The identity for a width x height camera (InvalidArgument for sizes < 1 or step < 8).
 RowWarp identity_row_warp(int width, int height, int step = kRowWarpStep);
 
