@@ -18,13 +18,13 @@ namespace {
 
 constexpr int kW = 160, kH = 120;
 
-// A floor texture: smoothed noise, mean 128, standard deviation about 35 grey levels.
-cv::Mat albedo(std::mt19937& rng) {
+// A floor texture: noise smoothed over `blur` pixels, mean 128, standard deviation 35 grey levels.
+cv::Mat albedo(std::mt19937& rng, double blur = 1.0) {
   cv::Mat a(kH, kW, CV_32FC1);
   std::normal_distribution<float> n(0.0f, 1.0f);
   for (int y = 0; y < kH; ++y)
     for (int x = 0; x < kW; ++x) a.at<float>(y, x) = n(rng);
-  cv::GaussianBlur(a, a, cv::Size(0, 0), 1.0);
+  cv::GaussianBlur(a, a, cv::Size(0, 0), blur);
   cv::Scalar mean, sd;
   cv::meanStdDev(a, mean, sd);
   return (a - mean[0]) * (35.0 / sd[0]) + 128.0;
@@ -109,16 +109,6 @@ TEST(Photometric, FitTakesTheLightOut) {
 // the settled rule's 6 %: the young rule must keep the identity there, and still see a lamp's
 // falloff (a spread of 0.75) at once.
 TEST(Photometric, YoungStatisticsTellALampFromTheirNoise) {
-  auto coarse = [](std::mt19937& rng) {
-    cv::Mat a(kH, kW, CV_32FC1);
-    std::normal_distribution<float> n(0.0f, 1.0f);
-    for (int y = 0; y < kH; ++y)
-      for (int x = 0; x < kW; ++x) a.at<float>(y, x) = n(rng);
-    cv::GaussianBlur(a, a, cv::Size(0, 0), 1.5);
-    cv::Scalar mean, sd;
-    cv::meanStdDev(a, mean, sd);
-    return cv::Mat((a - mean[0]) * (35.0 / sd[0]) + 128.0);
-  };
   cv::Mat gain, add;
   light(&gain, &add);
   const cv::Mat valid(kH, kW, CV_8UC1, cv::Scalar(1));
@@ -132,7 +122,7 @@ TEST(Photometric, YoungStatisticsTellALampFromTheirNoise) {
     lamp_l.mean = even_l.mean.clone();
     lamp_l.var = even_l.var.clone();
     for (int k = 1; k <= n; ++k) {
-      const cv::Mat a = coarse(rng);
+      const cv::Mat a = albedo(rng, 1.5);
       photometric_learn_reference(a, 1.0f / static_cast<float>(k), &even_l.mean, &even_l.var);
       photometric_learn_reference(cv::Mat(a.mul(gain)), 1.0f / static_cast<float>(k), &lamp_l.mean, &lamp_l.var);
     }

@@ -53,11 +53,29 @@ cv::Mat to_gray(const cv::Mat& f) {
   return g;
 }
 
+// The robot's pose at each sensor row's read: P exp(tau_r twist), tau_r = r / (H - 1) * readout.
+std::vector<SE2> row_poses(const SE2& P, const Eigen::Vector3d& twist, double readout, int height) {
+  std::vector<SE2> rows(static_cast<size_t>(height));
+  for (int r = 0; r < height; ++r)
+    rows[static_cast<size_t>(r)] = P * SE2::exp(twist * (static_cast<double>(r) / (height - 1) * readout));
+  return rows;
+}
+
 struct Case {
   int configuration;
   Eigen::Vector3d twist;  // vx, vy, omega
   double readout;
 };
+
+// A 320 x 240 camera with the case's readout at the case's paper configuration.
+sim::Options case_options(const Case& c) {
+  sim::Options o;
+  o.camera = sim::default_camera(320, 240);
+  o.camera.rolling_shutter_readout = c.readout;
+  o.extrinsics = sim::paper_configuration(c.configuration);
+  o.supersampling = 2;
+  return o;
+}
 
 TEST(RollingShutter, UndistortedFrameIsTheGlobalShuttersAtTheStamp) {
   ocl::Runtime rt;
@@ -66,16 +84,10 @@ TEST(RollingShutter, UndistortedFrameIsTheGlobalShuttersAtTheStamp) {
                         {2, {1.0, 0.0, -0.8}, 0.03},  // a tilted, yawed camera
                         {3, {2.5, 0.0, 0.3}, 0.02}};  // configuration 3 at speed
   for (const Case& c : cases) {
-    sim::Options o;
-    o.camera = sim::default_camera(320, 240);
-    o.camera.rolling_shutter_readout = c.readout;
-    o.extrinsics = sim::paper_configuration(c.configuration);
-    o.supersampling = 2;
+    sim::Options o = case_options(c);
     sim::Renderer renderer(rt, smooth_texture(1024, 5 + static_cast<uint64_t>(c.configuration)), o);
     const SE2 P(0.11, -0.04, 0.3);
-    std::vector<SE2> rows(static_cast<size_t>(o.camera.height));
-    for (int r = 0; r < o.camera.height; ++r)
-      rows[static_cast<size_t>(r)] = P * SE2::exp(c.twist * (static_cast<double>(r) / (o.camera.height - 1) * c.readout));
+    const std::vector<SE2> rows = row_poses(P, c.twist, c.readout, o.camera.height);
     const cv::Mat rolling = to_gray(renderer.render_float_rows(rows));
     const cv::Mat global = to_gray(renderer.render_float(P));
     const UndistortMap map = compute_undistort_map(o.camera);
@@ -110,18 +122,12 @@ TEST(RollingShutter, TheLightStaysOnTheCamerasPixels) {
   ocl::Runtime rt;
   const Case cases[] = {{1, {0.8, 0.0, 1.5}, 0.025}, {2, {1.0, 0.0, -0.8}, 0.03}};
   for (const Case& c : cases) {
-    sim::Options o;
-    o.camera = sim::default_camera(320, 240);
-    o.camera.rolling_shutter_readout = c.readout;
-    o.extrinsics = sim::paper_configuration(c.configuration);
-    o.supersampling = 2;
+    sim::Options o = case_options(c);
     o.lamp_falloff = 0.6;
     o.shadow = 0.6;
     sim::Renderer renderer(rt, smooth_texture(1024, 9 + static_cast<uint64_t>(c.configuration)), o);
     const SE2 P(0.05, 0.02, -0.2);
-    std::vector<SE2> rows(static_cast<size_t>(o.camera.height));
-    for (int r = 0; r < o.camera.height; ++r)
-      rows[static_cast<size_t>(r)] = P * SE2::exp(c.twist * (static_cast<double>(r) / (o.camera.height - 1) * c.readout));
+    const std::vector<SE2> rows = row_poses(P, c.twist, c.readout, o.camera.height);
     const sim::Lighting light = sim::camera_lighting(o);
     cv::Mat lit = renderer.render_float_rows(rows);
     sim::apply_lighting(light, lit);
