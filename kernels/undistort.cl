@@ -25,7 +25,7 @@
 #define UNDISTORT_WG_Y 4
 #endif
 
-// PV_INVALID and pv_store_head come from kernels/common.cl.
+// PV_INVALID, pv_store_head and pv_load_head come from kernels/common.cl.
 
 __kernel __attribute__((reqd_work_group_size(UNDISTORT_WG_X, UNDISTORT_WG_Y, 1)))
 void undistort(__global const uchar* src, __global const int* index,
@@ -99,8 +99,9 @@ void photometric(__global const float* raw, __global const float* model, const f
 // each pixel is. `undistort_rolling` reads output pixel p from camera pixel distort(H_r p), which
 // the model (per undistorted pixel of a global shutter) has at q = p + light(p); light is the
 // row warp's second field (RowWarp::light), interpolated as `undistort_rolling` interpolates its
-// first (between the node rows first). The model is sampled bilinearly at q clamped to the
-// image; a pixel has no value where any of the four taps' scale is 0.
+// first (between the node rows first). The model is read at the pixel nearest q clamped to the
+// image (two gathers a pixel, where bilinear sampling takes eight); a pixel has no value where
+// that one's scale is 0.
 //
 //   raw      width x height floats (PV_INVALID where no source): undistort_rolling's output
 //   model    2 planes of width x height floats: scale, then offset
@@ -119,29 +120,38 @@ void photometric_rolling(__global const float* raw, __global const float* model,
   const float gy = (float)y * inv_step;
   const int j = min((int)gy, nodes_y - 2);
   const float ay = gy - (float)j;
+  // The light field at the eight pixels, as undistort_rolling reads its grid (three node columns
+  // from the first lane's; lanes past the row's end are computed, not stored).
+  const float8 gx = convert_float8((int8)(x) + (int8)(0, 1, 2, 3, 4, 5, 6, 7)) * inv_step;
+  const int8 cell = min(convert_int8(gx), (int8)(nodes_x - 2));
+  const float8 ax = gx - convert_float8(cell);
+  const int i0 = cell.s0, i2 = min(i0 + 2, nodes_x - 1);
   const int g0 = j * nodes_x, g1 = g0 + nodes_x;
-  const int end = min(x + 8, width);
-  for (int u = x; u < end; ++u) {
-    const int p = y * width + u;
-    const float v = raw[p];
-    const float gx = (float)u * inv_step;
-    const int i = min((int)gx, nodes_x - 2);
-    const float ax = gx - (float)i;
-    const float2 left = light[g0 + i] + ay * (light[g1 + i] - light[g0 + i]);
-    const float2 right = light[g0 + i + 1] + ay * (light[g1 + i + 1] - light[g0 + i + 1]);
-    const float2 d = left + ax * (right - left);
-    const float qx = clamp((float)u + d.x, 0.0f, (float)(width - 1));
-    const float qy = clamp((float)y + d.y, 0.0f, (float)(height - 1));
-    const int x0 = min((int)qx, max(width - 2, 0)), y0 = min((int)qy, max(height - 2, 0));
-    const float fx = qx - (float)x0, fy = qy - (float)y0;
-    const int t = y0 * width + x0;
-    const float s00 = model[t], s01 = model[t + 1], s10 = model[t + width], s11 = model[t + width + 1];
-    const float o00 = model[n + t], o01 = model[n + t + 1], o10 = model[n + t + width], o11 = model[n + t + width + 1];
-    const float scale = (1.0f - fy) * ((1.0f - fx) * s00 + fx * s01) + fy * ((1.0f - fx) * s10 + fx * s11);
-    const float offset = (1.0f - fy) * ((1.0f - fx) * o00 + fx * o01) + fy * ((1.0f - fx) * o10 + fx * o11);
-    const bool use = v > 0.5f * PV_INVALID && v < saturation && min(min(s00, s01), min(s10, s11)) > 0.0f;
-    dst[p] = use ? v * scale + offset : PV_INVALID;
-  }
+  const float2 c0 = light[g0 + i0] + ay * (light[g1 + i0] - light[g0 + i0]);
+  const float2 c1 = light[g0 + i0 + 1] + ay * (light[g1 + i0 + 1] - light[g0 + i0 + 1]);
+  const float2 c2 = light[g0 + i2] + ay * (light[g1 + i2] - light[g0 + i2]);
+  const int8 second = cell > (int8)(i0);
+  const float8 lx = select((float8)(c0.x), (float8)(c1.x), second), rx = select((float8)(c1.x), (float8)(c2.x), second);
+  const float8 ly = select((float8)(c0.y), (float8)(c1.y), second), ry = select((float8)(c1.y), (float8)(c2.y), second);
+  const float8 u = convert_float8((int8)(x) + (int8)(0, 1, 2, 3, 4, 5, 6, 7));
+  const float8 qx = clamp(u + (lx + ax * (rx - lx)), 0.0f, (float)(width - 1));
+  const float8 qy = clamp((float8)((float)y) + (ly + ax * (ry - ly)), 0.0f, (float)(height - 1));
+  // The nearest model pixel: the model is smooth over tens of pixels (a box of the image's width
+  // / 40), so half a pixel changes it by under 0.1 %; where it is not (a shadow's edge) it has
+  // no value.
+  const int8 t = convert_int8(qy + 0.5f) * width + convert_int8(qx + 0.5f);
+  float8 scale, offset;
+#define PR_GATHER(k) scale.s##k = model[t.s##k]; offset.s##k = model[n + t.s##k];
+  PR_GATHER(0) PR_GATHER(1) PR_GATHER(2) PR_GATHER(3) PR_GATHER(4) PR_GATHER(5) PR_GATHER(6) PR_GATHER(7)
+#undef PR_GATHER
+  const int p = y * width + x;
+  const float8 v = x + 8 <= width ? vload8(0, raw + p) : pv_load_head(raw + p, width - x, PV_INVALID);
+  const int8 use = (v > (float8)(0.5f * PV_INVALID)) & (v < (float8)(saturation)) & (scale > (float8)(0.0f));
+  const float8 value = select((float8)(PV_INVALID), v * scale + offset, use);
+  if (x + 8 <= width)
+    vstore8(value, 0, dst + p);
+  else
+    pv_store_head(value, dst + p, width - x);
 }
 
 // The photometric model's statistics (plain C++ reference: photometric_learn_reference): from

@@ -366,18 +366,11 @@ cv::Mat photometric_rolling_reference(const cv::Mat& raw, const PhotometricFit& 
       const Eigen::Vector2f d = row_warp_at(warp, warp.light, x, y);
       const float qx = std::clamp(static_cast<float>(x) + d[0], 0.0f, static_cast<float>(w - 1));
       const float qy = std::clamp(static_cast<float>(y) + d[1], 0.0f, static_cast<float>(h - 1));
-      const int x0 = std::min(static_cast<int>(qx), w - 2), y0 = std::min(static_cast<int>(qy), h - 2);
-      const float fx = qx - static_cast<float>(x0), fy = qy - static_cast<float>(y0);
-      auto sample = [&](const cv::Mat& m) {
-        const float* top = m.ptr<float>(y0) + x0;
-        const float* bottom = m.ptr<float>(y0 + 1) + x0;
-        return (1.0f - fy) * ((1.0f - fx) * top[0] + fx * top[1]) + fy * ((1.0f - fx) * bottom[0] + fx * bottom[1]);
-      };
-      const float* s0 = fit.scale.ptr<float>(y0) + x0;
-      const float* s1 = fit.scale.ptr<float>(y0 + 1) + x0;
+      const int mx = static_cast<int>(qx + 0.5f), my = static_cast<int>(qy + 0.5f);
+      const float scale = fit.scale.at<float>(my, mx), offset = fit.offset.at<float>(my, mx);
       const float v = raw.at<float>(y, x);
-      const bool use = v > 0.5f * kInvalidIntensity && v < sat && std::min({s0[0], s0[1], s1[0], s1[1]}) > 0.0f;
-      out.at<float>(y, x) = use ? v * sample(fit.scale) + sample(fit.offset) : kInvalidIntensity;
+      const bool use = v > 0.5f * kInvalidIntensity && v < sat && scale > 0.0f;
+      out.at<float>(y, x) = use ? v * scale + offset : kInvalidIntensity;
     }
   }
   return out;

@@ -128,10 +128,8 @@ void write_flat_field(const std::string& path, const cv::Mat& gain);
 // (kInvalidIntensity where not valid) -> corrected.
 cv::Mat photometric_reference(const cv::Mat& raw, const PhotometricFit& fit, double saturation);
 // Plain C++ reference of the `photometric_rolling` kernel: raw is undistort_rolling_reference's
-// output for `warp`; the model is sampled bilinearly at p + the warp's light field (interpolated
-// as undistort_rolling_reference interpolates its displacement), clamped to the image, and has
-// no value where any of its four taps' scale is 0 (with the identity warp: photometric_reference
-// but for the pixels beside one without a value).
+// output for `warp`; the model is read at the pixel nearest p + the warp's light field
+// (row_warp_at), clamped to the image (with the identity warp: photometric_reference).
 cv::Mat photometric_rolling_reference(const cv::Mat& raw, const PhotometricFit& fit, const RowWarp& warp,
                                       double saturation);
 // Plain C++ reference of the `photometric_learn` kernel: updates the mean and mean square

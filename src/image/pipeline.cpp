@@ -395,9 +395,10 @@ struct ImagePipeline::Impl {
     undistorted_source = &source;
     undistorted_rolling = !r.identity;
     if (photometric) {
-      // The light is fixed to the camera's pixels, which the row warp moves (RowWarp::light).
+      // The light is fixed to the camera's pixels, which the row warp moves (RowWarp::light); an
+      // identity model is the same everywhere.
       const float saturation = static_cast<float>(photometric->options().saturation);
-      if (r.identity)
+      if (r.identity || photometric->fit().identity)
         kernels.photometric(uncorrected, photometric->model(), saturation, w(0), h(0), level0);
       else
         kernels.photometric_rolling(uncorrected, photometric->model(), r.buffer, r.warp, saturation, level0);

@@ -451,25 +451,14 @@ TEST(PipelineKernels, PhotometricRollingMatchesReference) {
       const std::vector<float> k = download(rt, dst, n);
       const cv::Mat ref = photometric_rolling_reference(raw, fit, warp, 200.0);
       if (!moving) {
-        // At rest the model is read at each pixel itself: photometric's value wherever the
-        // pixel and its right and lower neighbours have one.
-        const cv::Mat plain = photometric_reference(raw, fit, 200.0);
-        size_t differ = 0, kept = 0;
-        for (int y = 0; y < s[1]; ++y)
-          for (int x = 0; x < s[0]; ++x)
-            if (ref.at<float>(y, x) != kInvalidIntensity) {
-              ++kept;
-              differ += ref.at<float>(y, x) != plain.at<float>(y, x);
-            }
-        EXPECT_EQ(differ, 0u) << what;
-        EXPECT_GT(kept, n / 5) << what;  // a 20 x 13 image is mostly invalid blobs
+        // At rest the model is read at each pixel itself: photometric's correction exactly.
+        EXPECT_EQ(cv::norm(ref, photometric_reference(raw, fit, 200.0), cv::NORM_INF), 0.0) << what;
         expect_intensity_matches(k, ref, what);
         continue;
       }
       // The light field's interpolation may round differently (contracted multiply-adds): the
-      // model's coordinate by an ulp (6e-5 px near 640), which across this random model's
-      // neighbour jumps (3 in scale, 200 in offset) is up to 0.05 grey levels, and a tap rounded
-      // across a pixel's edge may change a rare pixel's validity.
+      // model's coordinate by an ulp (6e-5 px near 640), which moves a rare coordinate across
+      // the middle between two pixels, and this random model differs between neighbours.
       size_t unwritten = 0, validity = 0, off = 0, valid = 0, overrun = 0;
       double worst = 0.0;
       for (size_t i = 0; i < n; ++i) {
@@ -479,14 +468,14 @@ TEST(PipelineKernels, PhotometricRollingMatchesReference) {
         else if (want != kInvalidIntensity) {
           ++valid;
           worst = std::max(worst, std::abs(static_cast<double>(got) - want));
-          off += !(std::abs(static_cast<double>(got) - want) <= 0.06);
+          off += !(std::abs(static_cast<double>(got) - want) <= kTolerance);
         }
       }
       for (size_t i = n; i < k.size(); ++i) overrun += k[i] != kPoison;
       EXPECT_EQ(unwritten, 0u) << what;
       EXPECT_EQ(overrun, 0u) << what;
       EXPECT_LE(validity, n / 10000) << what;
-      EXPECT_EQ(off, 0u) << what << ": worst difference " << worst;
+      EXPECT_LE(off, n / 10000) << what << ": worst difference " << worst;
       EXPECT_GT(valid, n / 3) << what;
     }
 }

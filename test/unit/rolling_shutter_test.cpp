@@ -278,5 +278,73 @@ TEST(RollingShutter, PipelineUsesEachFramesRowWarp) {
   EXPECT_THROW(pipeline.set_row_warp(identity_row_warp(cam.width, cam.height + 1)), Error);
 }
 
+// The pipeline with a photometric model (a known one, so that nothing is learnt) and a row warp:
+// level 0 is the rolling undistortion corrected through the warp's light field
+// (photometric_rolling_reference), for the frame and for the kept frame with its own warp; an
+// identity model, or an identity warp, is the plain correction.
+TEST(RollingShutter, PipelineReadsTheLightThroughEachFramesWarp) {
+  ocl::Runtime rt;
+  CameraModel cam = sim::default_camera(160, 120);
+  cam.k1 = -0.08;
+  cam.rolling_shutter_readout = 0.03;
+  const Extrinsics e = sim::paper_configuration(1);
+  const UndistortMap map = compute_undistort_map(cam);
+  ImagePipelineOptions po;
+  po.prefilter = false;
+  po.photometric.enabled = true;
+  ImagePipeline pipeline(rt, cam, 2, po);
+  ASSERT_NE(pipeline.photometric(), nullptr);
+  // A smooth falloff with a hole (no value) and a sharp step: both move with the warp.
+  PhotometricFit fit = identity_photometric(cam.width, cam.height);
+  fit.identity = false;
+  for (int y = 0; y < cam.height; ++y)
+    for (int x = 0; x < cam.width; ++x) {
+      fit.scale.at<float>(y, x) = 1.0f + 0.004f * static_cast<float>(std::hypot(x - 80, y - 50)) + (y > 90 ? 1.0f : 0.0f);
+      fit.offset.at<float>(y, x) = y > 90 ? -20.0f : 0.0f;
+    }
+  cv::circle(fit.scale, cv::Point(40, 40), 6, cv::Scalar(0.0f), cv::FILLED);
+  pipeline.photometric()->set(fit);
+  cv::Mat a, b;
+  smooth_texture(cam.width, 3)(cv::Rect(0, 0, cam.width, cam.height)).convertTo(a, CV_8UC1);
+  smooth_texture(cam.width, 4)(cv::Rect(0, 0, cam.width, cam.height)).convertTo(b, CV_8UC1);
+  const RowWarp wa = rolling_shutter_warp(cam, e, Eigen::Vector3d(1.0, 0.0, 0.5));
+  const RowWarp wb = rolling_shutter_warp(cam, e, Eigen::Vector3d(-0.7, 0.1, -1.0));
+  const double sat = pipeline.photometric()->options().saturation;
+  auto level0 = [&](const Pyramid& p) {
+    std::vector<cv::Mat> ch;
+    cv::split(download_pyramid(rt, p)[0], ch);
+    cv::Mat i = ch[0].clone();
+    for (int y = 0; y < i.rows; ++y)
+      for (int x = 0; x < i.cols; ++x)
+        if (ch[3].at<float>(y, x) == 0.0f) i.at<float>(y, x) = kInvalidIntensity;
+    return i;
+  };
+  auto expect_matches = [&](const cv::Mat& got, const cv::Mat& want, const std::string& what) {
+    size_t n = 0;
+    EXPECT_LT(mean_abs_diff(got, want, 1, &n), 0.01) << what;
+    EXPECT_GT(n, got.total() / 2) << what;
+  };
+  auto corrected = [&](const cv::Mat& frame, const RowWarp& w) {
+    return photometric_rolling_reference(undistort_rolling_reference(frame, cam, map, w), fit, w, sat);
+  };
+  Pyramid out;
+  pipeline.set_row_warp(wa);
+  pipeline.process(a, out);
+  const cv::Mat got_a = level0(out);
+  expect_matches(got_a, corrected(a, wa), "the frame, through its warp's light field");
+  // The light read in place would differ (the step and the hole moved by the warp).
+  size_t n = 0;
+  EXPECT_GT(mean_abs_diff(got_a, photometric_reference(undistort_rolling_reference(a, cam, map, wa), fit, sat), 1, &n), 1.0);
+  pipeline.keep();
+  pipeline.set_row_warp(wb);
+  pipeline.process(b, out);
+  expect_matches(level0(out), corrected(b, wb), "the next frame, its own warp");
+  pipeline.reprocess_kept(out);
+  expect_matches(level0(out), corrected(a, wa), "the kept frame keeps its warp's light field");
+  pipeline.set_row_warp(identity_row_warp(cam.width, cam.height));
+  pipeline.reprocess(out);
+  expect_matches(level0(out), photometric_reference(undistort_reference(b, map), fit, sat), "the identity warp");
+}
+
 }  // namespace
 }  // namespace planarvo
