@@ -94,6 +94,33 @@ void photometric(__global const float* raw, __global const float* model, const f
   }
 }
 
+// A row warp's field (RowWarp::delta or RowWarp::light, nodes_x x nodes_y float2, row-major) at
+// the eight pixels (x .. x + 7, y), interpolated bilinearly as row_warp_at (rolling_shutter.h):
+// (dx of the eight, dy of the eight). Eight pixels span at most two cells of a grid with a step
+// of 8 or more, so the grid is read at three node columns from the first lane's, interpolated
+// between the two rows first; lanes past the row's end are computed, not stored.
+inline float16 pv_row_warp8(__global const float2* field, const int nodes_x, const int nodes_y,
+                            const float inv_step, const int x, const int y) {
+  const float gy = (float)y * inv_step;
+  const int j = min((int)gy, nodes_y - 2);
+  const float ay = gy - (float)j;
+  const float8 gx = convert_float8((int8)(x) + (int8)(0, 1, 2, 3, 4, 5, 6, 7)) * inv_step;
+  const int8 cell = min(convert_int8(gx), (int8)(nodes_x - 2));
+  const float8 ax = gx - convert_float8(cell);
+  const int i0 = cell.s0, i2 = min(i0 + 2, nodes_x - 1);
+  const int g0 = j * nodes_x, g1 = g0 + nodes_x;
+  const float2 c0 = field[g0 + i0] + ay * (field[g1 + i0] - field[g0 + i0]);
+  const float2 c1 = field[g0 + i0 + 1] + ay * (field[g1 + i0 + 1] - field[g0 + i0 + 1]);
+  const float2 c2 = field[g0 + i2] + ay * (field[g1 + i2] - field[g0 + i2]);
+  const int8 second = cell > (int8)(i0);  // the lane lies in the next cell
+  const float8 lx = select((float8)(c0.x), (float8)(c1.x), second), rx = select((float8)(c1.x), (float8)(c2.x), second);
+  const float8 ly = select((float8)(c0.y), (float8)(c1.y), second), ry = select((float8)(c1.y), (float8)(c2.y), second);
+  float16 d;
+  d.lo = lx + ax * (rx - lx);
+  d.hi = ly + ax * (ry - ly);
+  return d;
+}
+
 // The photometric correction of a rolling-shutter frame (plain C++ reference:
 // photometric_rolling_reference): as `photometric`, but the model is read where the light of
 // each pixel is. `undistort_rolling` reads output pixel p from camera pixel distort(H_r p), which
@@ -116,26 +143,11 @@ void photometric_rolling(__global const float* raw, __global const float* model,
   const int y = (int)get_global_id(1);
   if (x >= width || y >= height) return;
   const int n = width * height;
-  __global const float2* light = grid + nodes_x * nodes_y;
-  const float gy = (float)y * inv_step;
-  const int j = min((int)gy, nodes_y - 2);
-  const float ay = gy - (float)j;
-  // The light field at the eight pixels, as undistort_rolling reads its grid (three node columns
-  // from the first lane's; lanes past the row's end are computed, not stored).
-  const float8 gx = convert_float8((int8)(x) + (int8)(0, 1, 2, 3, 4, 5, 6, 7)) * inv_step;
-  const int8 cell = min(convert_int8(gx), (int8)(nodes_x - 2));
-  const float8 ax = gx - convert_float8(cell);
-  const int i0 = cell.s0, i2 = min(i0 + 2, nodes_x - 1);
-  const int g0 = j * nodes_x, g1 = g0 + nodes_x;
-  const float2 c0 = light[g0 + i0] + ay * (light[g1 + i0] - light[g0 + i0]);
-  const float2 c1 = light[g0 + i0 + 1] + ay * (light[g1 + i0 + 1] - light[g0 + i0 + 1]);
-  const float2 c2 = light[g0 + i2] + ay * (light[g1 + i2] - light[g0 + i2]);
-  const int8 second = cell > (int8)(i0);
-  const float8 lx = select((float8)(c0.x), (float8)(c1.x), second), rx = select((float8)(c1.x), (float8)(c2.x), second);
-  const float8 ly = select((float8)(c0.y), (float8)(c1.y), second), ry = select((float8)(c1.y), (float8)(c2.y), second);
+  // The light field at the eight pixels.
+  const float16 d = pv_row_warp8(grid + nodes_x * nodes_y, nodes_x, nodes_y, inv_step, x, y);
   const float8 u = convert_float8((int8)(x) + (int8)(0, 1, 2, 3, 4, 5, 6, 7));
-  const float8 qx = clamp(u + (lx + ax * (rx - lx)), 0.0f, (float)(width - 1));
-  const float8 qy = clamp((float8)((float)y) + (ly + ax * (ry - ly)), 0.0f, (float)(height - 1));
+  const float8 qx = clamp(u + d.lo, 0.0f, (float)(width - 1));
+  const float8 qy = clamp((float8)((float)y) + d.hi, 0.0f, (float)(height - 1));
   // The nearest model pixel: the model is smooth over tens of pixels (a box of the image's width
   // / 40), so half a pixel changes it by under 0.1 %; where it is not (a shadow's edge) it has
   // no value.
@@ -210,28 +222,13 @@ void undistort_rolling(__global const uchar* src, __global const float* map, __g
   const int x = (int)get_global_id(0) * 8;
   const int y = (int)get_global_id(1);
   if (x >= width || y >= height) return;
-  const float gy = (float)y * inv_step;
-  const int j = min((int)gy, nodes_y - 2);
-  const float ay = gy - (float)j;
-  // The eight pixels' grid cells and weights (lanes past the row's end are computed, not stored).
-  // Eight pixels span at most two cells of a grid with a step of 8 or more, so the grid is read at
-  // three node columns from the first lane's, interpolated between the two rows first.
-  const float8 gx = convert_float8((int8)(x) + (int8)(0, 1, 2, 3, 4, 5, 6, 7)) * inv_step;
-  const int8 cell = min(convert_int8(gx), (int8)(nodes_x - 2));
-  const float8 ax = gx - convert_float8(cell);
-  const int i0 = cell.s0, i2 = min(i0 + 2, nodes_x - 1);
-  const int g0 = j * nodes_x, g1 = g0 + nodes_x;
-  const float2 c0 = grid[g0 + i0] + ay * (grid[g1 + i0] - grid[g0 + i0]);
-  const float2 c1 = grid[g0 + i0 + 1] + ay * (grid[g1 + i0 + 1] - grid[g0 + i0 + 1]);
-  const float2 c2 = grid[g0 + i2] + ay * (grid[g1 + i2] - grid[g0 + i2]);
-  const int8 second = cell > (int8)(i0);  // the lane lies in the next cell
-  const float8 lx = select((float8)(c0.x), (float8)(c1.x), second), rx = select((float8)(c1.x), (float8)(c2.x), second);
-  const float8 ly = select((float8)(c0.y), (float8)(c1.y), second), ry = select((float8)(c1.y), (float8)(c2.y), second);
+  // The rolling shutter's displacement at the eight pixels.
+  const float16 d = pv_row_warp8(grid, nodes_x, nodes_y, inv_step, x, y);
   // The map's eight (x, y) pairs (the last work-item of a row may read into the next row: the
   // map is padded by 8 pairs).
   const float16 m = vload16(0, map + 2 * (y * width + x));
-  const float8 sx = m.even + (lx + ax * (rx - lx));
-  const float8 sy = m.odd + (ly + ax * (ry - ly));
+  const float8 sx = m.even + d.lo;
+  const float8 sy = m.odd + d.hi;
   const int8 valid = (sx >= (float8)(roi.x)) & (sx <= (float8)(roi.z)) & (sy >= (float8)(roi.y)) & (sy <= (float8)(roi.w));
   // The top-left tap clamped to the second-last column and row, where the weight of the right or
   // lower tap is then 1 (exactly the last pixel's value, as the reference's clamped taps give),

@@ -165,8 +165,8 @@ class PhotometricModel {
   float next_alpha();
   int frames() const;
   // A refit is due: learning, at least kPhotometricFirstFitFrames frames and a quarter more (at
-  // least 4) since the last fit; or, when the model is `needed` (the caller sees the light hold its alignments), at
-  // least min_frames frames and one more since the last fit.
+  // least 4) since the last fit; or, when the model is `needed` (the caller sees the light hold
+  // its alignments), at least min_frames frames and one more since the last fit.
   bool refit_due(bool needed = false) const;
   // Reads the statistics back (blocking), fits (fit_photometric) and uploads the model.
   void refit(bool needed = false);

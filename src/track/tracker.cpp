@@ -545,9 +545,7 @@ struct Tracker::Impl {
     }
     if (!photometric->refit_due(true)) return false;
     photometric->refit(true);
-    pipeline->reprocess_kept(keyframe);
-    pipeline->reprocess(slots[live_slot]);
-    select_keyframe_pixels();
+    correct_with_new_model();
     return true;
   }
 
@@ -567,6 +565,12 @@ struct Tracker::Impl {
     if (rough ? photometric->frames() - fit.frames < std::max(1, fit.frames / 4) : !photometric->refit_due()) return;
     photometric->refit(rough);
     if (!rough && photometric->fit().identity) return;
+    correct_with_new_model();
+  }
+
+  // The kept keyframe and the live frame corrected again with the model just fitted, so that
+  // they are corrected alike (the live frame's alignment starts afresh from them).
+  void correct_with_new_model() {
     pipeline->reprocess_kept(keyframe);
     pipeline->reprocess(slots[live_slot]);
     select_keyframe_pixels();
