@@ -52,6 +52,11 @@ struct RollPitchOptions {
   // (30 frames), and, when it is not the identity, the map started again with it. An evenly lit
   // camera keeps the identity, and its frames are what they were without the model.
   PhotometricOptions photometric;
+  // When a light was found, the map is complete only once the model's statistics hold
+  // light_frames frames in motion (or max_frames is reached): the model is then fitted again
+  // from all of them and every keyframe corrected with it before the joint alignment
+  // (the 30-frame model's noise pulls the orientation; src/calib/README.md).
+  int light_frames = 120;
   // The map: a frame becomes a keyframe when its overlap with the last one falls below this
   // (0.9: pairs a tenth of the view apart; at 0.7, a tilted camera's pairs span more than a camera
   // height, near and far field swap resolution between the two views and the pairs stop aligning,
@@ -66,6 +71,15 @@ struct RollPitchOptions {
   // (radians), at most max_rounds.
   int max_rounds = 4;
   double round_tolerance = 1e-5;
+  // A rolling shutter: the keyframes undistorted again with the measured motion and aligned again
+  // until roll and pitch move less than unroll_tolerance (radians), at most max_unrolls times.
+  int max_unrolls = 6;
+  double unroll_tolerance = 1e-4;
+  // The keyframes are aligned band-passed (image/band_pass.h): sigma at full resolution, level
+  // pixels; 0: as the pipeline made them. Under a lamp, a reflection and a shadow the light
+  // model's remaining error otherwise pulls roll by up to 1.5 degrees on a faint floor; on
+  // evenly lit drives it changes roll and pitch by under 0.02 degrees (src/calib/README.md).
+  double band_pass_sigma = 2.5;
   // A pair does not align when its residual's mean square stays above search_residual_ratio of
   // its keyframe's intensity variance (the tracker's "images do not match" level: unaligned pairs
   // measured 1.0-2.5; aligned ones 0.03-0.12 on textured floors and up to 0.48 on a low-texture
@@ -108,6 +122,7 @@ struct RollPitchResult {
   int keyframes = 0;
   int pairs = 0;         // keyframe pairs in the estimate (consecutive keyframes that align)
   int rounds = 0;        // joint alignments run (search included)
+  int unrolls = 0;       // a rolling shutter: times the keyframes were undistorted again
   int passes = 0;        // fused passes of the joint alignments
   double motion = 0.0;  // the camera's motion summed over the pairs: heights of translation + radians
   double residual_ratio = 0.0;  // worst pair's residual mean square over its keyframe's variance
