@@ -31,6 +31,8 @@ Extrinsics camera_frame(double roll, double pitch) { return Extrinsics{0.0, 0.0,
 
 // A camera motion counts as moving above these (camera heights, radians).
 constexpr double kMovedTranslation = 2e-3, kMovedRotation = 2e-3;
+// Rounds of each leave-one-out alignment (jackknife_covariance): it starts at the estimate.
+constexpr int kJackknifeRounds = 2;
 
 std::string degrees(double rad) {
   char b[32];
@@ -355,6 +357,38 @@ struct RollPitchEstimator::Impl {
     return true;
   }
 
+  // The jackknife over the pairs (Efron's delete-one): the orientation aligned again without each
+  // pair in turn, from the estimate; (n - 1) / n times the spread of
+  // the n results about their mean. It sees what is not the same in every pair (a keyframe's
+  // rolling-shutter twist, texture that aligns badly, the light's error where each pair puts it)
+  // and the analytic covariance, built on independent pixels, does not.
+  Eigen::Matrix2d jackknife_covariance(const Run& best, const AlignmentLevels& levels) {
+    const size_t n = best.pairs.size();
+    if (n < 3) return Eigen::Matrix2d::Zero();
+    // At the level above the finest: the pairs' influence is their geometry's and the light's, not
+    // the pixels' noise (measured on four drives: the same sigma within 25 %, except where the
+    // finest level's were smaller), at 40 % of the cost (1.3 s instead of 3.2 s at 640 x 480).
+    AlignmentLevels one = levels;
+    one.finest = std::min(levels.finest + 1, levels.coarsest);
+    one.coarsest = one.finest;
+    std::vector<Eigen::Vector2d> est;
+    for (size_t leave = 0; leave < n; ++leave) {
+      Run r;
+      for (size_t q = 0; q < n; ++q)
+        if (q != leave) r.pairs.push_back(best.pairs[q]);
+      r.ext = best.ext;
+      rounds(&r, one, kJackknifeRounds);
+      if (r.report.ok) est.emplace_back(r.ext.roll, r.ext.pitch);
+    }
+    if (est.size() < 3) return Eigen::Matrix2d::Zero();
+    Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+    for (const Eigen::Vector2d& e : est) mean += e;
+    mean /= static_cast<double>(est.size());
+    Eigen::Matrix2d c = Eigen::Matrix2d::Zero();
+    for (const Eigen::Vector2d& e : est) c += (e - mean) * (e - mean).transpose();
+    return c * (static_cast<double>(est.size() - 1) / static_cast<double>(est.size()));
+  }
+
   Run start(double roll, double pitch) {
     Run run;
     run.pairs = initial_pairs();
@@ -472,6 +506,17 @@ struct RollPitchEstimator::Impl {
     res.covariance = invertible ? Eigen::Matrix2d(opt.covariance_inflation * opt.covariance_inflation * s2 *
                                                   ldlt.solve(Eigen::Matrix2d::Identity()))
                                 : Eigen::Matrix2d::Identity() * 1e6;
+    if (opt.jackknife && invertible) {
+      // What the jackknife's covariance has beyond the analytic one (the positive part of their
+      // difference) is added: the sum covers both, and where they agree nothing changes.
+      const Eigen::Matrix2d jk = jackknife_covariance(best, levels);
+      const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> d(jk - res.covariance);
+      if (d.info() == Eigen::Success) {
+        const Eigen::Vector2d excess = d.eigenvalues().cwiseMax(0.0);
+        res.covariance += d.eigenvectors() * excess.asDiagonal() * d.eigenvectors().transpose();
+      }
+      res.jackknife_covariance = jk;
+    }
     const double worst_sigma = std::sqrt(std::max(res.covariance(0, 0), res.covariance(1, 1)));
     if (!(worst_sigma <= opt.max_sigma)) {
       res.status = RollPitchResult::Status::TooLittleMotion;

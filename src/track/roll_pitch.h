@@ -98,6 +98,11 @@ struct RollPitchOptions {
   // sigma was 1.95 for roll and 4.90 for pitch without inflation; 3 (in standard deviation) makes
   // it 0.65 and 1.63 (src/calib/README.md).
   double covariance_inflation = 3.0;
+  // Plus what the jackknife's over the pairs has beyond it (the positive part of their
+  // difference): the analytic one misses what differs from pair to pair. Under a lamp, a reflection, a
+  // shadow and a rolling shutter it claimed 3-14 times too little (brick_floor: 0.025 degrees
+  // off with sigma 0.003); on an evenly lit drive the two agree (src/calib/README.md).
+  bool jackknife = true;
   // Refusals: too little motion when the camera's motion summed over the pairs (camera heights of
   // translation plus radians of rotation) is below min_motion, or a standard deviation of roll
   // or pitch above max_sigma.
@@ -126,6 +131,9 @@ struct RollPitchResult {
   int passes = 0;        // fused passes of the joint alignments
   double motion = 0.0;  // the camera's motion summed over the pairs: heights of translation + radians
   double residual_ratio = 0.0;  // worst pair's residual mean square over its keyframe's variance
+  // The jackknife's covariance over the pairs (RollPitchOptions::jackknife; zero when off or
+  // fewer than 3 pairs), rad^2.
+  Eigen::Matrix2d jackknife_covariance = Eigen::Matrix2d::Zero();
   double track_ms = 0.0, align_ms = 0.0;  // picking the keyframes, the joint alignment
   // The map: which frames (0-based, in the order fed) are its keyframes, and the camera's planar
   // motion of each pair in the estimate (reference keyframe index, live keyframe index, motion in
