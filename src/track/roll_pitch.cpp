@@ -238,7 +238,7 @@ struct RollPitchEstimator::Impl {
   // The light fitted at 30 frames is the map's from its start, but its statistics' noise is still
   // in it (the mean of a few dozen views of the floor at each pixel), and an error of the model
   // fixed to the camera pulls the joint alignment's orientation. The statistics go on to
-  // light_frames moving frames (light_learning): the model is fitted again from them and every
+  // light_frames moving frames (light_wants_frames): the model is fitted again from them and every
   // keyframe corrected with it, before the alignment (under a rolling shutter, a lamp, a
   // reflection and a shadow, anti_skid_tiles: roll 1.50 -> 0.94 degrees off on its own;
   // src/calib/README.md).
@@ -251,20 +251,21 @@ struct RollPitchEstimator::Impl {
     for (size_t k = 0; k < K; ++k) pipeline.process(keyframe_gray[k], keyframes[k]);
   }
 
-  // What the joint alignment aligns (image/band_pass.h): the smooth error the light model leaves
-  // fixed to the camera pulls the orientation in proportion to the floor's mean level squared.
+  // A keyframe undistorted again (unroll_keyframes) is band-passed as the others once the
+  // refinement has started (estimate; image/band_pass.h: the smooth error the light model leaves
+  // fixed to the camera pulls the orientation in proportion to the floor's mean level squared).
   void band_pass_keyframe(Pyramid& k) {
     if (band_passed) band_pass(rt, k, opt.band_pass_sigma);
   }
 
-  // The light found at the first fit still learning towards light_frames (final_light).
-  bool light_learning() {
+  // The light found at the first fit still wants frames, up to light_frames (final_light).
+  bool light_wants_frames() {
     const PhotometricModel* model = pipeline.photometric();
     return model && model->learning() && light_fitted && !model->fit().identity && model->frames() < opt.light_frames;
   }
 
   bool finish_frame(Clock::time_point t0) {
-    if (static_cast<int>(keyframes.size()) >= opt.max_keyframes && !light_learning()) done = true;
+    if (static_cast<int>(keyframes.size()) >= opt.max_keyframes && !light_wants_frames()) done = true;
     if (opt.max_frames > 0 && frames_moving >= opt.max_frames) done = true;
     track_ms += ms_since(t0);
     return done;
@@ -463,7 +464,7 @@ struct RollPitchEstimator::Impl {
     const double ratio_as_made = best.ratio;
     if (best.report.ok && opt.band_pass_sigma > 0.0 && !band_passed) {
       band_passed = true;
-      for (Pyramid& k : keyframes) band_pass_keyframe(k);
+      for (Pyramid& k : keyframes) band_pass(rt, k, opt.band_pass_sigma);
       const int r0 = best.rounds, p0 = best.passes;
       rounds(&best, levels, opt.max_rounds);
       res.rounds += best.rounds - r0;

@@ -243,11 +243,17 @@ void expect_matches(const cv::Mat& got, const cv::Mat& want, const std::string& 
   EXPECT_GT(n, got.total() / 2) << what;
 }
 
-TEST(RollingShutter, PipelineUsesEachFramesRowWarp) {
-  ocl::Runtime rt;
+// The pipeline tests' camera: small, distorted, read out over 30 ms.
+CameraModel pipeline_test_camera() {
   CameraModel cam = sim::default_camera(160, 120);
   cam.k1 = -0.08;
   cam.rolling_shutter_readout = 0.03;
+  return cam;
+}
+
+TEST(RollingShutter, PipelineUsesEachFramesRowWarp) {
+  ocl::Runtime rt;
+  const CameraModel cam = pipeline_test_camera();
   const Extrinsics e = sim::paper_configuration(1);
   const UndistortMap map = compute_undistort_map(cam);
   ImagePipelineOptions po;
@@ -289,9 +295,7 @@ TEST(RollingShutter, PipelineUsesEachFramesRowWarp) {
 // identity model, or an identity warp, is the plain correction.
 TEST(RollingShutter, PipelineReadsTheLightThroughEachFramesWarp) {
   ocl::Runtime rt;
-  CameraModel cam = sim::default_camera(160, 120);
-  cam.k1 = -0.08;
-  cam.rolling_shutter_readout = 0.03;
+  const CameraModel cam = pipeline_test_camera();
   const Extrinsics e = sim::paper_configuration(1);
   const UndistortMap map = compute_undistort_map(cam);
   ImagePipelineOptions po;
