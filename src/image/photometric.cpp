@@ -13,6 +13,7 @@
 
 #include "core/error.h"
 #include "core/output_file.h"
+#include "image/light_level.h"
 #include "image/pipeline.h"
 #include "ocl/runtime.h"
 
@@ -101,7 +102,7 @@ PhotometricFit fit_photometric(const cv::Mat& mean, const cv::Mat& square, const
   const cv::Mat m = masked_box(mean, valid01, radius);
   // The floor's contrast as the pixel sees it: the spread of the values over the box and the
   // frames together (the texture within the box varies from the first frame on).
-  cv::Mat own_var = cv::max(square - mean.mul(mean), 0.0f);
+  const cv::Mat own_var = cv::max(square - mean.mul(mean), 0.0f);
   const cv::Mat q = masked_box(square, valid01, radius);
   cv::Mat sd;
   cv::sqrt(cv::max(q - m.mul(m), 0.0f), sd);
@@ -152,15 +153,10 @@ PhotometricFit fit_photometric(const cv::Mat& mean, const cv::Mat& square, const
     const uint8_t* k = valid.ptr<uint8_t>(y);
     const uint8_t* b = bad.ptr<uint8_t>(y);
     const float* mm = m.ptr<float>(y);
-    float* sc = f.scale.ptr<float>(y);
     for (int x = 0; x < mean.cols; ++x) {
       if (!k[x]) continue;
       ++n_valid;
-      if (b[x] || !(mm[x] > 0)) {
-        ++n_unusable;
-        continue;
-      }
-      sc[x] = static_cast<float>(mean_ref / mm[x]);
+      if (b[x] || !(mm[x] > 0)) ++n_unusable;
     }
   }
   f.unusable = n_valid > 0 ? static_cast<double>(n_unusable) / static_cast<double>(n_valid) : 0.0;
@@ -181,6 +177,33 @@ PhotometricFit fit_photometric(const cv::Mat& mean, const cv::Mat& square, const
     f.scale.setTo(1.0f, valid);
     f.offset.setTo(0.0f);
     f.identity = true;
+    return f;
+  }
+  // Once settled: the young statistics' noise, not the box's bias, is their error (sharpened at
+  // 8-10 frames, anti_skid_tiles' first model put two frames' brightness 2x off). The level is
+  // fitted to the pixels that do not reach the camera's white level (a mean within 2.5 of its
+  // own standard deviations of it): a saturated spot's clipped mean would pull its
+  // surroundings' level down (by 1-3 % over 40 pixels around the reflection's core); and to the
+  // pixels that have a value: a plane across a shadow's edge, sharpened, rings 3-8 % beside the
+  // edge's band.
+  cv::Mat level = m;
+  if (frames >= kPhotometricSettledFrames) {
+    cv::Mat support(mean.size(), CV_8UC1, cv::Scalar(0));
+    for (int y = 0; y < mean.rows; ++y)
+      for (int x = 0; x < mean.cols; ++x) {
+        const float mm = mean.at<float>(y, x);
+        support.at<uint8_t>(y, x) = valid.at<uint8_t>(y, x) && !bad.at<uint8_t>(y, x) && mm > 0 &&
+                                    mm + 2.5f * std::sqrt(own_var.at<float>(y, x)) < o.saturation;
+      }
+    level = settled_light_level(mean, support, radius);
+  }
+  for (int y = 0; y < mean.rows; ++y) {
+    const uint8_t* k = valid.ptr<uint8_t>(y);
+    const uint8_t* b = bad.ptr<uint8_t>(y);
+    const float* mm = level.ptr<float>(y);
+    float* sc = f.scale.ptr<float>(y);
+    for (int x = 0; x < mean.cols; ++x)
+      if (k[x] && !b[x] && mm[x] > 0) sc[x] = static_cast<float>(mean_ref / mm[x]);
   }
   return f;
 }

@@ -85,7 +85,10 @@ PhotometricFit identity_photometric(int width, int height);
 // per pixel, the mean and the mean square of its values (CV_32FC1) over `frames` frames in
 // motion; valid (CV_8UC1, non-zero where the undistortion has a source) marks the pixels that
 // have statistics. Mean and contrast over a box of the options' radius and the frames
-// together; references the medians over valid pixels.
+// together; references the medians over valid pixels. From kPhotometricSettledFrames frames on,
+// the level the scale divides by is the box's least-squares plane sharpened by one step of van
+// Cittert's deconvolution, over the pixels with a value that do not reach `saturation`
+// (README.md, "The settled level").
 // `needed`: the caller has seen the light hold its alignments, so the model is used even where
 // the statistics cannot yet tell the light from their own noise (PhotometricFit::uniform).
 PhotometricFit fit_photometric(const cv::Mat& mean, const cv::Mat& square, const cv::Mat& valid,
