@@ -52,10 +52,11 @@ struct Scene {
   double exposure = 0.0;  // exposure=SECONDS: motion blur over this long before each row's read
   sim::MotionProfile motion = sim::MotionProfile::Mixed;
   double lamp = 0.0, reflection = 0.0, shadow = 0.0;  // the light fixed to the camera (sim::Options)
+  double gain_variation = 0.05;  // gain=A: the camera's slow gain and offset change (sim::Options)
 
   Extrinsics extrinsics() const { return has_ext ? ext : sim::paper_configuration(config); }
 
-  // Takes one key=value argument: config, ext, fov, motion, speed, turn, radius, noise, ss, mip, dist,
+  // Takes one key=value argument: config, ext, fov, motion, speed, turn, radius, noise, gain, ss, mip, dist,
   // readout, exposure. False
   // for another key; exits with a message on a bad value.
   bool parse(const std::string& k, const std::string& v) {
@@ -85,6 +86,8 @@ struct Scene {
       radius = std::atof(v.c_str());
     } else if (k == "noise") {
       noise = std::atof(v.c_str());
+    } else if (k == "gain") {
+      gain_variation = std::atof(v.c_str());
     } else if (k == "ss") {
       supersampling = std::atoi(v.c_str());
     } else if (k == "mip") {
@@ -122,6 +125,7 @@ struct Scene {
     so.max_turn_rate = turn;
     so.min_turn_radius = radius;
     so.pixel_noise = noise;
+    so.gain_variation = gain_variation;
     so.extrinsics = extrinsics();
     so.supersampling = supersampling;
     so.mipmap = mipmap;
