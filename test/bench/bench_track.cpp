@@ -13,7 +13,7 @@
 //        levels, select=B0,B1,.. (level l on one pixel per Bl x Bl block), prior=0|1 (a
 //        subsampled level joined with the level before it), prior_chi2=X (its consistency test; 0: off),
 //        prefilter=0|1 (level 0 smoothed before the pyramid; default 1), search=0 (no motion search for frames that would be Lost), the fused pass's lanes=1|8, pix=N,
-//        wg=XxY; scene extras ss=N (the renderer's supersampling), mip=0|1, dist=0 (no lens distortion), readout=S, exposure=S (rolling shutter, motion blur; seconds), unroll=0 (the tracker not told the readout nor the exposure), told_readout=S, told_exposure=S (told another), rs_tol=PX; BENCH_PREBLUR=sigma blurs each camera image first; BENCH_VERBOSE=1 adds per-level
+//        wg=XxY; scene extras ss=N (the renderer's supersampling), mip=0|1, dist=0 (no lens distortion), readout=S, exposure=S (rolling shutter, motion blur; seconds), lamp=F, reflection=GREY, shadow=F (the camera's light; then a line of the learnt photometric model's error against it at 2 s and at the end), gain=A (the camera's gain drift), unroll=0 (the tracker not told the readout nor the exposure), told_readout=S, told_exposure=S (told another), rs_tol=PX; BENCH_PREBLUR=sigma blurs each camera image first; BENCH_VERBOSE=1 adds per-level
 //        times, the slowest frames and the frames not tracked ok; see main())
 //   bench_track nees [key=value...]         NEES of the covariances (alignment and frame-to-frame
 //       motion) and the lag-1 correlation of the errors per texture x configuration x size x
@@ -42,6 +42,7 @@
 #include <opencv2/video/tracking.hpp>
 
 #include "core/se2.h"
+#include "image/photometric.h"
 #include "image/undistort.h"
 #include "ocl/runtime.h"
 #include "sim/simulator.h"
@@ -196,7 +197,49 @@ struct SequenceReport {
   // FrameResult::texture_residual: the largest over frames within 0.2 mm, the smallest over
   // frames more than 1 mm off (the honest-status check's margin).
   double tex_good_max = 0, tex_bad_min = HUGE_VAL;
+  // Under the camera's light: the photometric model against the light that made the images, at
+  // 2 s of driving and at the end (flat_field_error); NaN while the model is the identity.
+  struct FlatFieldError {
+    double rms = NAN, p99 = NAN, with_value = NAN;
+  } flat_2s, flat_end;
 };
+
+// The photometric model in use against the simulator's light: the model's gain per camera pixel
+// (flat_field_to_distorted: 0 where it has no value) against the light's mean level there,
+// gain * (the texture's mean) + add, both scaled to agree in the median. Relative errors over the
+// pixels with a value that the light leaves below the white level (250); with_value: their
+// fraction of the camera's pixels the light leaves below it (the corners the undistortion has no
+// source for have none: 12.5 % at 640 x 480 with the default lens).
+SequenceReport::FlatFieldError flat_field_error(const track::Tracker& tracker, const CameraModel& camera,
+                                                const sim::Lighting& lighting, double floor_mean) {
+  SequenceReport::FlatFieldError out;
+  const PhotometricFit* fit = tracker.photometric_model();
+  if (!fit || lighting.empty()) return out;
+  const cv::Mat model = flat_field_to_distorted(*fit, camera);
+  std::vector<double> ratio, err;
+  long below_white = 0;
+  for (int y = 0; y < model.rows; ++y)
+    for (int x = 0; x < model.cols; ++x) {
+      const double level = lighting.gain.at<float>(y, x) * floor_mean + lighting.add.at<float>(y, x);
+      if (!(level < 250.0)) continue;
+      ++below_white;
+      if (model.at<float>(y, x) > 0.0f) ratio.push_back(level / model.at<float>(y, x));
+    }
+  if (ratio.empty()) return out;
+  std::vector<double> sorted = ratio;
+  std::nth_element(sorted.begin(), sorted.begin() + static_cast<long>(sorted.size() / 2), sorted.end());
+  const double k = sorted[sorted.size() / 2];
+  double ss = 0.0;
+  for (const double r : ratio) {
+    err.push_back(std::abs(k / r - 1.0));
+    ss += err.back() * err.back();
+  }
+  std::nth_element(err.begin(), err.begin() + static_cast<long>(0.99 * static_cast<double>(err.size() - 1)), err.end());
+  out.rms = std::sqrt(ss / static_cast<double>(err.size()));
+  out.p99 = err[static_cast<size_t>(0.99 * static_cast<double>(err.size() - 1))];
+  out.with_value = static_cast<double>(ratio.size()) / static_cast<double>(below_white);
+  return out;
+}
 
 // unroll=0: the tracker is not told the camera's rolling shutter nor its exposure (what it did
 // before it could take them out); told_readout=S, told_exposure=S: it is told S seconds (a wrong
@@ -231,6 +274,10 @@ SequenceReport run_sequence(ocl::Runtime& rt, const sim::Options& so, const trac
     const double c0 = cpu_ms();
     const track::FrameResult r = tracker.track(img.data, img.cols, img.rows, img.step, traj.t[k]);
     rep.cpu_frame += cpu_ms() - c0;
+    if (!lighting.empty() && k > 0 && traj.t[k] - traj.t[0] >= 2.0 && traj.t[k - 1] - traj.t[0] < 2.0)
+      rep.flat_2s = flat_field_error(tracker, tracker_camera, lighting, renderer.pyramid().mean);
+    if (!lighting.empty() && k + 1 == traj.t.size())
+      rep.flat_end = flat_field_error(tracker, tracker_camera, lighting, renderer.pyramid().mean);
     rep.ms_frame += r.ms;
     if (k > 0) rep.ms.push_back(r.ms);
     if (verbose && k > 0) {
@@ -330,6 +377,11 @@ int bench_accuracy(const std::vector<std::string>& textures, double seconds, int
     std::printf("\n");
     std::printf("  texture residual (the honest-status check): largest of frames within 0.2 mm %.3f, smallest of "
                 "frames over 1 mm %.3f\n", r.tex_good_max, r.tex_bad_min);
+    if (!std::isnan(r.flat_end.with_value) || !std::isnan(r.flat_2s.with_value))
+      std::printf("  flat field (the photometric model against the light, relative): at 2 s RMS %.2f %%, p99 %.2f %% "
+                  "(%.1f %% of the camera's pixels below white have one); at the end RMS %.2f %%, p99 %.2f %% (%.1f %%)\n",
+                  100 * r.flat_2s.rms, 100 * r.flat_2s.p99, 100 * r.flat_2s.with_value, 100 * r.flat_end.rms,
+                  100 * r.flat_end.p99, 100 * r.flat_end.with_value);
     if (verbose)
       std::printf("  covariance: position std median %.2g m (max %.2g), heading std median %.2g rad; "
                   "mean NEES %.1f (3 if calibrated); largest std ratio of the position axes %.1f\n", r.std_pos_median,
