@@ -189,12 +189,13 @@ PhotometricFit fit_photometric(const cv::Mat& mean, const cv::Mat& square, const
   cv::Mat level = m;
   if (frames >= kPhotometricSettledFrames) {
     cv::Mat support(mean.size(), CV_8UC1, cv::Scalar(0));
-    for (int y = 0; y < mean.rows; ++y)
-      for (int x = 0; x < mean.cols; ++x) {
-        const float mm = mean.at<float>(y, x);
-        support.at<uint8_t>(y, x) = valid.at<uint8_t>(y, x) && !bad.at<uint8_t>(y, x) && mm > 0 &&
-                                    mm + 2.5f * std::sqrt(own_var.at<float>(y, x)) < o.saturation;
-      }
+    for (int y = 0; y < mean.rows; ++y) {
+      const uint8_t *k = valid.ptr<uint8_t>(y), *b = bad.ptr<uint8_t>(y);
+      const float *mm = mean.ptr<float>(y), *v = own_var.ptr<float>(y);
+      uint8_t* s = support.ptr<uint8_t>(y);
+      for (int x = 0; x < mean.cols; ++x)
+        s[x] = k[x] && !b[x] && mm[x] > 0 && mm[x] + 2.5f * std::sqrt(v[x]) < o.saturation;
+    }
     level = settled_light_level(mean, support, radius);
   }
   for (int y = 0; y < mean.rows; ++y) {

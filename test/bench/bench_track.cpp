@@ -234,9 +234,10 @@ SequenceReport::FlatFieldError flat_field_error(const track::Tracker& tracker, c
     err.push_back(std::abs(k / r - 1.0));
     ss += err.back() * err.back();
   }
-  std::nth_element(err.begin(), err.begin() + static_cast<long>(0.99 * static_cast<double>(err.size() - 1)), err.end());
+  const size_t i99 = static_cast<size_t>(0.99 * static_cast<double>(err.size() - 1));
+  std::nth_element(err.begin(), err.begin() + static_cast<long>(i99), err.end());
   out.rms = std::sqrt(ss / static_cast<double>(err.size()));
-  out.p99 = err[static_cast<size_t>(0.99 * static_cast<double>(err.size() - 1))];
+  out.p99 = err[i99];
   out.with_value = static_cast<double>(ratio.size()) / static_cast<double>(below_white);
   return out;
 }
@@ -274,10 +275,11 @@ SequenceReport run_sequence(ocl::Runtime& rt, const sim::Options& so, const trac
     const double c0 = cpu_ms();
     const track::FrameResult r = tracker.track(img.data, img.cols, img.rows, img.step, traj.t[k]);
     rep.cpu_frame += cpu_ms() - c0;
-    if (!lighting.empty() && k > 0 && traj.t[k] - traj.t[0] >= 2.0 && traj.t[k - 1] - traj.t[0] < 2.0)
-      rep.flat_2s = flat_field_error(tracker, tracker_camera, lighting, renderer.pyramid().mean);
-    if (!lighting.empty() && k + 1 == traj.t.size())
-      rep.flat_end = flat_field_error(tracker, tracker_camera, lighting, renderer.pyramid().mean);
+    if (!lighting.empty()) {
+      const bool at_2s = k > 0 && traj.t[k] - traj.t[0] >= 2.0 && traj.t[k - 1] - traj.t[0] < 2.0;
+      if (at_2s) rep.flat_2s = flat_field_error(tracker, tracker_camera, lighting, renderer.pyramid().mean);
+      if (k + 1 == traj.t.size()) rep.flat_end = flat_field_error(tracker, tracker_camera, lighting, renderer.pyramid().mean);
+    }
     rep.ms_frame += r.ms;
     if (k > 0) rep.ms.push_back(r.ms);
     if (verbose && k > 0) {
