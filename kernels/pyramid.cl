@@ -128,11 +128,10 @@ inline float8 pv_load8(__global const float* row, const int x, const int w) {
                   pv_at(row, x + 6, w), pv_at(row, x + 7, w));
 }
 
-__kernel __attribute__((reqd_work_group_size(PYRAMID_WG_X, PYRAMID_WG_Y, 1)))
-void gradient(__global const float* src, const int w, const int h, __global float* dst) {
-  const int x = (int)get_global_id(0) * 8;
-  const int y = (int)get_global_id(1);
-  if (x >= w || y >= h) return;
+// The 8 pixels x .. x + 7 of row y; the gradients less (bu, bv) (I - mean) where valid (0: the
+// plain gradients).
+inline void pv_gradient8(__global const float* src, const int w, const int h, const int x, const int y,
+                         const float8 bu, const float8 bv, const float mean, __global float* dst) {
   __global const float* row = src + y * w;
   const float8 c = pv_load8(row, x, w);
   const float8 l = pv_load8(row, x - 1, w);
@@ -142,8 +141,8 @@ void gradient(__global const float* src, const int w, const int h, __global floa
   const int8 valid = (c + l + r + t + b) >= 0.0f;
   const float8 zero = (float8)(0.0f);
   const float8 i = select(zero, c, valid);
-  const float8 gu = select(zero, (r - l) * 0.5f, valid);
-  const float8 gv = select(zero, (b - t) * 0.5f, valid);
+  const float8 gu = select(zero, (r - l) * 0.5f - bu * (c - mean), valid);
+  const float8 gv = select(zero, (b - t) * 0.5f - bv * (c - mean), valid);
   const float8 m = select(zero, (float8)(1.0f), valid);
   // One float4 per pixel: assembling them into two float16 first measured 1.5x slower on
   // PoCL (the shuffles cost more than the stores).
@@ -157,4 +156,32 @@ void gradient(__global const float* src, const int w, const int h, __global floa
   if (n > 5) vstore4((float4)(i.s5, gu.s5, gv.s5, m.s5), 5, o);
   if (n > 6) vstore4((float4)(i.s6, gu.s6, gv.s6, m.s6), 6, o);
   if (n > 7) vstore4((float4)(i.s7, gu.s7, gv.s7, m.s7), 7, o);
+}
+
+__kernel __attribute__((reqd_work_group_size(PYRAMID_WG_X, PYRAMID_WG_Y, 1)))
+void gradient(__global const float* src, const int w, const int h, __global float* dst) {
+  const int x = (int)get_global_id(0) * 8;
+  const int y = (int)get_global_id(1);
+  if (x >= w || y >= h) return;
+  pv_gradient8(src, w, h, x, y, (float8)(0.0f), (float8)(0.0f), 0.0f, dst);
+}
+
+// The gradients with the noise's share taken out (src/image/gradient_noise.h; plain C++
+// reference: decorrelated_gradient_reference): beta, two floats (u, v) per pixel of the level.
+__kernel __attribute__((reqd_work_group_size(PYRAMID_WG_X, PYRAMID_WG_Y, 1)))
+void gradient_decorrelated(__global const float* src, const int w, const int h, __global float* dst,
+                           __global const float* beta, const float mean) {
+  const int x = (int)get_global_id(0) * 8;
+  const int y = (int)get_global_id(1);
+  if (x >= w || y >= h) return;
+  __global const float* b = beta + 2 * (y * w + x);
+  float16 p;
+  if (x + 8 <= w) {
+    p = vload16(0, b);
+  } else {
+    float tail[16];
+    for (int k = 0; k < 16; ++k) tail[k] = k < 2 * (w - x) ? b[k] : 0.0f;
+    p = vload16(0, tail);
+  }
+  pv_gradient8(src, w, h, x, y, p.even, p.odd, mean, dst);
 }

@@ -218,6 +218,9 @@ PhotometricFit flat_field_photometric(const cv::Mat& gain, const cv::Mat& valid,
   PhotometricFit f = identity_photometric(gain.cols, gain.rows);
   f.offset.setTo(0.0f);
   f.frames = 0;
+  // A known flat field is a model like a learnt one (its light moves with a rolling shutter's
+  // rows; its noise varies over the image), even where it is flat.
+  f.identity = false;
   long n_valid = 0, n_unusable = 0;
   for (int y = 0; y < gain.rows; ++y) {
     const float* g = gain.ptr<float>(y);
@@ -427,6 +430,7 @@ struct PhotometricModel::Impl {
   PhotometricFit fit, known;
   bool has_known = false;
   int frames = 0, frames_at_fit = 0;
+  long revision = 0;
 
   Impl(ocl::Runtime& r, const cv::Mat& v, const PhotometricOptions& o)
       : rt(r), options(o), valid(v.clone()), width(v.cols), height(v.rows) {}
@@ -438,6 +442,7 @@ struct PhotometricModel::Impl {
     rt.queue().enqueueWriteBuffer(model, CL_TRUE, 0, bytes, f.scale.ptr<float>());
     rt.queue().enqueueWriteBuffer(model, CL_TRUE, bytes, bytes, f.offset.ptr<float>());
     fit = f;
+    ++revision;
   }
 };
 
@@ -465,6 +470,7 @@ const cl::Buffer& PhotometricModel::model() const { return impl_->model; }
 cl::Buffer& PhotometricModel::statistics() { return impl_->stats; }
 int PhotometricModel::frames() const { return impl_->frames; }
 const PhotometricFit& PhotometricModel::fit() const { return impl_->fit; }
+long PhotometricModel::revision() const { return impl_->revision; }
 
 bool PhotometricModel::learning() const { return impl_->options.learn && !impl_->has_known; }
 

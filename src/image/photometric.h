@@ -177,6 +177,9 @@ class PhotometricModel {
   void set(const PhotometricFit& fit);
   // The model in use.
   const PhotometricFit& fit() const;
+  // Counts the models put in use (each refit, set and reset): what was made from fit() is stale
+  // when it changed.
+  long revision() const;
   // Forgets the statistics; back to the identity (or the known model given with set()).
   void reset();
 

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "core/error.h"
+#include "image/gradient_noise.h"
 #include "ocl/runtime.h"
 
 namespace planarvo {
@@ -169,6 +170,7 @@ PipelineKernels::PipelineKernels(ocl::Runtime& runtime, const ImagePipelineOptio
     smooth_ = make_kernel(pyramid, "smooth", dev, pyramid_wg_);
     downsample_ = make_kernel(pyramid, "downsample", dev, pyramid_wg_);
     gradient_ = make_kernel(pyramid, "gradient", dev, pyramid_wg_);
+    gradient_decorrelated_ = make_kernel(pyramid, "gradient_decorrelated", dev, pyramid_wg_);
   } catch (const cl::Error& e) {
     throw_opencl("creating the kernels", e);
   }
@@ -286,6 +288,17 @@ void PipelineKernels::gradient(const cl::Buffer& src, int width, int height, con
   launch(runtime_.queue(), gradient_, pyramid_wg_, width, height);
 }
 
+void PipelineKernels::gradient_decorrelated(const cl::Buffer& src, int width, int height, const cl::Buffer& beta,
+                                            float mean, const cl::Buffer& dst) {
+  gradient_decorrelated_.setArg(0, src);
+  gradient_decorrelated_.setArg(1, static_cast<cl_int>(width));
+  gradient_decorrelated_.setArg(2, static_cast<cl_int>(height));
+  gradient_decorrelated_.setArg(3, dst);
+  gradient_decorrelated_.setArg(4, beta);
+  gradient_decorrelated_.setArg(5, mean);
+  launch(runtime_.queue(), gradient_decorrelated_, pyramid_wg_, width, height);
+}
+
 // ---------------------------------------------------------------------------------------------
 
 struct ImagePipeline::Impl {
@@ -298,6 +311,7 @@ struct ImagePipeline::Impl {
   cl::Buffer map_index, map_weights;  // PipelineKernels::device_map
   std::vector<cl::Buffer> intensity;  // per level, its intensity image
   bool prefilter = true;
+  bool decorrelate_noise = true;
   cl::Buffer raw;                     // level 0 before the prefilter (when it is on)
   std::unique_ptr<PhotometricModel> photometric;  // when on
   cl::Buffer uncorrected;             // level 0 before the photometric correction (when on)
@@ -314,10 +328,36 @@ struct ImagePipeline::Impl {
     cl::Buffer buffer;
     bool identity = true;
   } row_warp, kept_row_warp;
+  // The noise's share in the gradients under the photometric model (gradient_noise.h): beta per
+  // level, made from the model of revision beta_revision (-1: none yet).
+  std::vector<cl::Buffer> beta;
+  long beta_revision = -1;
+  // The corrected image's mean level, which beta multiplies the intensity's difference from
+  // (any level not made from the pixel's own noise serves; near the image's, the texture's share
+  // stays small): raw x scale over every 8th pixel of every 8th row of the last frame processed
+  // (the raw pixel at the undistorted one's coordinates: a mean needs no more).
+  float corrected_mean = 0.0f;
+  void note_mean(const uint8_t* gray, size_t stride) {
+    if (!photometric || photometric->fit().identity) return;
+    const cv::Mat& scale = photometric->fit().scale;
+    const double white = photometric->options().saturation;
+    double sum = 0.0;
+    long n = 0;
+    for (int y = 4; y < camera.height; y += 8)
+      for (int x = 4; x < camera.width; x += 8) {
+        const float sc = scale.at<float>(y, x);
+        const double v = gray[static_cast<size_t>(y) * stride + static_cast<size_t>(x)];
+        if (sc > 0.0f && v < white) {
+          sum += v * sc;
+          ++n;
+        }
+      }
+    if (n > 0) corrected_mean = static_cast<float>(sum / static_cast<double>(n));
+  }
   // What `uncorrected` was last made from (learn()).
   const cl::Buffer* undistorted_source = nullptr;
   bool undistorted_rolling = false;
-  Impl(ocl::Runtime& r, const ImagePipelineOptions& o) : rt(r), kernels(r, o), prefilter(o.prefilter) {}
+  Impl(ocl::Runtime& r, const ImagePipelineOptions& o) : rt(r), kernels(r, o), prefilter(o.prefilter), decorrelate_noise(o.decorrelate_noise) {}
 
   int w(int l) const { return level_size(camera.width, l); }
   int h(int l) const { return level_size(camera.height, l); }
@@ -418,9 +458,33 @@ struct ImagePipeline::Impl {
                          intensity[static_cast<size_t>(l)]);
   }
   void gradients(Pyramid& out) {
-    for (int l = 0; l < levels; ++l)
-      kernels.gradient(intensity[static_cast<size_t>(l)], w(l), h(l),
-                       out.levels[static_cast<size_t>(l)].data);
+    // An evenly lit camera (the identity model) has the same noise everywhere: nothing to take out.
+    // A young model (fitted from fewer than kPhotometricSettledFrames frames) is not: its level
+    // is the statistics' noise as much as the light's, and its log's slope more so.
+    const PhotometricFit* fit = photometric ? &photometric->fit() : nullptr;
+    const bool lit = decorrelate_noise && fit && !fit->identity &&
+                     (fit->frames == 0 || fit->frames >= kPhotometricSettledFrames);
+    if (lit && beta_revision != photometric->revision()) make_beta();
+    for (int l = 0; l < levels; ++l) {
+      const cl::Buffer& dst = out.levels[static_cast<size_t>(l)].data;
+      if (lit)
+        kernels.gradient_decorrelated(intensity[static_cast<size_t>(l)], w(l), h(l), beta[static_cast<size_t>(l)],
+                                      corrected_mean, dst);
+      else
+        kernels.gradient(intensity[static_cast<size_t>(l)], w(l), h(l), dst);
+    }
+  }
+  void make_beta() {
+    const std::vector<cv::Mat> b =
+        gradient_noise_beta(corrected_noise_shape(photometric->fit().scale), levels, prefilter);
+    beta.resize(b.size());
+    for (size_t l = 0; l < b.size(); ++l) {
+      const size_t bytes = b[l].total() * b[l].elemSize();
+      if (!beta[l]()) beta[l] = cl::Buffer(rt.context(), CL_MEM_READ_ONLY, bytes);
+      // Blocking: b is a local.
+      rt.queue().enqueueWriteBuffer(beta[l], CL_TRUE, 0, bytes, b[l].ptr<float>());
+    }
+    beta_revision = photometric->revision();
   }
 };
 
@@ -475,6 +539,7 @@ void ImagePipeline::process(const uint8_t* gray, int width, int height, size_t s
   try {
     m.upload(gray, stride);
     m.has_frame = true;
+    m.note_mean(gray, stride);
     m.stages(m.frame, m.row_warp, out);
   } catch (const cl::Error& e) {
     throw_opencl("processing a frame", e);
@@ -577,6 +642,7 @@ PipelineTimings ImagePipeline::process_timed(const cv::Mat& gray, Pyramid& out) 
     auto t0 = std::chrono::steady_clock::now();
     m.upload(gray.ptr<uint8_t>(), gray.step[0]);
     m.has_frame = true;
+    m.note_mean(gray.ptr<uint8_t>(), gray.step[0]);
     q.finish();
     t.upload_ms = ms_since(t0);
     t0 = std::chrono::steady_clock::now();

@@ -96,6 +96,10 @@ struct ImagePipelineOptions {
   // resampled bilinearly by the alignment, otherwise biases it (src/track/README.md, "The
   // prefilter").
   bool prefilter = true;
+  // Under a photometric model that is not the identity (settled, or a known flat field), the
+  // noise's share in each level's gradients is taken out (gradient_noise.h): corrected, the noise
+  // varies over the image and otherwise pulls the alignment towards zero motion.
+  bool decorrelate_noise = true;
   // The photometric model (photometric.h): between the undistortion and the prefilter, the
   // light fixed to the camera is taken out and saturated pixels left out; learnt from the
   // frames process() is told are in motion. Off by default here (the tracker turns it on).
@@ -162,10 +166,14 @@ class PipelineKernels {
   void downsample(const cl::Buffer& src, int src_width, int src_height, const cl::Buffer& dst);
   // src: an intensity image; dst: width * height float4, pyramid.h's layout.
   void gradient(const cl::Buffer& src, int width, int height, const cl::Buffer& dst);
+  // As gradient, less beta (I - mean) (gradient_noise.h): beta, width * height float2.
+  void gradient_decorrelated(const cl::Buffer& src, int width, int height, const cl::Buffer& beta, float mean,
+                             const cl::Buffer& dst);
 
  private:
   ocl::Runtime& runtime_;
-  cl::Kernel undistort_, undistort_rolling_, photometric_, photometric_learn_, photometric_rolling_, smooth_, downsample_, gradient_;
+  cl::Kernel undistort_, undistort_rolling_, photometric_, photometric_learn_, photometric_rolling_, smooth_, downsample_, gradient_,
+      gradient_decorrelated_;
   size_t undistort_wg_[2] = {1, 1}, pyramid_wg_[2] = {1, 1};
 };
 

@@ -603,6 +603,7 @@ struct Tracker::Impl {
     if (!pipeline) {
       ImagePipelineOptions po;
       po.prefilter = opt.prefilter;
+      po.decorrelate_noise = opt.decorrelate_noise;
       po.photometric = opt.photometric;
       pipeline = std::make_unique<ImagePipeline>(rt, camera, opt.levels, po);
       if (known_photometric && pipeline->photometric()) pipeline->photometric()->set(*known_photometric);

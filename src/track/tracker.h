@@ -89,6 +89,9 @@ struct TrackerOptions : AlignerOptions {
   // prefilter; src/track/README.md, "The prefilter"). Pyramids given to track(Pyramid) are
   // taken as they are.
   bool prefilter = true;
+  // Under the camera's light, the noise's share in the gradients is taken out
+  // (ImagePipelineOptions::decorrelate_noise, image/gradient_noise.h).
+  bool decorrelate_noise = true;
   // The camera-frame path takes the light fixed to the camera out of each frame before its
   // pyramid (image/photometric.h: learnt online, saturated and contrast-less pixels left out).
   // The model learns from a frame when the image has moved by at least learn_motion_px

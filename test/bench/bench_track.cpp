@@ -13,7 +13,7 @@
 //        levels, select=B0,B1,.. (level l on one pixel per Bl x Bl block), prior=0|1 (a
 //        subsampled level joined with the level before it), prior_chi2=X (its consistency test; 0: off),
 //        prefilter=0|1 (level 0 smoothed before the pyramid; default 1), search=0 (no motion search for frames that would be Lost), the fused pass's lanes=1|8, pix=N,
-//        wg=XxY; scene extras ss=N (the renderer's supersampling), mip=0|1, dist=0 (no lens distortion), readout=S, exposure=S (rolling shutter, motion blur; seconds), lamp=F, reflection=GREY, shadow=F (the camera's light; then a line of the learnt photometric model's error against it at 2 s and at the end), gain=A (the camera's gain drift), unroll=0 (the tracker not told the readout nor the exposure), told_readout=S, told_exposure=S (told another), rs_tol=PX; BENCH_PREBLUR=sigma blurs each camera image first; BENCH_VERBOSE=1 adds per-level
+//        wg=XxY; scene extras ss=N (the renderer's supersampling), mip=0|1, dist=0 (no lens distortion), readout=S, exposure=S (rolling shutter, motion blur; seconds), lamp=F, reflection=GREY, shadow=F (the camera's light; then a line of the learnt photometric model's error against it at 2 s and at the end), gain=A (the camera's gain drift), unroll=0 (the tracker not told the readout nor the exposure), told_readout=S, told_exposure=S (told another), rs_tol=PX, decorrelate=0 (the noise's share left in the gradients, image/gradient_noise.h), brightness=0 (no brightness model); BENCH_PREBLUR=sigma blurs each camera image first; BENCH_VERBOSE=1 adds per-level
 //        times, the slowest frames and the frames not tracked ok; see main())
 //   bench_track nees [key=value...]         NEES of the covariances (alignment and frame-to-frame
 //       motion) and the lag-1 correlation of the errors per texture x configuration x size x
@@ -744,6 +744,8 @@ int main(int argc, char** argv) {
       }
       else if (k == "conv") topt.convergence_px = std::atof(v.c_str());
       else if (k == "huber") topt.huber_factor = std::atof(v.c_str());
+      else if (k == "brightness") topt.estimate_brightness = v != "0";
+      else if (k == "decorrelate") topt.decorrelate_noise = v != "0";
       else if (k == "kf_scale") topt.keyframe_scale_change = std::atof(v.c_str());
       else if (k == "overlap") topt.keyframe_overlap = std::atof(v.c_str());
       else if (k == "maxit") {
