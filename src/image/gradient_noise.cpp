@@ -60,9 +60,7 @@ double gradient_noise_coefficient(int level, bool prefilter) {
 
 cv::Mat corrected_noise_shape(const cv::Mat& scale) {
   if (scale.type() != CV_32FC1) throw_invalid_argument("corrected_noise_shape: the scale must be CV_32FC1");
-  cv::Mat out = scale.mul(scale);
-  out.setTo(0.0f, scale <= 0.0f);
-  return out;
+  return scale.mul(scale);  // 0 where the scale is: gradient_noise_beta fills it
 }
 
 std::vector<cv::Mat> gradient_noise_beta(const cv::Mat& variance_shape, int levels, bool prefilter) {

@@ -337,8 +337,19 @@ struct ImagePipeline::Impl {
   // stays small): raw x scale over every 8th pixel of every 8th row of the last frame processed
   // (the raw pixel at the undistorted one's coordinates: a mean needs no more).
   float corrected_mean = 0.0f;
+  // Whether the gradients take the noise's share out: an evenly lit camera (the identity model)
+  // has the same noise everywhere, nothing to take out; a young model (fitted from fewer than
+  // kPhotometricSettledFrames frames) is the statistics' noise as much as the light, and its
+  // log's slope more so.
+  bool decorrelating() const {
+    if (!decorrelate_noise || !photometric) return false;
+    const PhotometricFit& fit = photometric->fit();
+    return !fit.identity && (fit.frames == 0 || fit.frames >= kPhotometricSettledFrames);
+  }
+  // Noted for a young model too: a refit that settles it is followed by reprocess(), which has no
+  // frame of its own to note.
   void note_mean(const uint8_t* gray, size_t stride) {
-    if (!photometric || photometric->fit().identity) return;
+    if (!decorrelate_noise || !photometric || photometric->fit().identity) return;
     const cv::Mat& scale = photometric->fit().scale;
     const double white = photometric->options().saturation;
     double sum = 0.0;
@@ -458,12 +469,7 @@ struct ImagePipeline::Impl {
                          intensity[static_cast<size_t>(l)]);
   }
   void gradients(Pyramid& out) {
-    // An evenly lit camera (the identity model) has the same noise everywhere: nothing to take out.
-    // A young model (fitted from fewer than kPhotometricSettledFrames frames) is not: its level
-    // is the statistics' noise as much as the light's, and its log's slope more so.
-    const PhotometricFit* fit = photometric ? &photometric->fit() : nullptr;
-    const bool lit = decorrelate_noise && fit && !fit->identity &&
-                     (fit->frames == 0 || fit->frames >= kPhotometricSettledFrames);
+    const bool lit = decorrelating();
     if (lit && beta_revision != photometric->revision()) make_beta();
     for (int l = 0; l < levels; ++l) {
       const cl::Buffer& dst = out.levels[static_cast<size_t>(l)].data;
