@@ -318,6 +318,18 @@ typedef struct planarvo_sim_options {
                                  (a bright spot that saturates); 0..1000 */
   double shadow;              /* the robot's shadow over the image's bottom: fraction of light
                                  taken; 0..0.95 */
+  /* A body on its suspension (a car) and a knock to the camera's mounting; each read only when
+   * struct_size covers it. The camera turns with the body relative to the local ground plane,
+   * R_plane_body = Rx(roll) Ry(pitch) about the robot frame's origin; data sets then get
+   * plane.txt, the true attitude per frame (the format of planarvo track --plane-out). */
+  double lean;                /* body roll per yaw rate, seconds (radians per rad/s, or degrees
+                                 per degree/s); the paper's car about -0.07; default 0 */
+  double bumps;               /* speed bumps every 10 m driven (2.5 m long): peak body pitch,
+                                 radians, both signs over one bump; default 0 */
+  double knock_time;          /* seconds; default INFINITY (no knock). From then on the mounting
+                                 is off by: */
+  double knock_roll, knock_pitch; /* radians */
+  double knock_z;             /* metres; the data set gets extrinsics_knocked.yaml */
 } planarvo_sim_options;
 
 PLANARVO_API void planarvo_sim_options_init(planarvo_sim_options* options);

@@ -99,7 +99,9 @@ class SimOptions(ctypes.Structure):
                 ("pixel_noise", c_double), ("gain_variation", c_double), ("odometry_noise", c_double),
                 ("supersampling", c_int32), ("progress", PROGRESS_FN), ("progress_user_data", c_void_p),
                 ("min_turn_radius", c_double), ("readout_time", c_double), ("exposure_time", c_double),
-                ("lamp_falloff", c_double), ("reflection", c_double), ("shadow", c_double)]
+                ("lamp_falloff", c_double), ("reflection", c_double), ("shadow", c_double),
+                ("lean", c_double), ("bumps", c_double), ("knock_time", c_double), ("knock_roll", c_double),
+                ("knock_pitch", c_double), ("knock_z", c_double)]
 
 
 class TrackerOptions(ctypes.Structure):

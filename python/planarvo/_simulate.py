@@ -50,6 +50,17 @@ class SimOptions:
     lamp_falloff: Optional[float] = None
     reflection: Optional[float] = None
     shadow: Optional[float] = None
+    # A car's body and its camera's mounting: the body rolls lean * yaw rate (seconds: degrees
+    # per degree/s; the paper's car about -0.07) and pitches over speed bumps every 10 m (peak
+    # pitch, radians); the data set then gets plane.txt, the true attitude per frame. At
+    # knock_time seconds the mounting's roll, pitch (radians) and height (metres) change by the
+    # knock_* amounts, and the data set gets extrinsics_knocked.yaml.
+    lean: Optional[float] = None
+    bumps: Optional[float] = None
+    knock_time: Optional[float] = None
+    knock_roll: Optional[float] = None
+    knock_pitch: Optional[float] = None
+    knock_z: Optional[float] = None
 
 
 def default_texture() -> str:
@@ -68,7 +79,8 @@ def default_texture() -> str:
 def simulate(context: Context, out_directory: PathLike, options: Optional[SimOptions] = None,
              progress: Optional[ProgressFn] = None) -> None:
     """Renders a data set into out_directory (created if missing): camera.yaml, images/,
-    frames.txt, odometry.txt, direction.txt, groundtruth.txt, extrinsics_gt.yaml."""
+    frames.txt, odometry.txt, direction.txt, groundtruth.txt, extrinsics_gt.yaml (and plane.txt,
+    extrinsics_knocked.yaml for a body that leans or a knocked mounting)."""
     options = options or SimOptions()
     c = _c_options(N.SimOptions, "planarvo_sim_options_init", options,
                    skip=("texture", "extrinsics", "camera"))

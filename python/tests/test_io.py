@@ -15,6 +15,22 @@ def test_camera_round_trip(tmp_path):
     assert planarvo.Camera.load(tmp_path / "camera.yaml") == cam
 
 
+def test_simulated_body_writes_its_true_plane_and_knocked_mount(context, tmp_path):
+    ext = planarvo.Extrinsics(-1.0, 0.0, 0.9, 0.0, math.radians(40.0), math.pi)
+    options = planarvo.SimOptions(camera=planarvo.Camera.simulator_default(96, 64, 60.0), seconds=4.0, fps=10.0,
+                                  extrinsics=ext, motion=planarvo.MotionProfile.CAR, max_speed=3.0,
+                                  min_turn_radius=6.0, lean=-0.07, bumps=math.radians(5.0), knock_time=2.0,
+                                  knock_roll=0.0, knock_pitch=math.radians(2.0), knock_z=0.01, supersampling=1)
+    planarvo.simulate(context, tmp_path / "car", options)
+    plane = np.loadtxt(tmp_path / "car" / "plane.txt")
+    assert plane.shape == (40, 5)
+    assert np.all(np.abs(plane[:, 1]) < math.radians(3.0)) and np.all(np.abs(plane[:, 2]) <= math.radians(5.0))
+    assert np.all(plane[:, 3:] == 0.0)
+    knocked = planarvo.Extrinsics.load(tmp_path / "car" / "extrinsics_knocked.yaml")
+    assert knocked.z == pytest.approx(0.91, abs=1e-12)
+    assert knocked.pitch == pytest.approx(math.radians(42.0), abs=1e-12)
+
+
 def test_rolling_shutter_readout_round_trip_and_simulated(context, tmp_path):
     cam = planarvo.Camera(640, 480, 501.25, 499.5, 319.75, 241.125, rolling_shutter_readout=0.0271,
                           exposure_time=0.0043)

@@ -38,6 +38,12 @@ PLANARVO_API void planarvo_sim_options_init(planarvo_sim_options* o) {
   o->lamp_falloff = d.lamp_falloff;
   o->reflection = d.reflection;
   o->shadow = d.shadow;
+  o->lean = d.lean;
+  o->bumps = d.bumps;
+  o->knock_time = d.knock_time;
+  o->knock_roll = d.knock_roll;
+  o->knock_pitch = d.knock_pitch;
+  o->knock_z = d.knock_z;
 }
 
 PLANARVO_API planarvo_status planarvo_sim_default_camera(int32_t width, int32_t height, double fov_deg,
@@ -89,6 +95,14 @@ PLANARVO_API planarvo_status planarvo_simulate(planarvo_context* context, const 
       s.lamp_falloff = o->lamp_falloff;
       s.reflection = o->reflection;
       s.shadow = o->shadow;
+    }
+    if (o->struct_size >= offsetof(planarvo_sim_options, knock_z) + sizeof(double)) {
+      s.lean = o->lean;
+      s.bumps = o->bumps;
+      s.knock_time = o->knock_time;
+      s.knock_roll = o->knock_roll;
+      s.knock_pitch = o->knock_pitch;
+      s.knock_z = o->knock_z;
     }
     s.pixel_noise = o->pixel_noise;
     s.gain_variation = o->gain_variation;

@@ -118,6 +118,24 @@ std::vector<double> Args::get_doubles(const std::string& name, size_t count) con
   return out;
 }
 
+std::vector<double> Args::get_stamped_doubles(const std::string& name, size_t count, double* time) const {
+  const std::string text = get(name);
+  const size_t colon = text.find(':');
+  if (colon == std::string::npos)
+    throw UsageError("option --" + name + " needs T:" + std::string(count > 0 ? "a" : "") +
+                     (count > 1 ? ",b" : "") + (count > 2 ? ",..." : "") + " (a time, a colon, then " +
+                     std::to_string(count) + " comma-separated numbers), got \"" + text + "\"");
+  *time = parse_double(name, text.substr(0, colon));
+  std::vector<double> out;
+  std::stringstream ss(text.substr(colon + 1));
+  std::string item;
+  while (std::getline(ss, item, ',')) out.push_back(parse_double(name, item));
+  if (out.size() != count)
+    throw UsageError("option --" + name + " needs " + std::to_string(count) + " comma-separated numbers after the colon, got \"" +
+                     text + "\"");
+  return out;
+}
+
 std::string format_options(const std::vector<OptionSpec>& specs) {
   std::ostringstream os;
   for (const auto& s : specs) {

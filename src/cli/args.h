@@ -42,6 +42,8 @@ class Args {
   void expect_output_files(const std::vector<std::string>& names) const;
   // Comma-separated numbers, exactly `count` of them.
   std::vector<double> get_doubles(const std::string& name, size_t count) const;
+  // "T:a,b,..." (a time, then exactly `count` comma-separated numbers): *time gets T.
+  std::vector<double> get_stamped_doubles(const std::string& name, size_t count, double* time) const;
   const std::vector<std::string>& positionals() const { return positionals_; }
 
  private:

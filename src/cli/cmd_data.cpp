@@ -58,6 +58,11 @@ std::vector<OptionSpec> simulate_options() {
       {"lamp", "F", "a camera-mounted lamp: the darkest corner gets 1 - F of the light (0..0.95)", "0 (even light)"},
       {"reflection", "GREY", "the lamp's reflection on a glossy floor: peak grey levels added (saturates)", "0"},
       {"shadow", "F", "the robot's shadow over the image's bottom: fraction of light taken (0..0.95)", "0"},
+      {"lean", "DEG_PER_DEG_S", "a car's body rolls with the yaw rate: degrees of roll per degree/s (the paper's "
+       "car: -0.07); writes the true attitude to plane.txt", "0"},
+      {"bumps", "DEG", "speed bumps every 10 m driven: the body's peak pitch, degrees; writes plane.txt", "0"},
+      {"knock", "T:DROLL,DPITCH,DZ", "the camera's mounting is knocked at T seconds: roll and pitch change by "
+       "degrees, the height by metres; writes extrinsics_knocked.yaml", "none"},
       {"width", "PX", "image width", "640"},
       {"height", "PX", "image height", "480"},
       {"fov", "DEG", "horizontal field of view", "80"},
@@ -101,6 +106,15 @@ void apply_simulate_args(const Args& a, planarvo_sim_options* o, std::string* te
   o->lamp_falloff = a.get_double("lamp", o->lamp_falloff);
   o->reflection = a.get_double("reflection", o->reflection);
   o->shadow = a.get_double("shadow", o->shadow);
+  o->lean = a.get_double("lean", o->lean);
+  o->bumps = a.get_double("bumps", o->bumps / kDeg) * kDeg;
+  if (a.has("knock")) {
+    const std::vector<double> d = a.get_stamped_doubles("knock", 3, &o->knock_time);
+    if (!(o->knock_time >= 0)) throw UsageError("option --knock: the time must be >= 0 seconds");
+    o->knock_roll = d[0] * kDeg;
+    o->knock_pitch = d[1] * kDeg;
+    o->knock_z = d[2];
+  }
   o->odometry_noise = a.get_double("odometry-noise", o->odometry_noise);
   o->readout_time = a.get_double("readout-time", o->readout_time);
   o->exposure_time = a.get_double("exposure", o->exposure_time);

@@ -59,6 +59,19 @@ struct DirectionLabel {
 std::vector<DirectionLabel> read_direction(const std::string& path);
 void write_direction(const std::string& path, const std::vector<DirectionLabel>& labels);
 
+// plane.txt (`track --plane-out`, the simulator's truth): "t roll pitch sigma_roll sigma_pitch"
+// per line, '#' comments; radians, the body's rotation relative to the local ground plane,
+// R_plane_body = Rx(roll) Ry(pitch) (docs/conventions.md). sigma 0: exact (the simulator's
+// truth). The reader refuses non-finite values, negative sigma, |roll| or |pitch| over pi/2
+// (another unit) and timestamps that do not increase.
+struct PlaneAttitude {
+  double t = 0.0;
+  double roll = 0.0, pitch = 0.0;
+  double sigma_roll = 0.0, sigma_pitch = 0.0;
+};
+std::vector<PlaneAttitude> read_plane(const std::string& path);
+void write_plane(const std::string& path, const std::vector<PlaneAttitude>& attitudes);
+
 // frames.txt: "timestamp relative/path" per line, '#' comments. The path is everything after
 // the whitespace that follows the timestamp, trimmed, so it may contain inner spaces.
 struct FrameEntry {

@@ -122,6 +122,46 @@ void write_direction(const std::string& path, const std::vector<DirectionLabel>&
   w.close();
 }
 
+std::vector<PlaneAttitude> read_plane(const std::string& path) {
+  LineReader r(path);
+  std::vector<PlaneAttitude> out;
+  std::string line;
+  static const char* const kNames[5] = {"timestamp", "roll", "pitch", "sigma_roll", "sigma_pitch"};
+  while (r.next(line)) {
+    const auto f = split_fields(line);
+    if (f.size() != 5)
+      r.fail("expected 5 fields 't roll pitch sigma_roll sigma_pitch', found " + std::to_string(f.size()));
+    double v[5];
+    for (int k = 0; k < 5; ++k) v[k] = parse_number(r, f[static_cast<size_t>(k)], kNames[k]);
+    check_increasing(r, !out.empty(), out.empty() ? 0.0 : out.back().t, v[0]);
+    for (int k = 1; k <= 2; ++k)
+      if (std::abs(v[k]) > 0.5 * M_PI)
+        r.fail(std::string(kNames[k]) + " = " + format_exact(v[k]) +
+               " is beyond pi/2: angles are radians (degrees by mistake?)");
+    for (int k = 3; k <= 4; ++k)
+      if (!(v[k] >= 0)) r.fail(std::string(kNames[k]) + " = " + format_exact(v[k]) + " is negative");
+    out.push_back({v[0], v[1], v[2], v[3], v[4]});
+  }
+  return out;
+}
+
+void write_plane(const std::string& path, const std::vector<PlaneAttitude>& attitudes) {
+  for (size_t i = 0; i < attitudes.size(); ++i) {
+    const PlaneAttitude& a = attitudes[i];
+    check_writer_time(path, i, i > 0, i > 0 ? attitudes[i - 1].t : 0.0, a.t);
+    if (!std::isfinite(a.roll + a.pitch + a.sigma_roll + a.sigma_pitch) || a.sigma_roll < 0 || a.sigma_pitch < 0)
+      throw_invalid_argument(path + ": entry " + std::to_string(i) +
+                             " has a non-finite angle or a negative or non-finite sigma");
+  }
+  detail::TextWriter w(path);
+  w.write("# timestamp roll pitch sigma_roll sigma_pitch: the body's rotation relative to the local ground "
+          "plane, R_plane_body = Rx(roll) Ry(pitch), radians\n");
+  for (const PlaneAttitude& a : attitudes)
+    w.write(format_fixed(a.t, kTimestampDecimals) + " " + format_exact(a.roll) + " " + format_exact(a.pitch) + " " +
+            format_exact(a.sigma_roll) + " " + format_exact(a.sigma_pitch) + "\n");
+  w.close();
+}
+
 std::vector<FrameEntry> read_frames(const std::string& path) {
   LineReader r(path);
   std::vector<FrameEntry> frames;

@@ -8,6 +8,7 @@
 // centres, texel (0, 0) centred on the world origin.
 #pragma once
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -102,8 +103,23 @@ struct Options {
                                // (saturates above about 130 on the default texture); 0: none
   double shadow = 0.0;         // the robot's own shadow over the image's bottom: the fraction of
                                // light it takes; 0: none
+  // The body on its suspension (a car; the paper's section 6.4 and Figures 18-19). The camera is
+  // fixed to the body, and the body rotates relative to the local ground plane about the robot
+  // frame's origin: R_plane_body = Rx(roll) Ry(pitch) (see body_attitude below).
+  double lean = 0.0;           // body roll per yaw rate, seconds (= degrees per degree/s); the
+                               // paper's car about -0.07; 0: none
+  double bumps = 0.0;          // speed bumps: peak body pitch, radians (both signs over one bump);
+                               // 0: none
+  double bump_spacing = 10.0;  // metres driven between bumps (the first at half of it)
+  double bump_length = 2.5;    // metres driven over one bump's pitch profile
+  // A knock to the camera's mounting at knock_time seconds (inf: none): from then on the
+  // camera's extrinsics are roll + knock_roll, pitch + knock_pitch (radians), z + knock_z (m).
+  double knock_time = HUGE_VAL;
+  double knock_roll = 0.0, knock_pitch = 0.0, knock_z = 0.0;
   // Called with the fraction done and the stage; return false to cancel (Error Cancelled).
   std::function<bool(double, const char*)> progress;
+  // The body leans, pitches or gets knocked: the camera's extrinsics vary over the drive.
+  bool body_moves() const { return lean != 0.0 || bumps != 0.0 || std::isfinite(knock_time); }
 };
 
 // Throws InvalidArgument naming the first bad value.
@@ -116,6 +132,7 @@ struct Trajectory {
   std::vector<Eigen::Vector2d> velocity;   // N-1: (v, omega), constant over interval k..k+1
   std::vector<int> direction;              // N-1: sign of v, 0 when v == 0
   std::vector<SE2> odometry;               // N wheel-odometry poses (odometry frame = world)
+  std::vector<double> distance;            // N: distance driven up to frame k, |v| integrated, m
 };
 
 // Pure and deterministic for a seed. Velocities are held constant over each frame interval
@@ -127,6 +144,29 @@ Trajectory generate_trajectory(const Options& options);
 // pose[k] * SE2::exp((t - t_k) * (v, 0, omega)) for t in [t_k, t_k+1), exactly pose[k] at t_k;
 // standing at pose[0] before t_0; after the last frame, the last interval's velocity continued.
 SE2 pose_at(const Trajectory& trajectory, double t);
+
+// ---------------------------------------------------------------------------------------------
+// The body's attitude and the camera's pose relative to the local ground plane over time.
+
+// The body's rotation relative to the local ground plane at time t, radians:
+// R_plane_body = Rx(roll) Ry(pitch) (body x forward, y left, z up), rotating about the robot
+// frame's origin on the ground. roll = lean * omega(t), with omega(t) the yaw rate interpolated
+// linearly between the midpoints of the frame intervals (held at the ends), so the body turns
+// smoothly. pitch = bumps * b(u) / max(b), b(u) = sin(2 pi u) sin^2(pi u), u the fraction of
+// bump_length driven since the bump's start (bumps start at spacing (j + 1/2), j = 0, 1, ...,
+// of the distance driven, forwards or backwards): smooth, nose one way then the other.
+struct BodyAttitude {
+  double roll = 0.0, pitch = 0.0;
+};
+BodyAttitude body_attitude(const Options& options, const Trajectory& trajectory, double t);
+
+// The camera's extrinsics relative to the local ground plane at time t: options.extrinsics
+// (after the knock when t >= knock_time) carried by the body's attitude,
+// T(t) = [R_plane_body 0; 0 1] T_vc. options.extrinsics exactly when the body does not move.
+Extrinsics camera_extrinsics_at(const Options& options, const Trajectory& trajectory, double t);
+
+// The mounting's extrinsics after the knock (options.extrinsics when there is none).
+Extrinsics knocked_extrinsics(const Options& options);
 
 // ---------------------------------------------------------------------------------------------
 // Rendering. The texture is prefiltered into a float mip pyramid; every output pixel averages
@@ -214,14 +254,19 @@ class Renderer {
   // The noise-free, gain-free image at a robot pose: CV_32FC1 grey levels, or rounded CV_8UC1.
   cv::Mat render_float(const SE2& robot_pose);
   cv::Mat render(const SE2& robot_pose);
+  // The same with the camera at `extrinsics` relative to the ground (a leaning body).
+  cv::Mat render_float(const SE2& robot_pose, const Extrinsics& extrinsics);
   // Row y seen from robot pose row_poses[y] (one per image row), CV_32FC1: one frame of a
   // rolling shutter at one instant of its exposure. Row y equals row y of
   // render_float(row_poses[y]) bit for bit.
   cv::Mat render_float_rows(const std::vector<SE2>& row_poses);
+  // The same with each row's camera at its own extrinsics (one per row).
+  cv::Mat render_float_rows(const std::vector<SE2>& row_poses, const std::vector<Extrinsics>& row_extrinsics);
 
   const MipPyramid& pyramid() const;
   const RayTable& rays() const;
   FrameParams params(const SE2& robot_pose) const;
+  FrameParams params(const SE2& robot_pose, const Extrinsics& extrinsics) const;
   // Texel size along u and v in metres (texel_size times the prepare_texture scale).
   Eigen::Vector2d texel() const;
   // The OpenCL build options of the render program (registered with the Runtime).

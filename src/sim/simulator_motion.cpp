@@ -281,6 +281,18 @@ void validate(const Options& o) {
   require(std::isfinite(o.reflection) && o.reflection >= 0 && o.reflection <= 1000,
           "reflection must be in [0, 1000] grey levels");
   require(std::isfinite(o.shadow) && o.shadow >= 0 && o.shadow <= 0.95, "shadow must be in [0, 0.95]");
+  require(std::isfinite(o.lean) && std::abs(o.lean) <= 1.0,
+          "lean must be within +-1 s (degrees of body roll per degree/s of yaw rate)");
+  require(std::isfinite(o.bumps) && std::abs(o.bumps) <= 20.0 * kDeg, "bumps must be within +-20 degrees");
+  require(std::isfinite(o.bump_spacing) && o.bump_spacing > 0 && std::isfinite(o.bump_length) &&
+              o.bump_length > 0 && o.bump_length <= o.bump_spacing,
+          "bump_spacing and bump_length must be positive, the length at most the spacing");
+  require(!std::isnan(o.knock_time) && o.knock_time >= 0, "knock_time must be a time >= 0 (inf: no knock)");
+  require(std::isfinite(o.knock_roll) && std::isfinite(o.knock_pitch) && std::isfinite(o.knock_z) &&
+              std::abs(o.knock_roll) <= 30.0 * kDeg && std::abs(o.knock_pitch) <= 30.0 * kDeg,
+          "the knock's roll and pitch must be finite and within +-30 degrees");
+  require(o.extrinsics.z + o.knock_z > 0.2 * o.extrinsics.z,
+          "the knock's height change leaves the camera too close to the ground");
   Eigen::Vector2d px;
   const double reach = farthest_ground_view(o.camera, o.extrinsics, &px);
   const std::string at = "pixel (" + std::to_string(static_cast<int>(px.x())) + ", " +
@@ -313,6 +325,7 @@ Trajectory generate_trajectory(const Options& o) {
   tr.odometry.resize(n);
   tr.velocity.resize(n - 1);
   tr.direction.resize(n - 1);
+  tr.distance.assign(n, 0.0);
   for (size_t k = 0; k < n; ++k) tr.t[k] = static_cast<double>(k) * dt;
   tr.pose[0] = tr.odometry[0] = o.start_pose;
   const double half_base = 0.5 * o.wheel_base;
@@ -323,6 +336,7 @@ Trajectory generate_trajectory(const Options& o) {
     tr.velocity[k] = vw;
     tr.direction[k] = std::abs(v) < 1e-9 ? 0 : (v > 0 ? 1 : -1);
     tr.pose[k + 1] = tr.pose[k] * SE2::exp(Eigen::Vector3d(v * dt, 0.0, w * dt));
+    tr.distance[k + 1] = tr.distance[k] + std::abs(v) * dt;
 
     // Wheel odometry: each wheel's travel with an unbiased relative error.
     const double left = (v - w * half_base) * dt, right = (v + w * half_base) * dt;

@@ -373,23 +373,37 @@ const RayTable& Renderer::rays() const { return impl_->rays; }
 Eigen::Vector2d Renderer::texel() const { return impl_->texel; }
 
 FrameParams Renderer::params(const SE2& robot_pose) const {
-  return frame_params(robot_pose, impl_->options.extrinsics, impl_->texel, impl_->pyramid,
-                      impl_->options.supersampling, impl_->options.mipmap);
+  return params(robot_pose, impl_->options.extrinsics);
+}
+
+FrameParams Renderer::params(const SE2& robot_pose, const Extrinsics& extrinsics) const {
+  return frame_params(robot_pose, extrinsics, impl_->texel, impl_->pyramid, impl_->options.supersampling,
+                      impl_->options.mipmap);
 }
 
 cv::Mat Renderer::render_float(const SE2& robot_pose) {
-  const FrameParams p = params(robot_pose);
+  return render_float(robot_pose, impl_->options.extrinsics);
+}
+
+cv::Mat Renderer::render_float(const SE2& robot_pose, const Extrinsics& extrinsics) {
+  const FrameParams p = params(robot_pose, extrinsics);
   return impl_->launch(p, row_homographies(p, impl_->rays.height));
 }
 
 cv::Mat Renderer::render_float_rows(const std::vector<SE2>& row_poses) {
+  return render_float_rows(row_poses, std::vector<Extrinsics>(row_poses.size(), impl_->options.extrinsics));
+}
+
+cv::Mat Renderer::render_float_rows(const std::vector<SE2>& row_poses,
+                                    const std::vector<Extrinsics>& row_extrinsics) {
   Impl& m = *impl_;
-  if (row_poses.size() != static_cast<size_t>(m.rays.height))
-    throw_invalid_argument("Renderer::render_float_rows: needs one pose per image row (" +
-                           std::to_string(m.rays.height) + "), got " + std::to_string(row_poses.size()));
+  if (row_poses.size() != static_cast<size_t>(m.rays.height) || row_extrinsics.size() != row_poses.size())
+    throw_invalid_argument("Renderer::render_float_rows: needs one pose and one extrinsics per image row (" +
+                           std::to_string(m.rays.height) + "), got " + std::to_string(row_poses.size()) +
+                           " and " + std::to_string(row_extrinsics.size()));
   std::vector<FrameParams> rows;
   rows.reserve(row_poses.size());
-  for (const SE2& pose : row_poses) rows.push_back(params(pose));
+  for (size_t y = 0; y < row_poses.size(); ++y) rows.push_back(params(row_poses[y], row_extrinsics[y]));
   return m.launch(rows.front(), row_homographies(rows));
 }
 

@@ -79,21 +79,27 @@ cv::Mat render_frame(Renderer& renderer, const Options& o, const Trajectory& tr,
   if (k >= tr.t.size() || tr.t.size() != tr.pose.size())
     throw_invalid_argument("render_frame: no such frame in the trajectory");
   const double readout = o.readout_time, E = o.exposure_time;
-  if (readout == 0.0 && E == 0.0) return renderer.render_float(tr.pose[k]);
+  if (readout == 0.0 && E == 0.0)
+    return renderer.render_float(tr.pose[k], camera_extrinsics_at(o, tr, tr.t[k]));
   const int height = renderer.rays().height;
   const int n = exposure_samples(o, tr, k);
   cv::Mat sum;
   std::vector<SE2> rows(static_cast<size_t>(height));
+  std::vector<Extrinsics> row_extrinsics(static_cast<size_t>(height));
   for (int i = 0; i < n; ++i) {
     // The midpoint of the i-th of n equal parts of [t_row - E, t_row].
     const double offset = E == 0.0 ? 0.0 : -E + (i + 0.5) * E / n;
     cv::Mat image;
     if (readout == 0.0 || height < 2) {
-      image = renderer.render_float(pose_at(tr, tr.t[k] + offset));
+      const double t = tr.t[k] + offset;
+      image = renderer.render_float(pose_at(tr, t), camera_extrinsics_at(o, tr, t));
     } else {
-      for (int r = 0; r < height; ++r)
-        rows[static_cast<size_t>(r)] = pose_at(tr, tr.t[k] + static_cast<double>(r) / (height - 1) * readout + offset);
-      image = renderer.render_float_rows(rows);
+      for (int r = 0; r < height; ++r) {
+        const double t = tr.t[k] + static_cast<double>(r) / (height - 1) * readout + offset;
+        rows[static_cast<size_t>(r)] = pose_at(tr, t);
+        row_extrinsics[static_cast<size_t>(r)] = camera_extrinsics_at(o, tr, t);
+      }
+      image = renderer.render_float_rows(rows, row_extrinsics);
     }
     if (i == 0)
       sum = image;

@@ -1,6 +1,7 @@
 // simulate(): a whole data set in the layout of docs/formats.md, written with the
 // writers of formats.h.
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <string>
@@ -51,6 +52,9 @@ void write_simulation_yaml(const std::string& path, const Options& o, const Eige
     fs << "readout_time" << o.readout_time << "exposure_time" << o.exposure_time;
     fs << "supersampling" << o.supersampling << "mipmap" << static_cast<int>(o.mipmap);
     fs << "lamp_falloff" << o.lamp_falloff << "reflection" << o.reflection << "shadow" << o.shadow;
+    fs << "lean" << o.lean << "bumps" << o.bumps << "bump_spacing" << o.bump_spacing << "bump_length" << o.bump_length;
+    if (std::isfinite(o.knock_time))
+      fs << "knock" << std::vector<double>{o.knock_time, o.knock_roll, o.knock_pitch, o.knock_z};
     fs.release();
   } catch (const cv::Exception& e) {
     throw Error(ErrorCode::Io, path + ": cannot be written (" + e.err + ")");
@@ -108,6 +112,22 @@ void simulate(ocl::Runtime& runtime, const Options& options, const std::string& 
   io::write_tum((dir / "groundtruth.txt").string(), truth);
   io::write_tum((dir / "odometry.txt").string(), odometry);
   io::write_direction((dir / "direction.txt").string(), labels);
+  if (options.lean != 0.0 || options.bumps != 0.0) {
+    // The body's true attitude relative to the local ground plane, in track --plane-out's format.
+    std::vector<io::PlaneAttitude> plane;
+    for (size_t k = 0; k < tr.t.size(); ++k) {
+      const BodyAttitude a = body_attitude(options, tr, tr.t[k]);
+      plane.push_back({tr.t[k], a.roll, a.pitch, 0.0, 0.0});
+    }
+    io::write_plane((dir / "plane.txt").string(), plane);
+  }
+  if (std::isfinite(options.knock_time)) {
+    io::ExtrinsicsFile knocked = gt;
+    knocked.value = knocked_extrinsics(options);
+    knocked.notes = "ground truth after the knock at t = " + std::to_string(options.knock_time) + " s (seed " +
+                    std::to_string(options.seed) + ")";
+    io::write_extrinsics_yaml((dir / "extrinsics_knocked.yaml").string(), knocked);
+  }
   write_simulation_yaml((dir / "simulation.yaml").string(), options, renderer.texel());
   st.write += seconds_since(t0);
 

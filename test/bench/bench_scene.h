@@ -53,11 +53,15 @@ struct Scene {
   sim::MotionProfile motion = sim::MotionProfile::Mixed;
   double lamp = 0.0, reflection = 0.0, shadow = 0.0;  // the light fixed to the camera (sim::Options)
   double gain_variation = 0.05;  // gain=A: the camera's slow gain and offset change (sim::Options)
+  // A car's body (sim::Options): lean=S (degrees of roll per degree/s), bumps=DEG (peak pitch),
+  // knock=T:DROLL,DPITCH,DZ (s, deg, deg, m).
+  double lean = 0.0, bumps_deg = 0.0;
+  double knock_time = HUGE_VAL, knock_roll_deg = 0.0, knock_pitch_deg = 0.0, knock_z = 0.0;
 
   Extrinsics extrinsics() const { return has_ext ? ext : sim::paper_configuration(config); }
 
   // Takes one key=value argument: config, ext, fov, motion, speed, turn, radius, noise, gain, ss, mip, dist,
-  // readout, exposure. False
+  // readout, exposure, lamp, reflection, shadow, lean, bumps, knock. False
   // for another key; exits with a message on a bad value.
   bool parse(const std::string& k, const std::string& v) {
     if (k == "config") {
@@ -104,6 +108,18 @@ struct Scene {
       readout = std::atof(v.c_str());
     } else if (k == "exposure") {
       exposure = std::atof(v.c_str());
+    } else if (k == "lean") {
+      lean = std::atof(v.c_str());
+    } else if (k == "bumps") {
+      bumps_deg = std::atof(v.c_str());
+    } else if (k == "knock") {
+      const size_t colon = v.find(':');
+      const std::vector<std::string> d = split(colon == std::string::npos ? "" : v.substr(colon + 1));
+      if (colon == std::string::npos || d.size() != 3) fail("knock=T:DROLL,DPITCH,DZ (s, deg, deg, m)");
+      knock_time = std::atof(v.substr(0, colon).c_str());
+      knock_roll_deg = std::atof(d[0].c_str());
+      knock_pitch_deg = std::atof(d[1].c_str());
+      knock_z = std::atof(d[2].c_str());
     } else {
       return false;
     }
@@ -136,6 +152,12 @@ struct Scene {
     so.exposure_time = exposure;
     so.camera.rolling_shutter_readout = readout;
     so.camera.exposure_time = exposure;
+    so.lean = lean;
+    so.bumps = bumps_deg * M_PI / 180.0;
+    so.knock_time = knock_time;
+    so.knock_roll = knock_roll_deg * M_PI / 180.0;
+    so.knock_pitch = knock_pitch_deg * M_PI / 180.0;
+    so.knock_z = knock_z;
     return so;
   }
 
@@ -155,6 +177,16 @@ struct Scene {
       char l[128];
       std::snprintf(l, sizeof l, "; lamp falloff %.2f, reflection %.0f, shadow %.2f", lamp, reflection, shadow);
       out += l;
+    }
+    if (lean != 0 || bumps_deg != 0 || std::isfinite(knock_time)) {
+      char l[160];
+      std::snprintf(l, sizeof l, "; body lean %.3f deg per deg/s, bumps %.1f deg", lean, bumps_deg);
+      out += l;
+      if (std::isfinite(knock_time)) {
+        std::snprintf(l, sizeof l, ", knock at %.1f s by %.2f, %.2f deg, %.1f mm", knock_time, knock_roll_deg,
+                      knock_pitch_deg, knock_z * 1e3);
+        out += l;
+      }
     }
     return out;
   }

@@ -520,6 +520,51 @@ TEST(IoDirection, MalformedLinesNameFileAndLine) {
   bad("inf.txt", "inf 1", "not finite");
 }
 
+// plane.txt (the body's attitude relative to the local ground plane)
+TEST(IoPlane, WriteThenReadExactlyAndHandWritten) {
+  ScratchDir dir;
+  const std::vector<io::PlaneAttitude> a = {{0.0, 0.0123456789012345, -0.17453292519943295, 1e-4, 2.5e-4},
+                                            {0.033333333, -1.5e-9, 0.0, 0.0, 0.0},
+                                            {1700000000.5, 1.5, -1.5, 0.25, 3.0}};
+  const std::string path = (dir / "plane.txt").string();
+  io::write_plane(path, a);
+  const auto back = io::read_plane(path);
+  ASSERT_EQ(back.size(), a.size());
+  for (size_t i = 0; i < a.size(); ++i) {
+    EXPECT_NEAR(back[i].t, a[i].t, 1e-9);
+    EXPECT_EQ(back[i].roll, a[i].roll);  // angles and sigma round-trip exactly
+    EXPECT_EQ(back[i].pitch, a[i].pitch);
+    EXPECT_EQ(back[i].sigma_roll, a[i].sigma_roll);
+    EXPECT_EQ(back[i].sigma_pitch, a[i].sigma_pitch);
+  }
+  write_text(dir / "hand.txt", "# t roll pitch sr sp\n1\t0.01 -0.02 0 0\n  2 1e-3 2e-3 1e-4 1e-4  \n");
+  const auto h = io::read_plane((dir / "hand.txt").string());
+  ASSERT_EQ(h.size(), 2u);
+  EXPECT_EQ(h[1].t, 2.0);
+  EXPECT_EQ(h[1].pitch, 2e-3);
+}
+
+TEST(IoPlane, MalformedLinesNameFileAndLine) {
+  ScratchDir dir;
+  const auto bad = [&](const std::string& name, const std::string& line2, const char* says) {
+    SCOPED_TRACE(name);
+    const std::string path = (dir / name).string();
+    write_text(path, "0.0 0 0 0 0\n" + line2 + "\n9 0 0 0 0\n");
+    const std::string msg = expect_invalid_input([&] { io::read_plane(path); }, path, 2);
+    EXPECT_THAT(msg, HasSubstr(says));
+  };
+  bad("degrees.txt", "1.0 2.5 0 0 0", "radians");
+  bad("degrees_pitch.txt", "1.0 0 -10 0 0", "radians");
+  bad("sigma.txt", "1.0 0 0 -0.1 0", "negative");
+  bad("fields.txt", "1.0 0 0 0", "5 fields");
+  bad("time.txt", "0.0 0 0 0 0", "not after");
+  bad("nan.txt", "1.0 nan 0 0 0", "not finite");
+  const std::string p = (dir / "w.txt").string();
+  expect_error([&] { io::write_plane(p, {{0.0, NAN, 0.0, 0.0, 0.0}}); }, ErrorCode::InvalidArgument, p);
+  expect_error([&] { io::write_plane(p, {{0.0, 0.0, 0.0, -1.0, 0.0}}); }, ErrorCode::InvalidArgument, p);
+  expect_error([&] { io::write_plane(p, {{1.0, 0, 0, 0, 0}, {1.0, 0, 0, 0, 0}}); }, ErrorCode::InvalidArgument, p);
+}
+
 TEST(IoFrames, WriteThenReadWithSpacesInPaths) {
   ScratchDir dir;
   const std::vector<FrameEntry> frames = {{0.0, "images/0000.png"},
