@@ -63,4 +63,15 @@ Eigen::Matrix3d ground_homography(const Eigen::Matrix3d& K, const Extrinsics& e,
   return H / H(2, 2);
 }
 
+Eigen::Matrix3d ground_homography(const Eigen::Matrix3d& K, const Extrinsics& e_ref, const Extrinsics& e_live,
+                                  const Eigen::Matrix4d& robot_motion) {
+  // X_l = T_cl_cr X_r with T_cl_cr = T_cv(live) * motion^-1 * T_vc(ref).
+  const Eigen::Matrix4d T_lr = e_live.T_vc().inverse() * robot_motion.inverse() * e_ref.T_vc();
+  const Eigen::Matrix3d R = T_lr.topLeftCorner<3, 3>();
+  const Eigen::Vector3d t = T_lr.topRightCorner<3, 1>();
+  const Eigen::Vector3d n = e_ref.plane_normal_camera();
+  const Eigen::Matrix3d H = K * (R - t * n.transpose() / e_ref.z) * K.inverse();
+  return H / H(2, 2);
+}
+
 }  // namespace planarvo

@@ -34,5 +34,12 @@ struct Extrinsics {
 // homography between two frames"; the paper's eq. 3). K is the 3x3 camera matrix.
 Eigen::Matrix3d ground_homography(const Eigen::Matrix3d& K, const Extrinsics& e,
                                   const Eigen::Matrix4d& robot_motion);
+// The same between two cameras with their own poses relative to the ground plane (a body that
+// leans: core/body_attitude.h): the reference camera at e_ref in the reference robot's ground
+// frame, the live camera at e_live in the live robot's, the live robot at robot_motion in the
+// reference's. The plane's normal and distance are the reference camera's. Equals the one above
+// when e_ref and e_live are the same.
+Eigen::Matrix3d ground_homography(const Eigen::Matrix3d& K, const Extrinsics& e_ref, const Extrinsics& e_live,
+                                  const Eigen::Matrix4d& robot_motion);
 
 }  // namespace planarvo

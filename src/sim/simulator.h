@@ -19,6 +19,7 @@
 #include <Eigen/Core>
 #include <opencv2/core.hpp>
 
+#include "core/body_attitude.h"
 #include "core/extrinsics.h"
 #include "core/se2.h"
 #include "image/camera.h"
@@ -155,9 +156,6 @@ SE2 pose_at(const Trajectory& trajectory, double t);
 // smoothly. pitch = bumps * b(u) / max(b), b(u) = sin(2 pi u) sin^2(pi u), u the fraction of
 // bump_length driven since the bump's start (bumps start at spacing (j + 1/2), j = 0, 1, ...,
 // of the distance driven, forwards or backwards): smooth, nose one way then the other.
-struct BodyAttitude {
-  double roll = 0.0, pitch = 0.0;
-};
 BodyAttitude body_attitude(const Options& options, const Trajectory& trajectory, double t);
 
 // The camera's extrinsics relative to the local ground plane at time t: options.extrinsics

@@ -4,8 +4,6 @@
 #include <algorithm>
 #include <cmath>
 
-#include <Eigen/Geometry>
-
 #include "core/error.h"
 #include "sim/simulator.h"
 
@@ -72,13 +70,7 @@ Extrinsics knocked_extrinsics(const Options& o) {
 
 Extrinsics camera_extrinsics_at(const Options& o, const Trajectory& tr, double t) {
   const Extrinsics mount = t >= o.knock_time ? knocked_extrinsics(o) : o.extrinsics;
-  const BodyAttitude a = body_attitude(o, tr, t);
-  if (a.roll == 0.0 && a.pitch == 0.0) return mount;
-  Eigen::Matrix4d B = Eigen::Matrix4d::Identity();
-  B.topLeftCorner<3, 3>() = (Eigen::AngleAxisd(a.roll, Eigen::Vector3d::UnitX()) *
-                             Eigen::AngleAxisd(a.pitch, Eigen::Vector3d::UnitY()))
-                                .toRotationMatrix();
-  return Extrinsics::from_matrix(B * mount.T_vc());
+  return on_plane(mount, body_attitude(o, tr, t));
 }
 
 }  // namespace planarvo::sim

@@ -79,6 +79,67 @@ MotionHomography motion_homography(const Eigen::Matrix3d& K, const Extrinsics& e
   return out;
 }
 
+MotionHomography local_plane_homography(const Eigen::Matrix3d& K, const Extrinsics& mounting, const SE2& motion,
+                                        const BodyAttitude& reference, const BodyAttitude& live) {
+  const Eigen::Matrix4d T_vc = mounting.T_vc();
+  const Eigen::Matrix4d T_cv = T_vc.inverse();
+  auto body = [](const Eigen::Matrix3d& R) {
+    Eigen::Matrix4d B = Eigen::Matrix4d::Identity();
+    B.topLeftCorner<3, 3>() = R;
+    return B;
+  };
+  const Eigen::Matrix3d Br = reference.R_plane_body(), Bl = live.R_plane_body();
+  const Eigen::Matrix4d E_r = body(Br) * T_vc;
+  const Eigen::Matrix4d El_inv = T_cv * body(Bl.transpose());
+  const Eigen::Matrix4d T_inv = motion.inverse().matrix3d();
+  const Eigen::Matrix4d M = El_inv * T_inv * E_r;
+  const Eigen::Matrix3d R_vc = T_vc.topLeftCorner<3, 3>();
+  const Eigen::Vector3d t_vc = T_vc.topRightCorner<3, 1>();
+  const Eigen::Vector3d n = R_vc.transpose() * Br.transpose() * Eigen::Vector3d::UnitZ();
+  const double z = (Br * t_vc).z();
+  const Eigen::Matrix3d Kinv = K.inverse();
+
+  const Eigen::Matrix3d Hu = K * plane_map(M, n, z) * Kinv;
+  const double s = Hu(2, 2);
+  MotionHomography out;
+  out.nparam = kMotionParams + kAttitudeParams;
+  out.H = Hu / s;
+  const Eigen::Matrix3d Hinv = out.H.inverse();
+  auto put = [&](int k, const Eigen::Matrix3d& dP) {
+    const Eigen::Matrix3d dHu = K * dP * Kinv;
+    out.dH[static_cast<size_t>(k)] = dHu / s - Hu * dHu(2, 2) / (s * s);
+    out.G[static_cast<size_t>(k)] = Hinv * out.dH[static_cast<size_t>(k)];
+  };
+  for (int i = 0; i < kMotionParams; ++i) {
+    Eigen::Matrix4d gen = Eigen::Matrix4d::Zero();
+    if (i == 0) gen(0, 3) = 1.0;
+    if (i == 1) gen(1, 3) = 1.0;
+    if (i == 2) {
+      gen(0, 1) = -1.0;
+      gen(1, 0) = 1.0;
+    }
+    put(i, plane_map(El_inv * (-gen) * T_inv * E_r, n, z));
+  }
+  // dB/droll = [e_x]_x B, dB/dpitch = B [e_y]_x.
+  const Eigen::Matrix3d ex = skew(Eigen::Vector3d::UnitX()), ey = skew(Eigen::Vector3d::UnitY());
+  const Eigen::Matrix3d dBr[2] = {ex * Br, Br * ey}, dBl[2] = {ex * Bl, Bl * ey};
+  for (int i = 0; i < 2; ++i) {
+    Eigen::Matrix4d dBr4 = Eigen::Matrix4d::Zero();
+    dBr4.topLeftCorner<3, 3>() = dBr[i];
+    const Eigen::Matrix4d dM = El_inv * T_inv * dBr4 * T_vc;
+    const Eigen::Vector3d dn = R_vc.transpose() * dBr[i].transpose() * Eigen::Vector3d::UnitZ();
+    const double dz = (dBr[i] * t_vc).z();
+    const Eigen::Vector3d Mt = M.topRightCorner<3, 1>();
+    put(kMotionParams + i, plane_map(dM, n, z) - Mt * dn.transpose() / z + Mt * n.transpose() * dz / (z * z));
+  }
+  for (int i = 0; i < 2; ++i) {
+    Eigen::Matrix4d dBl4 = Eigen::Matrix4d::Zero();
+    dBl4.topLeftCorner<3, 3>() = dBl[i].transpose();
+    put(kMotionParams + 2 + i, plane_map(T_cv * dBl4 * T_inv * E_r, n, z));
+  }
+  return out;
+}
+
 Extrinsics rotate_orientation(const Extrinsics& e, const Eigen::Vector2d& y) {
   Eigen::Matrix4d T = e.T_vc();
   const Eigen::Vector3d w(y.x(), y.y(), 0.0);

@@ -42,6 +42,7 @@
 
 #include <Eigen/Core>
 
+#include "core/body_attitude.h"
 #include "core/extrinsics.h"
 #include "core/se2.h"
 #include "image/camera.h"
@@ -50,12 +51,14 @@ namespace planarvo::track {
 
 inline constexpr int kMotionParams = 3;       // x, y, theta of the planar motion
 inline constexpr int kOrientationParams = 2;  // the camera's tilt (section 5.1)
+inline constexpr int kAttitudeParams = 4;     // the local plane (section 6.4): the reference's and
+                                              // the live body's roll and pitch
 
 struct MotionHomography {
   Eigen::Matrix3d H;  // reference -> live pixels, H(2,2) = 1
-  int nparam = kMotionParams;  // 3, or 5 with the orientation (motion first)
-  std::array<Eigen::Matrix3d, kMotionParams + kOrientationParams> dH;  // ∂H/∂x_i, then ∂H/∂y_i at 0
-  std::array<Eigen::Matrix3d, kMotionParams + kOrientationParams> G;   // Ĥ^-1 dH_i: reference side
+  int nparam = kMotionParams;  // 3, 5 with the orientation, 7 with the attitudes (motion first)
+  std::array<Eigen::Matrix3d, kMotionParams + kAttitudeParams> dH;  // ∂H/∂x_i, then ∂H/∂y_i at 0
+  std::array<Eigen::Matrix3d, kMotionParams + kAttitudeParams> G;   // Ĥ^-1 dH_i: reference side
 };
 
 // H, dH and G for the motion estimate T̂ (live pose in the reference robot frame), for the
@@ -63,6 +66,20 @@ struct MotionHomography {
 // (eqs. 21-24). In double, analytic.
 MotionHomography motion_homography(const Eigen::Matrix3d& K, const Extrinsics& extrinsics,
                                    const SE2& motion, bool with_orientation = false);
+
+// The local plane (section 6.4; core/body_attitude.h). The camera is fixed to a body that
+// rotates relative to the local ground plane about the robot's origin: the reference camera is at
+// E_r = B(a_r) T_vc, the live one at E_l = B(a_l) T_vc (B = [Rx(roll) Ry(pitch) 0; 0 1]) in
+// their robots' ground frames, so the camera motion is M = E_l^-1 T̂^-1 E_r and the plane's normal
+// and distance are the reference camera's, n_r = R_r^T e_z and z_r = e_z^T B(a_r) t_vc:
+//     H ~ K (M_R - M_t n_r^T / z_r) K^-1
+// (ground_homography(K, E_r, E_l, T̂)). Its parameters: the motion x (as above), then the
+// reference's and the live attitude's roll and pitch, each updated additively (a <- a + y), with
+// dB/droll = [e_x]_x B and dB/dpitch = B [e_y]_x. The live attitude moves the live camera only
+// (dM = T_vc^-1 dB_l^T T̂^-1 E_r); the reference's moves the reference camera and the plane
+// (dM = E_l^-1 T̂^-1 dB_r T_vc, dn_r = R_vc^T dB_r^T e_z, dz_r = e_z^T dB_r t_vc). nparam 7.
+MotionHomography local_plane_homography(const Eigen::Matrix3d& K, const Extrinsics& mounting, const SE2& motion,
+                                        const BodyAttitude& reference, const BodyAttitude& live);
 
 // The orientation update of eq. 20: R_vc <- exp([y1, y2, 0]_x) R_vc about the camera centre,
 // returned as extrinsics (roll, pitch and yaw re-read from the rotation; yaw moves only at second

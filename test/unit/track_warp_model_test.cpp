@@ -9,6 +9,7 @@
 #include <Eigen/Dense>
 #include <gtest/gtest.h>
 
+#include "core/body_attitude.h"
 #include "core/extrinsics.h"
 #include "core/se2.h"
 #include "sim/simulator.h"
@@ -144,6 +145,77 @@ TEST(TrackWarpModel, HomographyMovesProjectedGroundPoints) {
       const Eigen::Vector3d q = mh.H * p_ref.homogeneous();
       EXPECT_LT((q.hnormalized() - p_live).norm(), 1e-9);
     }
+}
+
+// The local plane (section 6.4): cameras on a body that rolls and pitches about the robot's
+// origin, each frame at its own attitude. Body rotations written out by hand.
+Eigen::Matrix4d body(double roll, double pitch) {
+  const double cr = std::cos(roll), sr = std::sin(roll), cp = std::cos(pitch), sp = std::sin(pitch);
+  Eigen::Matrix3d Rx, Ry;
+  Rx << 1, 0, 0, 0, cr, -sr, 0, sr, cr;
+  Ry << cp, 0, sp, 0, 1, 0, -sp, 0, cp;
+  Eigen::Matrix4d B = Eigen::Matrix4d::Identity();
+  B.topLeftCorner<3, 3>() = Rx * Ry;
+  return B;
+}
+
+TEST(TrackWarpModel, LocalPlaneHomographyMovesProjectedGroundPoints) {
+  // A camera 1 m behind the axle, 0.9 m up; the reference body rolled and pitched, the live one
+  // otherwise: a ground point seen by the reference camera at p is seen by the live one at H p.
+  CameraModel cam = sim::default_camera(640, 480, 60.0);
+  cam.k1 = cam.k2 = 0;
+  const Extrinsics e{-1.0, 0.05, 0.9, 2 * kDeg, 40 * kDeg, M_PI};
+  const SE2 T(-0.08, 0.01, 0.02);
+  const BodyAttitude ar{0.03, -0.05}, al{-0.02, 0.08};
+  const Eigen::Matrix4d E_r = body(ar.roll, ar.pitch) * e.T_vc(), E_l = body(al.roll, al.pitch) * e.T_vc();
+  const MotionHomography mh = local_plane_homography(cam.K(), e, T, ar, al);
+  EXPECT_LT((mh.H - ground_homography(cam.K(), on_plane(e, ar), on_plane(e, al), T.matrix3d())).norm(), 1e-9);
+  int seen = 0;
+  for (double gx : {-0.05, -0.3, -0.6})  // the camera looks at about x = -0.24
+    for (double gy : {-0.4, 0.0, 0.5}) {
+      const Eigen::Vector4d X(gx, gy, 0, 1);  // on the ground, in the reference robot's frame
+      const Eigen::Vector4d Xc_ref = E_r.inverse() * X;
+      const Eigen::Vector4d Xc_live = E_l.inverse() * T.matrix3d().inverse() * X;
+      ASSERT_GT(Xc_ref.z(), 0);
+      ASSERT_GT(Xc_live.z(), 0);
+      const Eigen::Vector3d q = mh.H * cam.project(Xc_ref.head<3>()).homogeneous();
+      EXPECT_LT((q.hnormalized() - cam.project(Xc_live.head<3>())).norm(), 1e-8);
+      ++seen;
+    }
+  EXPECT_EQ(seen, 9);
+  // Equal attitudes of zero: the rigid camera's homography.
+  EXPECT_LT((local_plane_homography(cam.K(), e, T, {}, {}).H - motion_homography(cam.K(), e, T).H).norm(), 1e-12);
+  EXPECT_LT((ground_homography(cam.K(), e, e, T.matrix3d()) - ground_homography(cam.K(), e, T.matrix3d())).norm(),
+            1e-12);
+}
+
+TEST(TrackWarpModel, LocalPlaneDerivativesMatchCentralDifferences) {
+  std::mt19937 rng(23);
+  std::uniform_real_distribution<double> u(-1, 1);
+  for (int trial = 0; trial < 50; ++trial) {
+    const Extrinsics e{0.8 * u(rng), 0.2 * u(rng), 0.15 + 0.5 * (u(rng) + 1), 25 * kDeg * u(rng),
+                       40 * kDeg * u(rng), M_PI * u(rng)};
+    const Eigen::Matrix3d K = camera_matrix(200 + 300 * (u(rng) + 1), 320 + 10 * u(rng), 240 + 10 * u(rng));
+    const SE2 m(0.1 * u(rng), 0.05 * u(rng), 0.3 * u(rng));
+    const BodyAttitude ar{0.1 * u(rng), 0.15 * u(rng)}, al{0.1 * u(rng), 0.15 * u(rng)};
+    const MotionHomography mh = local_plane_homography(K, e, m, ar, al);
+    ASSERT_EQ(mh.nparam, 7);
+    const auto H_of = [&](const Eigen::Vector3d& x, const Eigen::Vector4d& y) {
+      const BodyAttitude r{ar.roll + y(0), ar.pitch + y(1)}, l{al.roll + y(2), al.pitch + y(3)};
+      return ground_homography(K, on_plane(e, r), on_plane(e, l), (m * SE2::exp(x)).matrix3d());
+    };
+    const double h = 1e-6;
+    for (int i = 0; i < 7; ++i) {
+      Eigen::Vector3d dx = Eigen::Vector3d::Zero();
+      Eigen::Vector4d dy = Eigen::Vector4d::Zero();
+      if (i < 3) dx(i) = h; else dy(i - 3) = h;
+      const Eigen::Matrix3d numeric = (H_of(dx, dy) - H_of(-dx, -dy)) / (2 * h);
+      const Eigen::Matrix3d& analytic = mh.dH[static_cast<size_t>(i)];
+      EXPECT_LT((numeric - analytic).norm(), 1e-6 * (1.0 + analytic.norm()))
+          << "trial " << trial << " parameter " << i << "\nnumeric\n" << numeric << "\nanalytic\n" << analytic;
+      EXPECT_LT((mh.H * mh.G[static_cast<size_t>(i)] - analytic).norm(), 1e-9 * (1.0 + analytic.norm()));
+    }
+  }
 }
 
 TEST(TrackWarpModel, PixelDisplacementOfASmallStep) {

@@ -1,0 +1,24 @@
+// The body's rotation relative to the local ground plane (the paper's section 6.4): a car's body
+// rolls in turns and pitches over bumps on its suspension, and the camera fixed to it turns with
+// it. R_plane_body = Rx(roll) Ry(pitch) (body x forward, y left, z up), the body rotating about
+// the robot frame's origin on the ground (docs/conventions.md, "The body's attitude"). A rigid
+// robot's body stays at 0, 0: the camera's extrinsics are then its pose relative to the ground.
+#pragma once
+#include <Eigen/Core>
+
+#include "core/extrinsics.h"
+
+namespace planarvo {
+
+struct BodyAttitude {
+  double roll = 0.0, pitch = 0.0;  // radians
+
+  bool zero() const { return roll == 0.0 && pitch == 0.0; }
+  Eigen::Matrix3d R_plane_body() const;
+};
+
+// The camera relative to the local ground plane when the body carrying it is at attitude a:
+// T = [R_plane_body 0; 0 1] T_vc of the mounting. The mounting exactly when a is zero.
+Extrinsics on_plane(const Extrinsics& mounting, const BodyAttitude& a);
+
+}  // namespace planarvo
