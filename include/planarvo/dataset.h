@@ -124,6 +124,18 @@ PLANARVO_API planarvo_status planarvo_bag_topics(const char* path, char* buffer,
 PLANARVO_API planarvo_status planarvo_read_tum(const char* path, double* timestamps, planarvo_se2* poses,
                                                size_t capacity, size_t* count);
 
+/* One frame's body attitude relative to the local ground plane (radians), as plane.txt holds it
+ * (planarvo track --plane-out, docs/formats.md). */
+typedef struct planarvo_plane_attitude {
+  double timestamp;
+  double roll, pitch;
+  double sigma_roll, sigma_pitch;
+} planarvo_plane_attitude;
+/* Writes plane.txt ("t roll pitch sigma_roll sigma_pitch" per line), complete or not at all.
+ * PLANARVO_ERROR_INVALID_ARGUMENT for timestamps that do not increase, non-finite values or a
+ * negative sigma; PLANARVO_ERROR_IO when it cannot be written. */
+PLANARVO_API planarvo_status planarvo_write_plane(const char* path, const planarvo_plane_attitude* rows, size_t count);
+
 /* Writes a TUM trajectory (t x y z qx qy qz qw, z = 0, rotation about z). */
 PLANARVO_API planarvo_status planarvo_write_tum(const char* path, const double* timestamps,
                                                 const planarvo_se2* poses, size_t count);

@@ -377,6 +377,15 @@ typedef struct planarvo_tracker_options {
    * not outlive the call. planarvo_tracker_save_flat_field writes such a file. Unread (so NULL)
    * for older struct_size. */
   const char* flat_field;
+  /* The local plane (the paper's section 6.4): non-zero estimates the body's roll and pitch
+   * relative to the local ground plane with every frame's motion (planarvo_track_result.roll,
+   * .pitch), for a car whose body leans in turns and pitches over bumps; the extrinsics are then
+   * the camera's mounting on the body at rest. Default 0 (a rigid body). local_plane_prior_sigma:
+   * the standard deviation, radians, of the prior that holds the attitude at the mounting where the
+   * images do not say otherwise; default 0.01745 (1 degree); must be positive and finite. Unread
+   * (so off) for older struct_size. */
+  int32_t local_plane;
+  double local_plane_prior_sigma;
 } planarvo_tracker_options;
 
 typedef enum planarvo_track_status {
@@ -400,6 +409,12 @@ typedef struct planarvo_track_result {
   double overlap;             /* keyframe pixels seen in this frame */
   int32_t keyframe;           /* non-zero when this frame became the keyframe */
   double ms;                  /* engine time: upload, undistortion, pyramid and tracking */
+  /* With planarvo_tracker_options.local_plane: the body's rotation relative to the local ground
+   * plane at this frame, R_plane_body = Rx(roll) Ry(pitch), radians, and its covariance (roll,
+   * pitch; row-major). A LOST frame keeps the last attitude with the prior's covariance. Zero
+   * otherwise. Written only when struct_size covers them. */
+  double roll, pitch;
+  double attitude_covariance[4];
 } planarvo_track_result;
 
 PLANARVO_API void planarvo_tracker_options_init(planarvo_tracker_options* options);

@@ -111,6 +111,17 @@ PLANARVO_API planarvo_status planarvo_write_tum(const char* path, const double* 
   });
 }
 
+PLANARVO_API planarvo_status planarvo_write_plane(const char* path, const planarvo_plane_attitude* rows, size_t count) {
+  return guard([&] {
+    require_path(path, "planarvo_write_plane");
+    require(count == 0 || rows != nullptr, "planarvo_write_plane: rows is NULL");
+    std::vector<planarvo::io::PlaneAttitude> v(count);
+    for (size_t i = 0; i < count; ++i)
+      v[i] = {rows[i].timestamp, rows[i].roll, rows[i].pitch, rows[i].sigma_roll, rows[i].sigma_pitch};
+    planarvo::io::write_plane(path, v);
+  });
+}
+
 struct planarvo_stats_writer {
   std::unique_ptr<planarvo::io::StatsWriter> writer;
 };

@@ -102,6 +102,12 @@ planarvo::track::TrackerOptions tracker_options_from_c(const planarvo_tracker_op
     if (options->struct_size >= offsetof(planarvo_tracker_options, flat_field) + sizeof(const char*) &&
         options->flat_field)
       o.flat_field = options->flat_field;
+    if (options->struct_size >= offsetof(planarvo_tracker_options, local_plane_prior_sigma) + sizeof(double)) {
+      o.local_plane = options->local_plane != 0;
+      require(std::isfinite(options->local_plane_prior_sigma) && options->local_plane_prior_sigma > 0,
+              "planarvo_tracker_options.local_plane_prior_sigma must be a positive, finite number of radians");
+      o.local_plane_prior_sigma = options->local_plane_prior_sigma;
+    }
   }
   return o;
 }
@@ -120,6 +126,8 @@ PLANARVO_API void planarvo_tracker_options_init(planarvo_tracker_options* o) {
   o->max_iterations = 0;
   o->keyframe_overlap = d.keyframe_overlap;
   o->estimate_brightness = d.estimate_brightness ? 1 : 0;
+  o->local_plane = d.local_plane ? 1 : 0;
+  o->local_plane_prior_sigma = d.local_plane_prior_sigma;
 }
 
 PLANARVO_API planarvo_status planarvo_tracker_create(planarvo_context* context, const planarvo_camera* camera,
@@ -182,6 +190,9 @@ PLANARVO_API planarvo_status planarvo_tracker_track(planarvo_tracker* tracker, c
     out.overlap = r.overlap;
     out.keyframe = r.keyframe ? 1 : 0;
     out.ms = r.ms;
+    out.roll = r.attitude.roll;
+    out.pitch = r.attitude.pitch;
+    planarvo::capi::matrix_to_c<2>(r.attitude_covariance, out.attitude_covariance);
     std::memcpy(result, &out, std::min(result->struct_size, sizeof out));
   });
 }

@@ -37,6 +37,7 @@ struct Tracked {
   std::vector<double> t;
   std::vector<planarvo_se2> pose, motion, truth;
   std::vector<planarvo_track_status> status;
+  std::vector<planarvo_plane_attitude> plane;  // the local plane's attitude per frame
   bool all_truth = true;
 };
 
@@ -198,6 +199,8 @@ TrackRun track_dataset(planarvo_context* ctx, planarvo_dataset* ds, const planar
     k.pose.push_back(r.pose);
     k.motion.push_back(r.motion);
     k.status.push_back(r.status);
+    k.plane.push_back({origin + fd.timestamp, r.roll, r.pitch, std::sqrt(std::max(0.0, r.attitude_covariance[0])),
+                       std::sqrt(std::max(0.0, r.attitude_covariance[3]))});
     k.truth.push_back(fd.groundtruth);
     k.all_truth = k.all_truth && fd.has_groundtruth;
     previous = fd;
@@ -209,6 +212,7 @@ TrackRun track_dataset(planarvo_context* ctx, planarvo_dataset* ds, const planar
     for (double& t : stamps) t += origin;
     check(planarvo_write_tum(outputs.trajectory.c_str(), stamps.data(), k.pose.data(), k.t.size()));
   }
+  if (!outputs.plane.empty()) check(planarvo_write_plane(outputs.plane.c_str(), k.plane.data(), k.plane.size()));
   if (!outputs.motions.empty()) check(planarvo_motion_pairs_save(outputs.motions.c_str(), pairs.data(), pairs.size()));
   if (!outputs.flat_field.empty()) {
     const planarvo_status s = planarvo_tracker_save_flat_field(tracker.get(), outputs.flat_field.c_str());
@@ -293,6 +297,13 @@ int cmd_track(int argc, char** argv) {
                              "of the camera's size (as DSO's vignette.png; --save-flat-field writes one)", ""},
       {"save-flat-field", "FILE", "after tracking, write the photometric model in use (learnt, or --flat-field's) as "
                                   "a 16-bit flat-field PNG for --flat-field (a warning when none was learnt)", ""},
+      {"local-plane", "", "estimate the body's roll and pitch relative to the local ground plane with every frame's "
+                          "motion (a car whose body leans in turns and pitches over bumps; the extrinsics are the "
+                          "camera's mounting on the body at rest)", "off: a rigid body"},
+      {"plane-prior", "DEG", "with --local-plane: the standard deviation of the prior that holds the attitude at the "
+                             "mounting where the images do not say otherwise", "1"},
+      {"plane-out", "FILE", "with --local-plane: write the body's attitude per frame (t roll pitch sigma_roll "
+                            "sigma_pitch, radians) to FILE", ""},
       {"quiet", "", "no progress bar", ""},
       {"help", "", "show this help", ""}};
   for (auto& b : bag_options()) specs.push_back(b);
@@ -310,13 +321,22 @@ int cmd_track(int argc, char** argv) {
   args.expect_positionals(1, "DATASET, the data set folder or a bag");
   const std::string dir = args.positionals()[0];
   // The options first: a usage error is reported before any file is read.
-  args.expect_output_files({"output", "stats", "motions-out", "save-flat-field"});
+  args.expect_output_files({"output", "stats", "motions-out", "save-flat-field", "plane-out"});
   planarvo_tracker_options o;
   planarvo_tracker_options_init(&o);
   o.levels = args.get_int_in("levels", o.levels, 1, 8);
   if (args.has("finest-level")) o.finest_level = args.get_int_in("finest-level", 0, 0, o.levels - 1);
   o.max_iterations = args.get_int_in("max-iterations", 0, 1, 1000);
   o.level0_subsample = args.get_int_in("level0-subsample", 0, 1, 8);
+  o.local_plane = args.has("local-plane") ? 1 : 0;
+  if ((args.has("plane-out") || args.has("plane-prior")) && !o.local_plane)
+    throw UsageError(std::string(args.has("plane-out") ? "--plane-out" : "--plane-prior") +
+                     " needs --local-plane: without it the body is taken as rigid and has no attitude to write");
+  if (args.has("plane-prior")) {
+    const double sigma = args.get_double("plane-prior", 1.0);
+    if (!(sigma > 0.0 && sigma <= 90.0)) throw UsageError("--plane-prior must be a positive number of degrees (up to 90)");
+    o.local_plane_prior_sigma = sigma * kDeg;
+  }
   const std::string flat_field = args.get("flat-field");  // outlives o
   o.flat_field = flat_field.empty() ? nullptr : flat_field.c_str();
   const std::optional<planarvo_region> roi = parse_roi(args);  // before any file is read
@@ -330,7 +350,7 @@ int cmd_track(int argc, char** argv) {
   DatasetPtr ds = open_dataset(dir, args, false, &progress, args.has("skip-bad-frames"));
   apply_roi(roi, ds.get());
   apply_readout(readout, ds.get());
-  const TrackRun run = track_dataset(ctx.get(), ds.get(), e, o, {args.get("output"), args.get("stats"), args.get("motions-out"), args.has("skip-bad-frames"), args.get("save-flat-field")}, &progress);
+  const TrackRun run = track_dataset(ctx.get(), ds.get(), e, o, {args.get("output"), args.get("stats"), args.get("motions-out"), args.has("skip-bad-frames"), args.get("save-flat-field"), args.get("plane-out")}, &progress);
   progress.finish();
   std::printf("tracked %s on %s\n", dir.c_str(), device_name(ctx.get()).c_str());
   print_track_run(run);

@@ -113,6 +113,8 @@ struct TrackOutputs {
   // The photometric model (the light fixed to the camera) as a flat-field PNG after tracking,
   // "" for none; a warning, not an error, when none was learnt.
   std::string flat_field;
+  // The local plane's attitude per tracked frame (plane.txt), "" for none.
+  std::string plane;
 };
 TrackRun track_dataset(planarvo_context* ctx, planarvo_dataset* ds, const planarvo_extrinsics& extrinsics,
                        const planarvo_tracker_options& options, const TrackOutputs& outputs, Progress* progress);

@@ -6,6 +6,7 @@
 
 #include <Eigen/Cholesky>
 
+#include "core/error.h"
 #include "ocl/runtime.h"
 #include "track/warp_model.h"
 
@@ -22,7 +23,7 @@ constexpr double kMadToSigma = 1.4826;
 
 using Vector5d = JointStep::Vector5d;
 using Matrix52d = JointStep::Matrix52d;
-// At most 5x5, on the stack (aligner.h's PriorMatrix and PriorVector).
+// At most kMaxJacobian square, on the stack (aligner.h's PriorMatrix and PriorVector).
 using MatrixL = PriorMatrix;
 using MatrixL2 = Eigen::Matrix<double, Eigen::Dynamic, 2, 0, 5, 2>;
 using VectorL = PriorVector;
@@ -39,21 +40,23 @@ WarpReduceOptions kernel_options(const AlignerOptions& o, bool stats) {
 // STATS), registered before main() so that exported kernel binaries hold them without an aligner
 // having been made (FPGA flows cannot compile at run time).
 const bool kDefaultVariantsRegistered = [] {
-  for (int nparam : {kMotionParams, kMotionParams + kOrientationParams}) {
+  for (int nparam : {kMotionParams, kMotionParams + kOrientationParams, kMotionParams + kAttitudeParams}) {
     const std::vector<std::string> uses =
         nparam == kMotionParams ? std::vector<std::string>{ocl::kUseTrack, ocl::kUseCalibrate}
-                                : std::vector<std::string>{ocl::kUseCalibrate};
+        : nparam == kMotionParams + kOrientationParams ? std::vector<std::string>{ocl::kUseCalibrate}
+                                                       : std::vector<std::string>{ocl::kUseTrack};
     for (bool stats : {false, true})
       ocl::Runtime::register_build_options(
           "warp_reduce", WarpReduce::build_options(nparam, kernel_options(AlignerOptions(), stats)), uses);
   }
   // The tracker's pass over a subsampled level (planarvo_tracker_options.level0_subsample; one
   // program for every block size).
-  for (bool stats : {false, true}) {
-    WarpReduceOptions k = kernel_options(AlignerOptions(), stats);
-    k.select_block = 2;
-    ocl::Runtime::register_build_options("warp_reduce", WarpReduce::build_options(kMotionParams, k), {ocl::kUseTrack});
-  }
+  for (int nparam : {kMotionParams, kMotionParams + kAttitudeParams})
+    for (bool stats : {false, true}) {
+      WarpReduceOptions k = kernel_options(AlignerOptions(), stats);
+      k.select_block = 2;
+      ocl::Runtime::register_build_options("warp_reduce", WarpReduce::build_options(nparam, k), {ocl::kUseTrack});
+    }
   return true;
 }();
 
@@ -98,25 +101,47 @@ PairBlock pair_block(const ReduceSums& s, int nl, bool orientation) {
   return b;
 }
 
-// The state of a pair relative to the prior's (the coarser level's estimate), in the pass's local
-// order: the motion in SE(2)'s tangent space, then log-gain and bias.
-Vector5d prior_error(const AlignmentPair& prior, const AlignmentPair& state) {
-  Vector5d e;
+// The state of a pair relative to the prior's (the coarser level's estimate), in the pass's sums'
+// order: the motion in SE(2)'s tangent space, the local plane's attitudes (local_plane), then
+// log-gain and bias (brightness). n entries.
+VectorL prior_error(const AlignmentPair& prior, const AlignmentPair& state, bool local_plane, bool brightness) {
+  const int n = kMotionParams + (local_plane ? kAttitudeParams : 0) + (brightness ? 2 : 0);
+  VectorL e(n);
   e.head<3>() = (prior.motion.inverse() * state.motion).log();
-  e(3) = state.log_gain - prior.log_gain;
-  e(4) = state.bias - prior.bias;
+  int i = kMotionParams;
+  if (local_plane) {
+    e(i++) = state.reference_attitude.roll - prior.reference_attitude.roll;
+    e(i++) = state.reference_attitude.pitch - prior.reference_attitude.pitch;
+    e(i++) = state.live_attitude.roll - prior.live_attitude.roll;
+    e(i++) = state.live_attitude.pitch - prior.live_attitude.pitch;
+  }
+  if (brightness) {
+    e(i++) = state.log_gain - prior.log_gain;
+    e(i++) = state.bias - prior.bias;
+  }
   return e;
 }
+
+// The local plane's attitudes of a pair against their prior's mean, radians.
+Eigen::Vector4d attitude_error(const AlignmentPair& p) {
+  return Eigen::Vector4d(p.reference_attitude.roll, p.reference_attitude.pitch, p.live_attitude.roll,
+                         p.live_attitude.pitch) -
+         p.attitude_prior_mean;
+}
+
+// The block of the pass's sums over the first n parameters in their own order (motion, the
+// model's, brightness when estimated: the homography's nparam followed by a and b, so without
+// brightness the first nparam).
+MatrixL sums_block(const ReduceSums& s, int n) { return s.JtWJ.topLeftCorner(n, n); }
+VectorL sums_gradient(const ReduceSums& s, int n) { return s.JtWr.head(n); }
 
 // Why the prior is tested (prior_consistency_scale, aligner.h): a rear camera 55 degrees from
 // vertical over asphalt, where half resolution blurs the foreshortened far field differently as
 // the view moves: its estimate is 10-15 of its standard deviations off, and with the prior at
 // full weight the subsample kept that bias (0.19 mm per frame where full resolution has 0.06).
-double prior_scale_of(const ReduceSums& data, const MatrixL& H, const Vector5d& e, int nl, double sigma,
-                      double chi2) {
-  const PairBlock b = pair_block(data, nl, false);
-  return prior_consistency_scale(MatrixL(b.A_ll.topLeftCorner(nl, nl)), VectorL(b.g_l.head(nl)), H,
-                                 e.head<3>(), sigma, chi2);
+double prior_scale_of(const ReduceSums& data, const MatrixL& H, const VectorL& e, double sigma, double chi2) {
+  const int n = static_cast<int>(e.size());
+  return prior_consistency_scale(sums_block(data, n), sums_gradient(data, n), H, e.head<3>(), sigma, chi2);
 }
 
 // Levenberg's damping H_ii (1 + lambda) plus a ridge of 1e-12 of the largest diagonal entry, so
@@ -153,28 +178,41 @@ double prior_consistency_scale(const PriorMatrix& A, const PriorVector& g, const
   return std::exp(lo);
 }
 
+namespace {
+// The pass of every level (the local plane's attitude levels add a pass of their own).
+int model_nparam(AlignerModel m) {
+  return m == AlignerModel::CameraTilt ? kMotionParams + kOrientationParams : kMotionParams;
+}
+}  // namespace
+
 Aligner::Aligner(ocl::Runtime& runtime, const Eigen::Matrix3d& K, const AlignerOptions& options,
                  bool with_orientation)
-    : K_(K), options_(options), with_orientation_(with_orientation), runtime_(runtime),
-      pass_(runtime, with_orientation ? kMotionParams + kOrientationParams : kMotionParams,
-            kernel_options(options, false)),
-      stats_pass_(runtime, with_orientation ? kMotionParams + kOrientationParams : kMotionParams,
-                  kernel_options(options, true)) {
+    : Aligner(runtime, K, options, with_orientation ? AlignerModel::CameraTilt : AlignerModel::Motion) {}
+
+Aligner::Aligner(ocl::Runtime& runtime, const Eigen::Matrix3d& K, const AlignerOptions& options, AlignerModel model)
+    : K_(K), options_(options), model_(model), with_orientation_(model == AlignerModel::CameraTilt),
+      nparam_(model_nparam(model)), runtime_(runtime),
+      pass_(runtime, nparam_, kernel_options(options, false)),
+      stats_pass_(runtime, nparam_, kernel_options(options, true)) {
   // The subsampled passes the options ask for, built now rather than at the first frame that
   // reaches their level.
+  if (model == AlignerModel::LocalPlane) {
+    attitude_pass_ = std::make_unique<WarpReduce>(runtime, kMotionParams + kAttitudeParams, kernel_options(options, false));
+    attitude_stats_pass_ =
+        std::make_unique<WarpReduce>(runtime, kMotionParams + kAttitudeParams, kernel_options(options, true));
+  }
   for (int b : options.select_blocks)
-    if (b >= 2) select_passes(b);
-  if (options.finest_level < 0 && options.auto_finer_block >= 2) select_passes(options.auto_finer_block);
+    if (b >= 2) select_passes(b, nparam_);
+  if (options.finest_level < 0 && options.auto_finer_block >= 2) select_passes(options.auto_finer_block, nparam_);
 }
 
-std::array<std::unique_ptr<WarpReduce>, 2>& Aligner::select_passes(int block) {
-  std::array<std::unique_ptr<WarpReduce>, 2>& passes = select_passes_[block];
+std::array<std::unique_ptr<WarpReduce>, 2>& Aligner::select_passes(int block, int nparam) {
+  std::array<std::unique_ptr<WarpReduce>, 2>& passes = select_passes_[{block, nparam}];
   if (!passes[0])
     for (int st : {0, 1}) {
       WarpReduceOptions k = kernel_options(options_, st == 1);
       k.select_block = block;
-      passes[static_cast<size_t>(st)] = std::make_unique<WarpReduce>(
-          runtime_, with_orientation_ ? kMotionParams + kOrientationParams : kMotionParams, k);
+      passes[static_cast<size_t>(st)] = std::make_unique<WarpReduce>(runtime_, nparam, k);
     }
   return passes;
 }
@@ -206,7 +244,7 @@ AlignmentLevels Aligner::levels(const Pyramid& reference, const Pyramid& live) c
 double Aligner::texture(const Pyramid& pyramid, int level) {
   const PyramidLevel& L = pyramid.levels[static_cast<size_t>(level)];
   WarpInputs in;
-  in.nparam = with_orientation_ ? kMotionParams + kOrientationParams : kMotionParams;
+  in.nparam = nparam_;
   for (Eigen::Matrix3d& G : in.G) G.setZero();
   in.huber_k = 1e30;
   ReduceSums s;
@@ -214,24 +252,38 @@ double Aligner::texture(const Pyramid& pyramid, int level) {
   return s.valid > 0 ? s.gref / s.valid : 0.0;
 }
 
+bool Aligner::attitude_level(const AlignmentPair& pair, int level, const AlignmentLevels& levels) const {
+  return model_ == AlignerModel::LocalPlane &&
+         (level == levels.coarsest ||
+          pair.live->levels[static_cast<size_t>(level)].width <= options_.attitude_max_width);
+}
+
 void Aligner::evaluate(const AlignmentPair& pair, const Extrinsics& e, int level, bool stats,
-                       ReduceSums* out) {
+                       ReduceSums* out, bool attitudes) {
   const PyramidLevel& R = pair.reference->levels[static_cast<size_t>(level)];
   const PyramidLevel& L = pair.live->levels[static_cast<size_t>(level)];
-  const MotionHomography mh = motion_homography(level_camera_matrix(K_, level), e, pair.motion, with_orientation_);
+  const Eigen::Matrix3d Kl = level_camera_matrix(K_, level);
+  const MotionHomography mh =
+      model_ == AlignerModel::LocalPlane
+          ? local_plane_homography(Kl, e, pair.motion, pair.reference_attitude, pair.live_attitude)
+          : motion_homography(Kl, e, pair.motion, with_orientation_);
   WarpInputs in;
   in.H = mh.H;
-  in.nparam = mh.nparam;
-  for (size_t i = 0; i < static_cast<size_t>(mh.nparam); ++i) in.G[i] = mh.G[i];
+  // The local plane's finer levels hold the attitudes: the motion's generators only.
+  in.nparam = model_ == AlignerModel::LocalPlane && !attitudes ? kMotionParams : mh.nparam;
+  for (size_t i = 0; i < static_cast<size_t>(in.nparam); ++i) in.G[i] = mh.G[i];
   in.gain = std::exp(pair.log_gain);
   in.bias = pair.bias;
   in.huber_k = options_.huber_factor * pair.sigma[static_cast<size_t>(level)];
   const SelectedPixels* sel = selection_at(pair, level);
   if (!sel) {
-    (stats ? stats_pass_ : pass_).run(R.data, R.width, R.height, L.data, L.width, L.height, in, out);
+    if (attitudes)
+      (stats ? *attitude_stats_pass_ : *attitude_pass_).run(R.data, R.width, R.height, L.data, L.width, L.height, in, out);
+    else
+      (stats ? stats_pass_ : pass_).run(R.data, R.width, R.height, L.data, L.width, L.height, in, out);
     return;
   }
-  select_passes(sel->block)[stats ? 1 : 0]->run(sel->data, sel->grid_w, sel->grid_h, L.data, L.width, L.height, in, out);
+  select_passes(sel->block, in.nparam)[stats ? 1 : 0]->run(sel->data, sel->grid_w, sel->grid_h, L.data, L.width, L.height, in, out);
 }
 
 const SelectedPixels* Aligner::selection_at(const AlignmentPair& pair, int level) {
@@ -291,6 +343,15 @@ bool solve_joint(const std::vector<ReduceSums>& sums, bool brightness, bool orie
   return true;
 }
 
+bool solve_dense(const ReduceSums& sums, int n, double lambda, PriorVector* step) {
+  MatrixL A = sums_block(sums, n);
+  damp(&A, n, lambda);
+  const Eigen::LDLT<MatrixL> ldlt(A);
+  if (ldlt.info() != Eigen::Success || !(ldlt.vectorD().minCoeff() > 0.0)) return false;
+  *step = -ldlt.solve(sums_gradient(sums, n));
+  return step->allFinite();
+}
+
 Eigen::Matrix2d joint_orientation_information(const std::vector<ReduceSums>& sums, bool brightness) {
   const int nl = brightness ? 5 : 3;
   Eigen::Matrix2d S = Eigen::Matrix2d::Zero();
@@ -313,6 +374,8 @@ AlignmentReport Aligner::align(std::vector<AlignmentPair>& pairs, Extrinsics* ex
   std::vector<double>& measured = measured_;
   measured.assign(P, 0.0);
   Extrinsics ext = *extrinsics;
+  const bool local_plane = model_ == AlignerModel::LocalPlane;
+  if (local_plane && P != 1) throw_invalid_argument("Aligner: the local plane aligns one image pair");
   auto fail = [&](const char* why, size_t p) {
     report.ok = false;
     report.reason = why;
@@ -327,13 +390,15 @@ AlignmentReport Aligner::align(std::vector<AlignmentPair>& pairs, Extrinsics* ex
 
   for (int level = levels.coarsest; level >= levels.finest; --level) {
     ++report.levels_used;
+    // This level estimates the local plane's attitudes (the seven-parameter pass), or holds them.
+    const bool att = local_plane && attitude_level(pairs[0], level, levels);
     const auto level_start = std::chrono::steady_clock::now();
     const auto L = static_cast<size_t>(level);
     const Eigen::Matrix3d Kl = level_camera_matrix(K_, level);
     int& passes = report.passes[L];
     for (size_t p = 0; p < P; ++p) {
       AlignmentPair& pair = pairs[p];
-      evaluate(pair, ext, level, true, &cur_[p]);
+      evaluate(pair, ext, level, true, &cur_[p], att);
       ++passes;
       if (!(cur_[p].valid >= options_.min_valid_fraction * reference_size(pair, level))) return fail(kAlignFewValid, p);
       if (!(cur_[p].glive >= options_.min_texture_ratio * cur_[p].gref)) return fail(kAlignNoLiveTexture, p);
@@ -346,7 +411,7 @@ AlignmentReport Aligner::align(std::vector<AlignmentPair>& pairs, Extrinsics* ex
       double& used = pair.sigma[L];
       if (!(measured[p] <= used * options_.rescale_ratio && measured[p] >= used / options_.rescale_ratio)) {
         used = measured[p];
-        evaluate(pair, ext, level, true, &cur_[p]);
+        evaluate(pair, ext, level, true, &cur_[p], att);
         ++passes;
       }
     }
@@ -357,24 +422,23 @@ AlignmentReport Aligner::align(std::vector<AlignmentPair>& pairs, Extrinsics* ex
     // sigma_there)^2), so that the subsample adds the fine texture's information to the coarser
     // level's instead of replacing it.
     // The prior's information per pair (empty: none), formed once for the level.
-    const int nl = local_size();
+    // The prior's parameters are the sums' own first n (motion, the local plane's attitudes,
+    // brightness), so its indices in the sums are 0 .. n-1 (the shared tilt has no such prior).
+    const bool brightness = options_.estimate_brightness;
+    const int n = (att ? kMotionParams + kAttitudeParams : nparam_) + (brightness ? 2 : 0);
     std::vector<MatrixL>& prior_H = prior_H_;
     prior_H.assign(P, MatrixL());
-    if (options_.subsample_prior && have_prev_ && !with_orientation_)
+    if (options_.subsample_prior && have_prev_ && !with_orientation_ && prev_attitudes_ == att)
       for (size_t p = 0; p < P; ++p)
         if (selection_at(pairs[p], level) != nullptr && prev_sigma_[p] > 0.0) {
-          prior_H[p] = std::pow(measured[p] / prev_sigma_[p], 2) *
-                       pair_block(prev_sums_[p], nl, false).A_ll.topLeftCorner(nl, nl);
-          prior_H[p] *= prior_scale_of(cur_[p], prior_H[p], prior_error(prev_state_[p], pairs[p]), nl,
-                                                measured[p], options_.prior_chi2);
+          prior_H[p] = std::pow(measured[p] / prev_sigma_[p], 2) * sums_block(prev_sums_[p], n);
+          prior_H[p] *= prior_scale_of(cur_[p], prior_H[p], prior_error(prev_state_[p], pairs[p], att, brightness),
+                                       measured[p], options_.prior_chi2);
         }
-    auto apply_prior = [&](size_t p, const AlignmentPair& state, ReduceSums* sums) {
-      const MatrixL& H = prior_H[p];
-      if (H.rows() == 0) return;
-      const int np = static_cast<int>(sums->JtWr.size()) - 2;
-      const int idx[5] = {0, 1, 2, np, np + 1};
-      const Vector5d e = prior_error(prev_state_[p], state);
-      const VectorL He = H * e.head(nl);
+    // Adds information H (cost units) on the sums' parameters `first` .. first + e.size() - 1 at
+    // the state's error e from its mean.
+    auto add_prior = [&](size_t p, const MatrixL& H, const VectorL& e, int first, ReduceSums* sums) {
+      const VectorL He = H * e;
       // For the covariance's sandwich (tracker.cpp): the prior is the Huber cost's Hessian too,
       // and its score, H e with e's covariance sigma_there^2 A_there^-1, has the covariance
       // sigma_here^2 H in this level's units.
@@ -382,18 +446,34 @@ AlignmentReport Aligner::align(std::vector<AlignmentPair>& pairs, Extrinsics* ex
       const bool bread = sums->has_stats && sums->JtJ_inlier.rows() == nj;
       const bool meat = sums->score_outer.rows() == nj;
       const double s2 = measured[p] * measured[p];
-      for (int i = 0; i < nl; ++i) {
-        for (int j = 0; j < nl; ++j) {
-          sums->JtWJ(idx[i], idx[j]) += H(i, j);
-          if (bread) sums->JtJ_inlier(idx[i], idx[j]) += H(i, j);
-          if (meat) sums->score_outer(idx[i], idx[j]) += s2 * H(i, j);
+      const int m = static_cast<int>(e.size());
+      for (int i = 0; i < m; ++i) {
+        for (int j = 0; j < m; ++j) {
+          sums->JtWJ(first + i, first + j) += H(i, j);
+          if (bread) sums->JtJ_inlier(first + i, first + j) += H(i, j);
+          if (meat) sums->score_outer(first + i, first + j) += s2 * H(i, j);
         }
-        sums->JtWr(idx[i]) += He(i);
+        sums->JtWr(first + i) += He(i);
       }
-      sums->cost += 0.5 * e.head(nl).dot(He);
+      sums->cost += 0.5 * e.dot(He);
+    };
+    // The attitudes' Gaussian prior (radians^-2) in this level's cost units: sigma^2 of the
+    // residuals (the data's J^T W J is the Hessian of sigma^2 times the negative log-likelihood).
+    auto attitude_prior = [&](size_t p, const AlignmentPair& state) -> MatrixL {
+      return measured[p] * measured[p] * state.attitude_prior_information;
+    };
+    const bool attitude_priors = att && !pairs[0].attitude_prior_information.isZero();
+    auto apply_prior = [&](size_t p, const AlignmentPair& state, ReduceSums* sums) {
+      if (prior_H[p].rows() > 0)
+        add_prior(p, prior_H[p], prior_error(prev_state_[p], state, att, brightness), 0, sums);
+      // The coarser level's information (prior_H) holds the data only: its own attitude prior
+      // was taken out (below), so that the consistency scale, which weakens prior_H when the
+      // motions disagree, does not weaken the attitudes' prior.
+      if (attitude_priors) add_prior(p, attitude_prior(p, state), VectorL(attitude_error(state)), kMotionParams, sums);
     };
     for (size_t p = 0; p < P; ++p) apply_prior(p, pairs[p], &cur_[p]);
     if (level == levels.finest) report.finest_stats = cur_;  // with the prior (if any), for the covariance
+    if (att) report.attitude_stats = cur_[0];
 
     double lambda = 0.0;
     int steps = 0;
@@ -402,7 +482,9 @@ AlignmentReport Aligner::align(std::vector<AlignmentPair>& pairs, Extrinsics* ex
     std::vector<AlignmentPair>& cand = cand_;
     cand = pairs;
     while (steps < max_steps) {
-      if (!solve_joint(cur_, options_.estimate_brightness, with_orientation_, lambda, &step)) {
+      const bool solved = local_plane ? solve_dense(cur_[0], n, lambda, &dense_step_)
+                                      : solve_joint(cur_, brightness, with_orientation_, lambda, &step);
+      if (!solved) {
         if (lambda >= 1e8) break;
         lambda = lambda == 0.0 ? options_.lambda_min : lambda * options_.lambda_up;
         continue;
@@ -411,12 +493,32 @@ AlignmentReport Aligner::align(std::vector<AlignmentPair>& pairs, Extrinsics* ex
       const Extrinsics cand_ext = with_orientation_ ? rotate_orientation(ext, step.orientation) : ext;
       double step_px = 0.0;
       for (size_t p = 0; p < P; ++p) {
-        const Vector5d& d = step.local[p];
         cand[p] = pairs[p];
+        const PyramidLevel& R = pairs[p].reference->levels[L];
+        if (local_plane) {
+          const VectorL& d = dense_step_;
+          cand[p].motion = pairs[p].motion * SE2::exp(d.head<3>());
+          int i = kMotionParams;
+          if (att) {
+            cand[p].reference_attitude = {pairs[p].reference_attitude.roll + d(3), pairs[p].reference_attitude.pitch + d(4)};
+            cand[p].live_attitude = {pairs[p].live_attitude.roll + d(5), pairs[p].live_attitude.pitch + d(6)};
+            i += kAttitudeParams;
+          }
+          if (brightness) {
+            cand[p].log_gain = pairs[p].log_gain + d(i);
+            cand[p].bias = pairs[p].bias + d(i + 1);
+          }
+          auto H = [&](const AlignmentPair& a) {
+            return ground_homography(Kl, on_plane(ext, a.reference_attitude), on_plane(ext, a.live_attitude),
+                                     a.motion.matrix3d());
+          };
+          step_px = std::max(step_px, max_pixel_displacement(H(pairs[p]), H(cand[p]), R.width, R.height));
+          continue;
+        }
+        const Vector5d& d = step.local[p];
         cand[p].motion = pairs[p].motion * SE2::exp(d.head<3>());
         cand[p].log_gain = pairs[p].log_gain + d(3);
         cand[p].bias = pairs[p].bias + d(4);
-        const PyramidLevel& R = pairs[p].reference->levels[L];
         step_px = std::max(step_px, max_pixel_displacement(Kl, ext, pairs[p].motion, cand_ext, cand[p].motion,
                                                            R.width, R.height));
       }
@@ -433,7 +535,7 @@ AlignmentReport Aligner::align(std::vector<AlignmentPair>& pairs, Extrinsics* ex
       }
       bool valid = true;
       for (size_t p = 0; p < P; ++p) {
-        evaluate(cand[p], cand_ext, level, false, &next_[p]);
+        evaluate(cand[p], cand_ext, level, false, &next_[p], att);
         apply_prior(p, cand[p], &next_[p]);
         ++passes;
         valid = valid && next_[p].valid >= options_.min_valid_fraction * reference_size(pairs[p], level);
@@ -452,14 +554,26 @@ AlignmentReport Aligner::align(std::vector<AlignmentPair>& pairs, Extrinsics* ex
       for (size_t p = 0; p < P; ++p) report.finest_huber_k[p] = options_.huber_factor * pairs[p].sigma[L];
     }
     for (size_t p = 0; p < P; ++p) pairs[p].sigma[L] = measured[p];
+    if (att) {
+      report.attitude_level = level;
+      report.attitude_sums = cur_[0];
+    }
+    if (level == levels.finest) report.finest_nparam = att ? kMotionParams + kAttitudeParams : nparam_;
+    prev_attitudes_ = att;
     prev_sums_ = cur_;
+    if (attitude_priors)
+      for (size_t p = 0; p < P; ++p)
+        prev_sums_[p].JtWJ.block(kMotionParams, kMotionParams, kAttitudeParams, kAttitudeParams) -=
+            attitude_prior(p, pairs[p]);
     prev_state_ = pairs;
     prev_sigma_ = measured;
     have_prev_ = true;
     report.level_ms[L] =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - level_start).count();
     for (size_t p = 0; p < P; ++p)
-      if (!finite(pairs[p].motion) || !std::isfinite(pairs[p].log_gain) || !std::isfinite(pairs[p].bias))
+      if (!finite(pairs[p].motion) || !std::isfinite(pairs[p].log_gain) || !std::isfinite(pairs[p].bias) ||
+          !std::isfinite(pairs[p].reference_attitude.roll + pairs[p].reference_attitude.pitch +
+                         pairs[p].live_attitude.roll + pairs[p].live_attitude.pitch))
         return fail(kAlignDiverged, p);
     if (!std::isfinite(ext.roll) || !std::isfinite(ext.pitch)) return fail(kAlignDiverged, 0);
   }

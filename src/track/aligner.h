@@ -13,16 +13,19 @@
 #pragma once
 #include <array>
 #include <map>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Core>
 
+#include "core/body_attitude.h"
 #include "core/extrinsics.h"
 #include "core/se2.h"
 #include <memory>
 
 #include "image/pyramid.h"
 #include "track/pixel_selection.h"
+#include "track/warp_model.h"
 #include "track/warp_reduce.h"
 
 namespace planarvo::ocl {
@@ -87,6 +90,20 @@ struct AlignerOptions {
   double min_texture_ratio = 0.1;
   // The fused pass's work-group shape etc. (stats and debug_output are set by the aligner).
   WarpReduceOptions kernel = WarpReduceOptions();
+  // AlignerModel::LocalPlane: the attitudes are estimated on the levels at most this many pixels
+  // wide (and on the coarsest level in any case), with the seven-parameter pass; the finer levels
+  // align the motion alone (the three-parameter pass) with the attitudes where the coarser ones
+  // left them. 160: levels 2-3 at 640x480, 1-3 at 320x240 (src/track/README.md, "The local plane").
+  int attitude_max_width = 1 << 30;
+};
+
+// What the homography's parameters are beyond the planar motion (warp_model.h).
+enum class AlignerModel {
+  Motion,      // the planar motion only (NPARAM 3): the tracker on a rigid body
+  CameraTilt,  // the pairs share the camera's tilt about its centre (NPARAM 5): roll and pitch
+               // calibration (section 5.1), updating the extrinsics
+  LocalPlane,  // the body's attitude relative to the local ground plane at the reference and at
+               // the live frame (NPARAM 7, section 6.4), per pair, with a Gaussian prior; one pair
 };
 
 // One image pair and the estimate of its own parameters: the live robot pose in the reference
@@ -102,6 +119,12 @@ struct AlignmentPair {
   // The robust scale per level (grey levels): brought in (a tracker keeps it from frame to
   // frame; 0 means initial_sigma) and left as measured.
   std::array<double, kMaxLevels> sigma{};
+  // AlignerModel::LocalPlane: the body's attitude at the reference and at the live frame (both
+  // estimated, from these values), and their Gaussian prior over (reference roll, reference
+  // pitch, live roll, live pitch): mean and information (radians^-2; zero: no prior).
+  BodyAttitude reference_attitude, live_attitude;
+  Eigen::Vector4d attitude_prior_mean = Eigen::Vector4d::Zero();
+  Eigen::Matrix4d attitude_prior_information = Eigen::Matrix4d::Zero();
 };
 
 struct AlignmentLevels {
@@ -131,6 +154,14 @@ struct AlignmentReport {
   // times the scale in use there: finest_sigma, or the one the pair brought when within
   // rescale_ratio of it), grey levels.
   std::vector<double> finest_huber_k;
+  // The homography's parameters at the finest level (the layout of `finest`): AlignerModel::
+  // LocalPlane estimates the attitudes on the coarser levels only (attitude_max_width).
+  int finest_nparam = kMotionParams;
+  // AlignerModel::LocalPlane: the last level that estimated the attitudes, its last pass's sums
+  // at the estimate and the STATS pass that opened it (both with the attitudes' prior), for the
+  // attitudes' covariance; attitude_level -1 when none did.
+  int attitude_level = -1;
+  ReduceSums attitude_sums, attitude_stats;
   // With the orientation: its information (Schur complement of the whole system at the finest
   // level, undamped, unscaled: J^T W J in grey levels^-2 units) and sum of w r^2 and valid pixels
   // over all pairs, for the covariance sigma^2 S^-1.
@@ -171,10 +202,13 @@ Eigen::Matrix2d joint_orientation_information(const std::vector<ReduceSums>& sum
 // chi-square with 3 degrees of freedom when both covariances are right. Returns 1 when d^2 <=
 // chi2 (or chi2 <= 0), else the factor s on H that makes the inflated prior explain the
 // difference (d^2 with H^-1 / s equal to chi2), 0 below 1e-6.
-using PriorMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 5, 5>;
-using PriorVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 5, 1>;
+using PriorMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxJacobian, kMaxJacobian>;
+using PriorVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxJacobian, 1>;
 double prior_consistency_scale(const PriorMatrix& A, const PriorVector& g, const PriorMatrix& H,
                                const Eigen::Vector3d& e_motion, double sigma, double chi2);
+// Solves the first n parameters of one pass's sums (their own order) densely: (A + lambda
+// diag(A) + ridge) step = -g. False when not positive definite at this damping.
+bool solve_dense(const ReduceSums& sums, int n, double lambda, PriorVector* step);
 
 class Aligner {
  public:
@@ -182,14 +216,16 @@ class Aligner {
   // camera's tilt (NPARAM 5) and align() updates the extrinsics' roll and pitch.
   Aligner(ocl::Runtime& runtime, const Eigen::Matrix3d& K, const AlignerOptions& options,
           bool with_orientation);
+  Aligner(ocl::Runtime& runtime, const Eigen::Matrix3d& K, const AlignerOptions& options, AlignerModel model);
 
   // The levels to align for pyramids like these (options' levels, finest_level, select_blocks
   // and auto_finer_block).
   AlignmentLevels levels(const Pyramid& reference, const Pyramid& live) const;
 
   // Aligns every pair from its current estimate, coarse to fine over `levels`, updating the
-  // pairs' motions, brightness and scales and (with the orientation) *extrinsics. The report
-  // says whether it worked; the estimates are finite either way (the last good ones).
+  // pairs' motions, brightness and scales, (with the orientation) *extrinsics and (the local
+  // plane) the pairs' attitudes. The report says whether it worked; the estimates are finite
+  // either way (the last good ones). The local plane aligns one pair (InvalidArgument otherwise).
   AlignmentReport align(std::vector<AlignmentPair>& pairs, Extrinsics* extrinsics,
                         const AlignmentLevels& levels);
 
@@ -201,33 +237,47 @@ class Aligner {
   // is not included): the inverse of its motion block's covariance up to sigma^2. n = 3 or 5.
   int local_size() const { return options_.estimate_brightness ? 5 : 3; }
   bool with_orientation() const { return with_orientation_; }
+  AlignerModel model() const { return model_; }
+  // The homography's parameters of the levels that estimate the model's (3, 5 or 7), and all
+  // parameters in the pass's sums' order (motion, the model's, then brightness when estimated).
+  int nparam() const { return model_ == AlignerModel::LocalPlane ? kMotionParams + kAttitudeParams : nparam_; }
+  int param_count() const { return nparam() + (options_.estimate_brightness ? 2 : 0); }
   const AlignerOptions& options() const { return options_; }
 
  private:
-  void evaluate(const AlignmentPair& pair, const Extrinsics& e, int level, bool stats, ReduceSums* out);
+  void evaluate(const AlignmentPair& pair, const Extrinsics& e, int level, bool stats, ReduceSums* out,
+                bool attitudes = false);
+  // AlignerModel::LocalPlane: whether `level` estimates the attitudes (attitude_max_width).
+  bool attitude_level(const AlignmentPair& pair, int level, const AlignmentLevels& levels) const;
   // The reference's size at `level` as the pass sees it: the level's pixels, or its selection's grid.
   static double reference_size(const AlignmentPair& pair, int level);
 
   Eigen::Matrix3d K_;
   AlignerOptions options_;
-  bool with_orientation_;
+  AlignerModel model_;
+  bool with_orientation_;  // model_ == CameraTilt
+  int nparam_;
   ocl::Runtime& runtime_;
   WarpReduce pass_, stats_pass_;
+  std::unique_ptr<WarpReduce> attitude_pass_, attitude_stats_pass_;  // LocalPlane: NPARAM 7
   // The passes over selected pixels (plain, STATS) per block size, made when first needed.
-  std::map<int, std::array<std::unique_ptr<WarpReduce>, 2>> select_passes_;
-  std::array<std::unique_ptr<WarpReduce>, 2>& select_passes(int block);
+  // Keyed by block size and NPARAM (the local plane's attitude levels use 7).
+  std::map<std::pair<int, int>, std::array<std::unique_ptr<WarpReduce>, 2>> select_passes_;
+  std::array<std::unique_ptr<WarpReduce>, 2>& select_passes(int block, int nparam);
   static const SelectedPixels* selection_at(const AlignmentPair& pair, int level);
   // The level just aligned: its last sums, the pairs' estimates and robust scales.
   std::vector<ReduceSums> prev_sums_;
   std::vector<AlignmentPair> prev_state_;
   std::vector<double> prev_sigma_;
   bool have_prev_ = false;
+  bool prev_attitudes_ = false;  // the level just aligned estimated the attitudes (its sums' layout)
   // Per pair, the prior's J^T W J at a subsampled level.
   std::vector<PriorMatrix> prior_H_;
   std::vector<ReduceSums> cur_, next_;
   std::vector<AlignmentPair> cand_;
   std::vector<double> measured_;
   JointStep step_;
+  PriorVector dense_step_;
 };
 
 }  // namespace planarvo::track

@@ -6,6 +6,11 @@ namespace planarvo::track {
 
 Eigen::Matrix3d alignment_covariance(const ReduceSums& s, const ReduceSums& st, int n, double floor_s2,
                                      const MatrixJ& A, const Eigen::LDLT<MatrixJ>& ldlt, double step_fraction) {
+  return alignment_covariance_all(s, st, n, floor_s2, A, ldlt, step_fraction).topLeftCorner(3, 3);
+}
+
+MatrixJ alignment_covariance_all(const ReduceSums& s, const ReduceSums& st, int n, double floor_s2, const MatrixJ& A,
+                                 const Eigen::LDLT<MatrixJ>& ldlt, double step_fraction) {
   // Bread: the Huber cost's Hessian, J^T J over the inliers (J^T W J also counts the pixels
   // beyond the threshold, with weight k / |r|, and would understate the spread).
   const ReduceSums& hs = s.has_stats ? s : st;
@@ -22,11 +27,11 @@ Eigen::Matrix3d alignment_covariance(const ReduceSums& s, const ReduceSums& st, 
   MatrixJ M = s.clusters > 2.0 * n ? MatrixJ(s.score_outer.topLeftCorner(n, n) * (s.clusters / (s.clusters - 1.0)))
                                    : MatrixJ(std::max(s.wrr / dof, floor_s2) * A);
   M += std::max(0.0, floor_s2 - s.wrr / dof) * A;
-  Eigen::Matrix3d C = (Binv * M * Binv.transpose()).topLeftCorner(3, 3);
-  C = 0.5 * (C + C.transpose());
+  MatrixJ C = Binv * M * Binv.transpose();
+  C = 0.5 * (C + C.transpose()).eval();
   // The last step, applied unchecked (or left over): the estimate is off by a fraction of it.
   const VectorJ step = -ldlt.solve(VectorJ(s.JtWr.head(n)));
-  const Eigen::Vector3d d = step_fraction * step.head(3);
+  const VectorJ d = step_fraction * step;
   if (d.allFinite()) C += d * d.transpose();
   return C;
 }

@@ -15,5 +15,9 @@ namespace planarvo::track {
 // ldlt its factorisation; step_fraction TrackerOptions::covariance_step_fraction.
 Eigen::Matrix3d alignment_covariance(const ReduceSums& s, const ReduceSums& st, int n, double floor_s2,
                                      const MatrixJ& A, const Eigen::LDLT<MatrixJ>& ldlt, double step_fraction);
+// The same over all n parameters (n x n; the motion's is its top-left 3 x 3): the local plane's
+// attitudes (AlignerModel::LocalPlane) take their covariance from it.
+MatrixJ alignment_covariance_all(const ReduceSums& s, const ReduceSums& st, int n, double floor_s2, const MatrixJ& A,
+                                 const Eigen::LDLT<MatrixJ>& ldlt, double step_fraction);
 
 }  // namespace planarvo::track

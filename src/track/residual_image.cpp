@@ -49,9 +49,13 @@ void ResidualImager::compute(const AlignmentRecord& a, const Extrinsics& extrins
     throw_invalid_argument("residual image: level " + std::to_string(level) + " is smaller than 2 x 2 pixels");
 
   // The final alignment's warp at this level; the generators only feed the sums, unused here.
-  const MotionHomography mh = motion_homography(level_camera_matrix(K_, level), extrinsics, a.motion);
+  const Eigen::Matrix3d Kl = level_camera_matrix(K_, level);
+  const MotionHomography mh = motion_homography(Kl, extrinsics, a.motion);
   WarpInputs in;
-  in.H = mh.H;
+  in.H = a.reference_attitude.zero() && a.live_attitude.zero()
+             ? mh.H
+             : ground_homography(Kl, on_plane(extrinsics, a.reference_attitude),
+                                 on_plane(extrinsics, a.live_attitude), a.motion.matrix3d());
   in.nparam = kMotionParams;
   for (size_t i = 0; i < static_cast<size_t>(kMotionParams); ++i) in.G[i] = mh.G[i];
   in.gain = std::exp(a.log_gain);
@@ -84,7 +88,7 @@ void ResidualImager::compute(const AlignmentRecord& a, const Extrinsics& extrins
     out->weight[i] = host_debug_[4 * i + 1];
     out->intensity[i] = host_ref_[4 * i + 3] != 0.0f ? host_ref_[4 * i] : nan;
   }
-  out->H = mh.H;
+  out->H = in.H;
   out->gain = in.gain;
   out->bias = in.bias;
   out->huber_k = in.huber_k;

@@ -11,6 +11,7 @@
 #include <CL/opencl.hpp>
 #include <Eigen/Core>
 
+#include "core/body_attitude.h"
 #include "core/extrinsics.h"
 #include "core/se2.h"
 #include "image/pyramid.h"
@@ -31,6 +32,8 @@ struct AlignmentRecord {
   double log_gain = 0, bias = 0;   // brightness: r = e^a I_l + b - I_r
   double huber_k = 0;              // the Huber threshold of the finest level tracked, grey levels
   int finest_level = 0;            // the finest level tracked
+  // The local plane's attitudes of the keyframe and the live frame (zero: the rigid body).
+  BodyAttitude reference_attitude, live_attitude;
 };
 
 struct ResidualImage {

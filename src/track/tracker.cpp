@@ -33,6 +33,7 @@ constexpr int kMinLevelSide = 8;
 struct Estimate {
   SE2 T;
   double a = 0.0, b = 0.0;
+  BodyAttitude att_ref, att_live;  // the local plane's: the keyframe's and this frame's attitude
   double huber_k = 0.0;  // of the alignment that made it: the finest level's threshold, and that level
   int finest = 0;
 };
@@ -140,6 +141,7 @@ struct Tracker::Impl {
   bool has_t = false;
   std::array<double, kMaxLevels> sigma{};  // the robust scale per level, from frame to frame
   std::vector<AlignmentPair> pairs = std::vector<AlignmentPair>(1);
+  LocalPlane plane;  // TrackerOptions::local_plane: the keyframe's attitude and its covariance
   AlignmentReport report;
   // The last frame's final alignment for residuals() (has_last), or why there is none (missing;
   // nullptr: no frame aligned since the first), and the residual image made from it (cached,
@@ -158,8 +160,10 @@ struct Tracker::Impl {
   Pyramid spare;
 
   Impl(ocl::Runtime& r, const CameraModel& c, const Extrinsics& e, const TrackerOptions& o)
-      : rt(r), camera(validated_tracker_camera(c, e, o)), ext(e), opt(o), aligner(r, c.K(), o, false), selector(r),
-        light_gate(camera.K(), camera.width, camera.height, e, o.learn_motion_px, o.max_texture_residual) {
+      : rt(r), camera(validated_tracker_camera(c, e, o)), ext(e), opt(o),
+        aligner(r, c.K(), o, o.local_plane ? AlignerModel::LocalPlane : AlignerModel::Motion), selector(r),
+        light_gate(camera.K(), camera.width, camera.height, e, o.learn_motion_px, o.max_texture_residual),
+        plane(o.local_plane_prior_sigma) {
     readout_twist = ReadoutTwist(camera.mean_row_time());
     // The flat field is read now, so that a bad file fails at once rather than at the first frame.
     if (!opt.flat_field.empty() && opt.photometric.enabled) {
@@ -194,6 +198,7 @@ struct Tracker::Impl {
     prev_predicted = false;
     prev_covariance.setZero();
     prev_tilt.setZero();
+    plane.reset();
     keyframe_shear_assumed = false;
     velocity.setZero();
     readout_twist.reset();
@@ -219,6 +224,7 @@ struct Tracker::Impl {
     pair.log_gain = init.a;
     pair.bias = init.b;
     pair.sigma = sigma;
+    if (opt.local_plane) plane.prepare(init.att_live, &pair);
     Extrinsics e = ext;
     AlignmentLevels levels = aligner.levels(keyframe, live);
     if (refine) levels.coarsest = std::max(levels.finest, std::min(1, levels.coarsest));
@@ -247,9 +253,16 @@ struct Tracker::Impl {
     out->T = pair.motion;
     out->a = pair.log_gain;
     out->b = pair.bias;
+    out->att_ref = pair.reference_attitude;
+    out->att_live = pair.live_attitude;
     out->huber_k = report.finest_huber_k.empty() ? 0.0 : report.finest_huber_k[0];
     out->finest = levels.finest;
     return true;
+  }
+
+  // A Lost frame's attitude: the prior's.
+  Eigen::Matrix2d lost_attitude_covariance() const {
+    return opt.local_plane_prior_sigma * opt.local_plane_prior_sigma * Eigen::Matrix2d::Identity();
   }
 
   // The position covariance too large, or much longer along one axis than the other (texture
@@ -282,6 +295,8 @@ struct Tracker::Impl {
     a.bias = e.b;
     a.huber_k = e.huber_k;
     a.finest_level = e.finest;
+    a.reference_attitude = e.att_ref;
+    a.live_attitude = e.att_live;
     return a;
   }
 
@@ -294,7 +309,8 @@ struct Tracker::Impl {
     res->overlap = s.ref > 0 ? s.valid / s.ref : 0.0;
     res->log_gain = e.a;
     res->bias = e.b;
-    const int n = opt.estimate_brightness ? 5 : 3;
+    const int nb = opt.estimate_brightness ? 2 : 0;
+    const int n = report.finest_nparam + nb;  // motion (the local plane's attitudes), brightness
     const double dof = std::max(1.0, s.valid - n);
     res->sigma = report.finest_sigma[0];
     // The independent-pixel covariance sigma^2 (J^T W J)^-1 (sigma^2 at least min_sigma^2, so
@@ -308,9 +324,26 @@ struct Tracker::Impl {
     Eigen::Matrix3d independent = s2 * inv.topLeftCorner(3, 3);
     if (!independent.allFinite()) independent = lost_covariance();
     // The motion's covariance is composed from this one by the caller (track_gray).
-    res->alignment_covariance =
-        alignment_covariance(s, report.finest_stats[0], n, floor_s2, A, ldlt, opt.covariance_step_fraction);
+    const MatrixJ C =
+        alignment_covariance_all(s, report.finest_stats[0], n, floor_s2, A, ldlt, opt.covariance_step_fraction);
+    res->alignment_covariance = C.topLeftCorner(3, 3);
     if (!res->alignment_covariance.allFinite()) res->alignment_covariance = lost_covariance();
+    if (opt.local_plane) {
+      // The live attitude (parameters 5, 6: after the motion and the keyframe's attitude), from
+      // the last level that estimated the attitudes.
+      res->attitude = e.att_live;
+      res->attitude_covariance = lost_attitude_covariance();
+      if (report.attitude_level >= 0) {
+        const int na = kMotionParams + kAttitudeParams + nb;
+        const ReduceSums& sa = report.attitude_sums;
+        const MatrixJ Aa = sa.JtWJ.topLeftCorner(na, na);
+        const Eigen::LDLT<MatrixJ> la(Aa);
+        const MatrixJ Ca =
+            alignment_covariance_all(sa, report.attitude_stats, na, floor_s2, Aa, la, opt.covariance_step_fraction);
+        const Eigen::Matrix2d cov = Ca.block(kMotionParams + 2, kMotionParams + 2, 2, 2);
+        if (cov.allFinite()) res->attitude_covariance = cov;
+      }
+    }
 
     // The images' match from the half-resolution level (or the finest, when coarser): at full
     // resolution a noisy, weakly textured view's residual is mostly pixel noise.
@@ -392,6 +425,7 @@ struct Tracker::Impl {
     select_keyframe_pixels();
     has_keyframe = true;
     prev = Estimate();
+    prev.att_ref = prev.att_live = plane.keyframe();
     prev_predicted = false;
     prev_covariance.setZero();
     prev_tilt.setZero();
@@ -681,11 +715,16 @@ struct Tracker::Impl {
       res.reason = why;
       res.motion.value = predicted;
       res.motion.covariance = res.alignment_covariance = lost_covariance();
+      if (opt.local_plane) {
+        res.attitude = prev.att_live;
+        res.attitude_covariance = lost_attitude_covariance();
+      }
       pose = pose * predicted;
       ++lost_in_a_row;
       // A frame misaligned by the light fixed to the camera is not a bad frame: the keyframe and
       // the light's model are what failed, and a new keyframe takes a new model into use.
       if (can_be_keyframe && (lost_in_a_row >= 2 || !predict || why == kMisaligned)) {
+        if (opt.local_plane) plane.take_keyframe(prev.att_live, lost_attitude_covariance());
         make_keyframe(live);
         keyframe_twist_measured = false;
         res.keyframe = true;
@@ -719,6 +758,10 @@ struct Tracker::Impl {
       keyframe_twist_measured = false;
       lost_in_a_row = 0;
       res.status = Status::First;
+      if (opt.local_plane) {
+        res.attitude = plane.keyframe();
+        res.attitude_covariance = plane.keyframe_covariance();
+      }
       res.keyframe = true;
       since_good = 0.0;
       return done(res);
@@ -805,6 +848,7 @@ struct Tracker::Impl {
     since_good = 0.0;
     lost_in_a_row = 0;
     if (res.overlap < opt.keyframe_overlap || log_scale_change(camera.K(), ext, est.T, camera.region()) > opt.keyframe_scale_change) {
+      if (opt.local_plane) plane.take_keyframe(est.att_live, res.attitude_covariance);
       make_keyframe(live);
       keyframe_twist_measured = true;
       // Frames aligned with it carry its own shutter offset, which the motions from it must not.

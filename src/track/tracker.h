@@ -11,6 +11,7 @@
 
 #include <Eigen/Core>
 
+#include "core/body_attitude.h"
 #include "core/extrinsics.h"
 #include "core/motion.h"
 #include "core/se2.h"
@@ -18,6 +19,7 @@
 #include "image/photometric.h"
 #include "image/pyramid.h"
 #include "track/aligner.h"
+#include "track/local_plane.h"
 #include "track/motion_search.h"
 #include "track/residual_image.h"
 #include "track/warp_reduce.h"
@@ -135,6 +137,14 @@ struct TrackerOptions : AlignerOptions {
   // 640x480 here). For the calibration (calib/tilt_propagation.h); off for tracking.
   bool tilt_jacobian = false;
 
+  // The local plane (the paper's section 6.4; local_plane.h): the body's roll and pitch relative
+  // to the local ground plane are estimated with every frame's motion (FrameResult::attitude), so
+  // that a car's body leaning in turns or pitching over bumps does not bend the motions. The
+  // extrinsics given are then the camera's mounting on the body at rest. The live attitude's
+  // prior is the mounting (zero) with standard deviation local_plane_prior_sigma, radians.
+  bool local_plane = false;
+  double local_plane_prior_sigma = 0.5 * M_PI / 180.0;
+
   static WarpReduceOptions default_kernel_options();
 };
 
@@ -187,6 +197,12 @@ struct FrameResult {
   // was given, in the right perturbation of motion.value (the covariance's coordinates) per
   // radian: how this motion would move had the tilt been different (zero otherwise, and Lost).
   Eigen::Matrix<double, 3, 2> motion_tilt_jacobian = Eigen::Matrix<double, 3, 2>::Zero();
+  // With TrackerOptions::local_plane: the body's attitude relative to the local ground plane at
+  // this frame, R_plane_body = Rx(roll) Ry(pitch) (core/body_attitude.h), and its covariance
+  // (radians^2). A Lost frame keeps the last attitude with the prior's covariance. Zero, with a
+  // zero covariance, without the local plane (the rigid body assumed).
+  BodyAttitude attitude;
+  Eigen::Matrix2d attitude_covariance = Eigen::Matrix2d::Zero();
   double ms = 0;               // wall time of track(), milliseconds
   double pipeline_ms = 0;      // of which the image pipeline (camera-frame API only)
 };

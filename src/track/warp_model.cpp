@@ -156,8 +156,11 @@ double max_pixel_displacement(const Eigen::Matrix3d& K, const Extrinsics& e, con
 
 double max_pixel_displacement(const Eigen::Matrix3d& K, const Extrinsics& ea, const SE2& a,
                               const Extrinsics& eb, const SE2& b, int width, int height) {
-  const Eigen::Matrix3d Ha = ground_homography(K, ea, a.matrix3d());
-  const Eigen::Matrix3d Hb = ground_homography(K, eb, b.matrix3d());
+  return max_pixel_displacement(ground_homography(K, ea, a.matrix3d()), ground_homography(K, eb, b.matrix3d()),
+                                width, height);
+}
+
+double max_pixel_displacement(const Eigen::Matrix3d& Ha, const Eigen::Matrix3d& Hb, int width, int height) {
   const double w = width - 1.0, h = height - 1.0;
   const double pts[5][2] = {{0, 0}, {w, 0}, {0, h}, {w, h}, {0.5 * w, 0.5 * h}};
   double worst = 0.0;

@@ -95,6 +95,9 @@ double max_pixel_displacement(const Eigen::Matrix3d& K, const Extrinsics& extrin
 double max_pixel_displacement(const Eigen::Matrix3d& K, const Extrinsics& ea, const SE2& a,
                               const Extrinsics& eb, const SE2& b, int width, int height);
 
+// The same between two homographies (reference -> live pixels).
+double max_pixel_displacement(const Eigen::Matrix3d& Ha, const Eigen::Matrix3d& Hb, int width, int height);
+
 // How much the ground's scale in the image changes under `motion` (the live pose in the
 // reference's robot frame): the largest |log| of the warp's linear scale (the square root of its
 // Jacobian's determinant) at the centre and the corners of `region`; HUGE_VAL where the warp

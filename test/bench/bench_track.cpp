@@ -194,6 +194,10 @@ struct SequenceReport {
   // The honest status: frames reported Ok whose motion is more than 1 mm off (missed), frames
   // reported Degraded or Lost whose motion is within 1 mm (false alarms).
   int missed = 0, false_alarms = 0;
+  // The local plane (TrackerOptions::local_plane) against the simulator's body: the attitude's
+  // errors (roll, pitch; RMS and largest over frames after the first, degrees), and RMS(error/sigma).
+  double att_rms[2] = {0, 0}, att_max[2] = {0, 0}, att_nz[2] = {0, 0};
+  int att_n = 0;
   // FrameResult::texture_residual: the largest over frames within 0.2 mm, the smallest over
   // frames more than 1 mm off (the honest-status check's margin).
   double tex_good_max = 0, tex_bad_min = HUGE_VAL;
@@ -299,6 +303,22 @@ SequenceReport run_sequence(ocl::Runtime& rt, const sim::Options& so, const trac
     rep.degraded += r.status == track::FrameResult::Status::Degraded;
     rep.lost += r.status == track::FrameResult::Status::Lost;
     if (k == 0) continue;
+    if (topt.local_plane) {
+      const BodyAttitude a = sim::body_attitude(so, traj, traj.t[k]);
+      const double err[2] = {r.attitude.roll - a.roll, r.attitude.pitch - a.pitch};
+      for (int i = 0; i < 2; ++i) {
+        rep.att_rms[i] += err[i] * err[i];
+        rep.att_max[i] = std::max(rep.att_max[i], std::abs(err[i]));
+        const double var = r.attitude_covariance(i, i);
+        if (var > 0) rep.att_nz[i] += err[i] * err[i] / var;
+      }
+      ++rep.att_n;
+      if (verbose && (std::abs(err[0]) > 0.2 * M_PI / 180 || std::abs(err[1]) > 0.2 * M_PI / 180))
+        std::printf("  frame %zu: attitude roll %.3f (true %.3f) pitch %.3f (true %.3f) deg, sigma %.3f %.3f\n", k,
+                    r.attitude.roll * 180 / M_PI, a.roll * 180 / M_PI, r.attitude.pitch * 180 / M_PI,
+                    a.pitch * 180 / M_PI, std::sqrt(r.attitude_covariance(0, 0)) * 180 / M_PI,
+                    std::sqrt(r.attitude_covariance(1, 1)) * 180 / M_PI);
+    }
     const SE2 t = traj.pose[k - 1].inverse() * traj.pose[k];
     est.push_back(r.motion.value);
     truth.push_back(t);
@@ -377,6 +397,12 @@ int bench_accuracy(const std::vector<std::string>& textures, double seconds, int
     std::printf("%6.2f %6.2f %6.2f ", t.median, t.p99_over_median, t.max_over_median);
     for (int l = topt.levels - 1; l >= 0; --l) std::printf(" %.2f", r.passes[l] / n);
     std::printf("\n");
+    if (topt.local_plane && r.att_n > 0)
+      std::printf("  local plane: roll error RMS %.3f max %.3f deg, pitch error RMS %.3f max %.3f deg; RMS error/sigma "
+                  "%.2f, %.2f\n",
+                  std::sqrt(r.att_rms[0] / r.att_n) * 180 / M_PI, r.att_max[0] * 180 / M_PI,
+                  std::sqrt(r.att_rms[1] / r.att_n) * 180 / M_PI, r.att_max[1] * 180 / M_PI,
+                  std::sqrt(r.att_nz[0] / r.att_n), std::sqrt(r.att_nz[1] / r.att_n));
     std::printf("  texture residual (the honest-status check): largest of frames within 0.2 mm %.3f, smallest of "
                 "frames over 1 mm %.3f\n", r.tex_good_max, r.tex_bad_min);
     if (!std::isnan(r.flat_end.with_value) || !std::isnan(r.flat_2s.with_value))
@@ -746,6 +772,9 @@ int main(int argc, char** argv) {
       else if (k == "huber") topt.huber_factor = std::atof(v.c_str());
       else if (k == "brightness") topt.estimate_brightness = v != "0";
       else if (k == "decorrelate") topt.decorrelate_noise = v != "0";
+      else if (k == "plane") topt.local_plane = v != "0";
+      else if (k == "plane_width") topt.attitude_max_width = std::atoi(v.c_str());
+      else if (k == "plane_sigma") topt.local_plane_prior_sigma = std::atof(v.c_str()) * M_PI / 180.0;
       else if (k == "kf_scale") topt.keyframe_scale_change = std::atof(v.c_str());
       else if (k == "overlap") topt.keyframe_overlap = std::atof(v.c_str());
       else if (k == "maxit") {

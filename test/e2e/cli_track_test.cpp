@@ -204,5 +204,35 @@ TEST(CliTrack, MissingExtrinsicsIsUsageError) {
   EXPECT_NE(r.output.find("extrinsics.yaml"), std::string::npos) << r.output;
 }
 
+// The local plane: `track --local-plane --plane-out` on a car whose body leans and pitches writes
+// one attitude per frame, against the simulator's truth (its plane.txt, the same format, read with
+// the same reader); --plane-out or --plane-prior without --local-plane, and a prior that is not a
+// positive number of degrees, are usage errors that write nothing.
+TEST(CliTrack, LocalPlaneWritesTheBodysAttitude) {
+  ScratchDir d;
+  const std::string seq = (d / "car").string();
+  auto r = run_cli("simulate --quiet --out " + seq + " --seconds 2 --width 320 --height 240 --fov 60 --motion car "
+                   "--max-speed 3 --min-turn-radius 6 --extrinsics=-1,0,0.9,0,40,180 --lean -0.07 --bumps 6 --seed 3");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const std::string plane = (d / "plane.txt").string(), extrinsics = seq + "/extrinsics_gt.yaml";
+  for (const std::string& bad : std::vector<std::string>{" --plane-out " + plane, " --plane-prior 1", " --local-plane --plane-prior 0",
+                                " --local-plane --plane-prior -2"}) {
+    r = run_cli("track --quiet " + seq + " --extrinsics " + extrinsics + bad);
+    EXPECT_EQ(r.exit_code, 2) << bad << "\n" << r.output;
+    EXPECT_FALSE(fs::exists(plane)) << bad;
+  }
+  r = run_cli("track --quiet " + seq + " --extrinsics " + extrinsics + " --local-plane --plane-out " + plane);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const std::vector<io::PlaneAttitude> got = io::read_plane(plane), truth = io::read_plane(seq + "/plane.txt");
+  ASSERT_EQ(got.size(), truth.size());
+  double sq = 0;
+  for (size_t k = 0; k < got.size(); ++k) {
+    EXPECT_NEAR(got[k].t, truth[k].t, 1e-6);
+    EXPECT_GT(got[k].sigma_roll, 0.0);
+    sq += std::pow(got[k].roll - truth[k].roll, 2) + std::pow(got[k].pitch - truth[k].pitch, 2);
+  }
+  EXPECT_LT(std::sqrt(sq / (2.0 * static_cast<double>(got.size()))), 0.3 * M_PI / 180.0);
+}
+
 }  // namespace
 }  // namespace planarvo

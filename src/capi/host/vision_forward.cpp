@@ -141,6 +141,11 @@ PLANARVO_API planarvo_status planarvo_write_tum(const char* path, const double* 
   return fn ? fn(path, timestamps, poses, count) : PLANARVO_ERROR_INTERNAL;
 }
 
+PLANARVO_API planarvo_status planarvo_write_plane(const char* path, const planarvo_plane_attitude* rows, size_t count) {
+  PLANARVO_FORWARD(planarvo_write_plane);
+  return fn ? fn(path, rows, count) : PLANARVO_ERROR_INTERNAL;
+}
+
 PLANARVO_API planarvo_status planarvo_stats_writer_open(const char* path, planarvo_stats_writer** writer) {
   PLANARVO_FORWARD(planarvo_stats_writer_open);
   return fn ? fn(path, writer) : PLANARVO_ERROR_INTERNAL;
