@@ -107,14 +107,16 @@ class SimOptions(ctypes.Structure):
 class TrackerOptions(ctypes.Structure):
     _fields_ = [("struct_size", c_size_t), ("levels", c_int32), ("finest_level", c_int32),
                 ("max_iterations", c_int32), ("keyframe_overlap", c_double), ("estimate_brightness", c_int32),
-                ("level0_subsample", c_int32), ("flat_field", c_char_p)]
+                ("level0_subsample", c_int32), ("flat_field", c_char_p), ("local_plane", c_int32),
+                ("local_plane_prior_sigma", c_double)]
 
 
 class TrackResult(ctypes.Structure):
     _fields_ = [("struct_size", c_size_t), ("status", c_enum), ("reason", c_char_p), ("motion", SE2),
                 ("covariance", c_double * 9), ("pose", SE2), ("iterations", c_int32 * 8), ("levels_used", c_int32),
                 ("final_cost", c_double), ("inlier_fraction", c_double), ("overlap", c_double),
-                ("keyframe", c_int32), ("ms", c_double)]
+                ("keyframe", c_int32), ("ms", c_double), ("roll", c_double), ("pitch", c_double),
+                ("attitude_covariance", c_double * 4)]
 
 
 class MotionAccuracy(ctypes.Structure):

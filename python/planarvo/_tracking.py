@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import ctypes
 import enum
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Optional, Tuple
 
 import numpy as np
@@ -40,6 +40,12 @@ class TrackerOptions:
     # brightest 1, 8- or 16-bit grey, the camera's size) instead of learning the light fixed to
     # the camera; None learns. Tracker.save_flat_field writes one.
     flat_field: Optional[PathLike] = None
+    # The local plane (the paper's section 6.4): estimate the body's roll and pitch relative to the
+    # local ground plane with every frame's motion (a car whose body leans and pitches); the
+    # extrinsics are then the camera's mounting on the body at rest. local_plane_prior_sigma:
+    # radians, the prior holding the attitude at the mounting where the images say nothing.
+    local_plane: Optional[bool] = None
+    local_plane_prior_sigma: Optional[float] = None
 
 
 def _tracker_options(options: Optional[TrackerOptions]) -> N.TrackerOptions:
@@ -53,7 +59,10 @@ def _tracker_options(options: Optional[TrackerOptions]) -> N.TrackerOptions:
 class TrackResult:
     """One tracked frame. motion: the frame's robot pose in the previous frame's robot frame;
     covariance: (3, 3) of motion (x, y, theta); pose: relative to the first frame; ms: the
-    engine's time for the frame (upload, undistortion, pyramid, tracking)."""
+    engine's time for the frame (upload, undistortion, pyramid, tracking). With
+    TrackerOptions.local_plane: roll, pitch (radians), the body's rotation relative to the local
+    ground plane, R_plane_body = Rx(roll) Ry(pitch), and attitude_covariance (2, 2); zeros
+    otherwise."""
     status: TrackStatus
     reason: str
     motion: SE2
@@ -66,6 +75,9 @@ class TrackResult:
     overlap: float
     keyframe: bool
     ms: float
+    roll: float = 0.0
+    pitch: float = 0.0
+    attitude_covariance: np.ndarray = field(default_factory=lambda: np.zeros((2, 2)))
 
 
 @dataclass
@@ -123,7 +135,8 @@ class Tracker(_Handle):
                            SE2(r.motion.x, r.motion.y, r.motion.theta),
                            np.frombuffer(r.covariance, dtype=np.float64).reshape(3, 3).copy(),
                            SE2(r.pose.x, r.pose.y, r.pose.theta), tuple(r.iterations), r.levels_used,
-                           r.final_cost, r.inlier_fraction, r.overlap, bool(r.keyframe), r.ms)
+                           r.final_cost, r.inlier_fraction, r.overlap, bool(r.keyframe), r.ms, r.roll, r.pitch,
+                           np.frombuffer(r.attitude_covariance, dtype=np.float64).reshape(2, 2).copy())
 
     def residuals(self, level: int = 0) -> Residuals:
         """The last tracked frame's residuals against the keyframe it was aligned with, at pyramid
