@@ -82,6 +82,8 @@ bool read_params(const ros::NodeHandle& nh, NodeParams* p) {
   planarvo_tracker_options_init(&p->tracker);
   planarvo_tracker_options& t = p->tracker;
   int levels = t.levels, finest = t.finest_level, subsample = t.level0_subsample, iterations = t.max_iterations;
+  bool local_plane = t.local_plane != 0;
+  double plane_prior_deg = t.local_plane_prior_sigma * 180.0 / M_PI;
   bool ok = get_text(nh, "camera", &p->camera) && get_text(nh, "extrinsics", &p->extrinsics) &&
             get_text(nh, "device", &p->device) && get_text(nh, "cache_dir", &p->cache_dir) &&
             get_text(nh, "kernel_binaries", &p->kernel_binaries) &&
@@ -91,7 +93,8 @@ bool read_params(const ros::NodeHandle& nh, NodeParams* p) {
             get_int(nh, "level0_subsample", 0, 8, &subsample) && get_text(nh, "flat_field", &p->flat_field) &&
             get_double(nh, "readout_time", -1.0, 1.0, &p->readout_time) &&
             get_double(nh, "exposure_time", -1.0, 1.0, &p->exposure_time) &&
-            get_int(nh, "max_iterations", 0, 1000, &iterations) &&
+            get_int(nh, "max_iterations", 0, 1000, &iterations) && get_bool(nh, "local_plane", &local_plane) &&
+            get_double(nh, "local_plane_prior_deg", 1e-6, 90.0, &plane_prior_deg) &&
             get_double(nh, "keyframe_overlap", 0.0, 1.0, &t.keyframe_overlap) &&
             get_int(nh, "queue_size", 1, 100000, &p->queue_size) &&
             get_int(nh, "max_pending", 1, 100000, &p->max_pending) &&
@@ -106,6 +109,8 @@ bool read_params(const ros::NodeHandle& nh, NodeParams* p) {
   t.finest_level = finest;
   t.level0_subsample = subsample;
   t.max_iterations = iterations;
+  t.local_plane = local_plane ? 1 : 0;
+  t.local_plane_prior_sigma = plane_prior_deg * M_PI / 180.0;
   if (p->calibrate && p->calibration_output.empty()) {
     ROS_FATAL("planarvo_node: ~calibrate is true but ~calibration_output (the extrinsics file to write) is not set");
     return false;

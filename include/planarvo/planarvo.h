@@ -499,6 +499,33 @@ PLANARVO_API planarvo_status planarvo_evaluate_motions(const planarvo_se2* estim
                                                        double gross_threshold,
                                                        planarvo_motion_accuracy* accuracy);
 
+/* A least-squares line y = slope x + offset; slope_sigma its standard error from the residual
+ * scatter (infinite with fewer than 3 samples or no spread in x); r2 the share of the variance
+ * it explains. */
+typedef struct planarvo_line_fit {
+  double slope, offset, slope_sigma, r2;
+  int32_t samples;
+} planarvo_line_fit;
+
+/* The vehicle's lean (the paper's Figure 18) from a drive tracked with the local plane: the body's
+ * roll against the yaw rate (slope in seconds: radians per rad/s, or degrees per degree/s; the
+ * paper's car -0.07) and its pitch against the longitudinal acceleration (radians per m/s^2). */
+typedef struct planarvo_body_lean {
+  size_t struct_size;
+  planarvo_line_fit roll_per_yaw_rate;
+  planarvo_line_fit pitch_per_acceleration;
+} planarvo_body_lean;
+
+/* Fits planarvo_body_lean: frame k has timestamps[k], motions[k] (over the interval from frame
+ * k-1; motions[0] is unused), roll[k] and pitch[k] (planarvo_track_result's); use[k] 0 leaves
+ * the frame out (NULL: all of them; leave LOST frames out). The yaw rate at a frame is the mean
+ * of its two intervals', the acceleration the forward speed's central difference. The slopes'
+ * sigma are lower bounds when the attitudes' own errors dominate the scatter (they are correlated
+ * from frame to frame). */
+PLANARVO_API planarvo_status planarvo_fit_body_lean(const double* timestamps, const planarvo_se2* motions,
+                                                    const double* roll, const double* pitch, const int32_t* use,
+                                                    size_t count, planarvo_body_lean* lean);
+
 /* ------------------------------------------------------------------------------------------ */
 /* Graph optimisation and calibration (no OpenCL device is used)                               */
 

@@ -14,6 +14,7 @@
 #include "capi/status.h"
 #include "core/error.h"
 #include "track/evaluation.h"
+#include "track/body_lean.h"
 #include "track/tracker.h"
 
 using planarvo::capi::guard;
@@ -235,6 +236,32 @@ PLANARVO_API planarvo_status planarvo_tracker_residuals(planarvo_tracker* tracke
     if (residual) std::copy(r.residual.begin(), r.residual.end(), residual);
     if (weight) std::copy(r.weight.begin(), r.weight.end(), weight);
     if (intensity) std::copy(r.intensity.begin(), r.intensity.end(), intensity);
+  });
+}
+
+namespace {
+planarvo_line_fit line_to_c(const planarvo::track::LineFit& f) {
+  return planarvo_line_fit{f.slope, f.offset, f.slope_sigma, f.r2, f.samples};
+}
+}  // namespace
+
+PLANARVO_API planarvo_status planarvo_fit_body_lean(const double* timestamps, const planarvo_se2* motions,
+                                                    const double* roll, const double* pitch, const int32_t* use,
+                                                    size_t count, planarvo_body_lean* lean) {
+  return guard([&] {
+    require(lean != nullptr, "planarvo_fit_body_lean: lean is NULL");
+    planarvo::capi::require_struct_size(lean->struct_size, sizeof(planarvo_body_lean), "planarvo_body_lean");
+    require(count == 0 || (timestamps && motions && roll && pitch), "planarvo_fit_body_lean: NULL arrays");
+    std::vector<double> t(timestamps, timestamps + count), r(roll, roll + count), p(pitch, pitch + count);
+    std::vector<planarvo::SE2> m(count);
+    std::vector<bool> u(count, true);
+    for (size_t i = 0; i < count; ++i) {
+      m[i] = planarvo::capi::to_cpp(motions[i]);
+      if (use) u[i] = use[i] != 0;
+    }
+    const planarvo::track::BodyLean f = planarvo::track::fit_body_lean(t, m, r, p, u);
+    lean->roll_per_yaw_rate = line_to_c(f.roll_per_yaw_rate);
+    lean->pitch_per_acceleration = line_to_c(f.pitch_per_acceleration);
   });
 }
 

@@ -226,6 +226,19 @@ TrackRun track_dataset(planarvo_context* ctx, planarvo_dataset* ds, const planar
   }
   account_lost(k, &run);
   evaluate(k, &run);
+  if (options.local_plane && k.t.size() >= 3) {
+    std::vector<double> roll(k.t.size()), pitch(k.t.size());
+    std::vector<int32_t> use(k.t.size());
+    for (size_t i = 0; i < k.t.size(); ++i) {
+      roll[i] = k.plane[i].roll;
+      pitch[i] = k.plane[i].pitch;
+      use[i] = k.status[i] == PLANARVO_TRACK_OK || k.status[i] == PLANARVO_TRACK_DEGRADED;
+    }
+    run.lean.struct_size = sizeof run.lean;
+    check(planarvo_fit_body_lean(k.t.data(), k.motion.data(), roll.data(), pitch.data(), use.data(), k.t.size(),
+                                 &run.lean));
+    run.has_lean = true;
+  }
   return run;
 }
 
@@ -248,6 +261,13 @@ void print_track_run(const TrackRun& run) {
               "tracking)\n",
               run.engine_ms / std::max<int64_t>(run.frames, 1), 1000.0 * static_cast<double>(run.frames) / run.engine_ms,
               median);
+  if (run.has_lean) {
+    const planarvo_line_fit &r = run.lean.roll_per_yaw_rate, &p = run.lean.pitch_per_acceleration;
+    std::printf("body lean (local plane), fitted over %d frames: roll %.4f +- %.4f deg per deg/s of yaw rate (R^2 "
+                "%.2f, offset %.3f deg); pitch %.3f +- %.3f deg per m/s^2 of acceleration (R^2 %.2f, offset %.3f deg)\n",
+                r.samples, r.slope, r.slope_sigma, r.r2, r.offset / kDeg, p.slope / kDeg, p.slope_sigma / kDeg, p.r2,
+                p.offset / kDeg);
+  }
   if (!run.has_accuracy) return;
   const planarvo_motion_accuracy& a = run.accuracy;
   std::printf("accuracy against ground truth over %d intervals (all of them, degraded and lost included), %.3f m "

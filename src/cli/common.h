@@ -102,6 +102,9 @@ struct TrackRun {
   bool has_accuracy = false;
   planarvo_motion_accuracy accuracy{};
   planarvo_motion_accuracy by_status[3]{};
+  // With the local plane: the vehicle's lean fitted over the frames not lost.
+  bool has_lean = false;
+  planarvo_body_lean lean{};
 };
 struct TrackOutputs {
   std::string trajectory, stats;  // "" for none

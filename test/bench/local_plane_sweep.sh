@@ -16,7 +16,7 @@ row() {  # name, tracker, keys...
   shift 2
   "$bench" accuracy seconds="$seconds" "$@" 2>&1 | awk -v s="$name" -v m="$mode" '
     $1 ~ /\.png$/ { printf "| %s | %s | %s | %s / %s / %s | %s | %s | %s / %s | %s | %s |", s, m, $1, $4, $5, $6, $10, $11, $12, $13, $16, $17; row = 1 }
-    /local plane:/ { printf " %s / %s | %s / %s | %s %s |\n", $6, $8, $13, $15, $18, $19; row = 0 }
+    /local plane:/ { printf " %s / %s | %s / %s | %s %s |\n", $6, $8, $13, $15, $19, $20; row = 0 }
     END { if (row) printf " | | |\n" }'
 }
 echo "| scene | tracker | texture | ok / deg / lost | slope v | slope w | RMS / max mm | drift % | ms/frame | roll err RMS / max deg | pitch err RMS / max deg | RMS err/sigma roll, pitch |"

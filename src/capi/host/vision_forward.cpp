@@ -216,6 +216,11 @@ PLANARVO_API planarvo_status planarvo_tracker_residuals(planarvo_tracker* tracke
   return fn ? fn(tracker, level, residual, weight, intensity, capacity, width, height, threshold) : PLANARVO_ERROR_INTERNAL;
 }
 
+PLANARVO_API planarvo_status planarvo_fit_body_lean(const double* timestamps, const planarvo_se2* motions, const double* roll, const double* pitch, const int32_t* use, size_t count, planarvo_body_lean* lean) {
+  PLANARVO_FORWARD(planarvo_fit_body_lean);
+  return fn ? fn(timestamps, motions, roll, pitch, use, count, lean) : PLANARVO_ERROR_INTERNAL;
+}
+
 PLANARVO_API planarvo_status planarvo_evaluate_motions(const planarvo_se2* estimated, const planarvo_se2* truth, const double* dt, const int32_t* valid, size_t count, double gross_threshold, planarvo_motion_accuracy* accuracy) {
   PLANARVO_FORWARD(planarvo_evaluate_motions);
   return fn ? fn(estimated, truth, dt, valid, count, gross_threshold, accuracy) : PLANARVO_ERROR_INTERNAL;
