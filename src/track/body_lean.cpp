@@ -7,37 +7,6 @@
 
 namespace planarvo::track {
 
-LineFit fit_line(const std::vector<double>& x, const std::vector<double>& y) {
-  LineFit f;
-  const size_t n = std::min(x.size(), y.size());
-  f.samples = static_cast<int>(n);
-  f.slope_sigma = HUGE_VAL;
-  if (n < 3) return f;
-  double mx = 0, my = 0;
-  for (size_t i = 0; i < n; ++i) {
-    mx += x[i];
-    my += y[i];
-  }
-  mx /= static_cast<double>(n);
-  my /= static_cast<double>(n);
-  double sxx = 0, sxy = 0, syy = 0;
-  for (size_t i = 0; i < n; ++i) {
-    sxx += (x[i] - mx) * (x[i] - mx);
-    sxy += (x[i] - mx) * (y[i] - my);
-    syy += (y[i] - my) * (y[i] - my);
-  }
-  if (!(sxx > 0)) {
-    f.offset = my;
-    return f;
-  }
-  f.slope = sxy / sxx;
-  f.offset = my - f.slope * mx;
-  const double rss = std::max(0.0, syy - f.slope * sxy);
-  f.slope_sigma = std::sqrt(rss / static_cast<double>(n - 2) / sxx);
-  f.r2 = syy > 0 ? 1.0 - rss / syy : 0.0;
-  return f;
-}
-
 BodyLean fit_body_lean(const std::vector<double>& t, const std::vector<SE2>& motion, const std::vector<double>& roll,
                        const std::vector<double>& pitch, const std::vector<bool>& use) {
   const size_t n = t.size();

@@ -14,15 +14,9 @@
 #include <vector>
 
 #include "core/se2.h"
+#include "track/evaluation.h"
 
 namespace planarvo::track {
-
-struct LineFit {
-  double slope = 0.0, offset = 0.0;
-  double slope_sigma = 0.0;  // standard error of the slope
-  double r2 = 0.0;           // the share of the variance the line explains
-  int samples = 0;           // frames used; fewer than 3, or no spread in x: slope 0, sigma inf
-};
 
 struct BodyLean {
   LineFit roll_per_yaw_rate;        // radians per (radian/s): seconds, the same as degrees per degree/s
@@ -33,8 +27,5 @@ struct BodyLean {
 // pitch[k]; use[k] false leaves it out (Lost frames, for example). Frame 0 is only a time.
 BodyLean fit_body_lean(const std::vector<double>& t, const std::vector<SE2>& motion, const std::vector<double>& roll,
                        const std::vector<double>& pitch, const std::vector<bool>& use);
-
-// The least-squares line y = slope x + offset.
-LineFit fit_line(const std::vector<double>& x, const std::vector<double>& y);
 
 }  // namespace planarvo::track

@@ -7,12 +7,13 @@
 #include "core/error.h"
 
 namespace planarvo::track {
-namespace {
 
-// Slope of the least-squares line y = a x + b (0 when x has no spread).
-double fitted_slope(const std::vector<double>& x, const std::vector<double>& y) {
-  const size_t n = x.size();
-  if (n < 2) return 0;
+LineFit fit_line(const std::vector<double>& x, const std::vector<double>& y) {
+  LineFit f;
+  const size_t n = std::min(x.size(), y.size());
+  f.samples = static_cast<int>(n);
+  f.slope_sigma = HUGE_VAL;
+  if (n < 2) return f;
   double mx = 0, my = 0;
   for (size_t i = 0; i < n; ++i) {
     mx += x[i];
@@ -20,15 +21,23 @@ double fitted_slope(const std::vector<double>& x, const std::vector<double>& y) 
   }
   mx /= static_cast<double>(n);
   my /= static_cast<double>(n);
-  double sxx = 0, sxy = 0;
+  double sxx = 0, sxy = 0, syy = 0;
   for (size_t i = 0; i < n; ++i) {
     sxx += (x[i] - mx) * (x[i] - mx);
     sxy += (x[i] - mx) * (y[i] - my);
+    syy += (y[i] - my) * (y[i] - my);
   }
-  return sxx > 0 ? sxy / sxx : 0;
+  if (!(sxx > 0)) {
+    f.offset = my;
+    return f;
+  }
+  f.slope = sxy / sxx;
+  f.offset = my - f.slope * mx;
+  const double rss = std::max(0.0, syy - f.slope * sxy);
+  if (n >= 3) f.slope_sigma = std::sqrt(rss / static_cast<double>(n - 2) / sxx);
+  f.r2 = syy > 0 ? 1.0 - rss / syy : 0.0;
+  return f;
 }
-
-}  // namespace
 
 MotionAccuracy evaluate_motions(const std::vector<SE2>& estimated, const std::vector<SE2>& truth,
                                 const std::vector<double>& dt, double gross_threshold,
@@ -65,8 +74,8 @@ MotionAccuracy evaluate_motions(const std::vector<SE2>& estimated, const std::ve
     a.rms_translation = std::sqrt(sq_t / a.intervals);
     a.rms_rotation = std::sqrt(sq_r / a.intervals);
   }
-  a.slope_linear = fitted_slope(v_true, v_est);
-  a.slope_angular = fitted_slope(w_true, w_est);
+  a.slope_linear = fit_line(v_true, v_est).slope;
+  a.slope_angular = fit_line(w_true, w_est).slope;
   a.endpoint_error = std::hypot(pose_est.x - pose_true.x, pose_est.y - pose_true.y);
   a.endpoint_drift = a.distance > 0 ? a.endpoint_error / a.distance : 0;
   a.endpoint_heading = std::abs(wrap_angle(pose_est.theta - pose_true.theta));

@@ -22,6 +22,16 @@ struct MotionAccuracy {
   double endpoint_heading = 0;    // radians
 };
 
+// The least-squares line y = slope x + offset (the velocity slopes above, the lean in
+// body_lean.h).
+struct LineFit {
+  double slope = 0.0, offset = 0.0;
+  double slope_sigma = 0.0;  // standard error of the slope: infinite below 3 samples or without spread in x
+  double r2 = 0.0;           // the share of the variance the line explains
+  int samples = 0;
+};
+LineFit fit_line(const std::vector<double>& x, const std::vector<double>& y);
+
 // estimated[i], truth[i]: motion over interval i (the robot's pose at its end in the robot
 // frame at its start); dt[i] its duration. Intervals with valid[i] == false (if given) are left
 // out of the per-interval figures, but the composed trajectory always uses the estimate.
