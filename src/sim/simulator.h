@@ -119,8 +119,6 @@ struct Options {
   double knock_roll = 0.0, knock_pitch = 0.0, knock_z = 0.0;
   // Called with the fraction done and the stage; return false to cancel (Error Cancelled).
   std::function<bool(double, const char*)> progress;
-  // The body leans, pitches or gets knocked: the camera's extrinsics vary over the drive.
-  bool body_moves() const { return lean != 0.0 || bumps != 0.0 || std::isfinite(knock_time); }
 };
 
 // Throws InvalidArgument naming the first bad value.

@@ -238,10 +238,6 @@ class Aligner {
   int local_size() const { return options_.estimate_brightness ? 5 : 3; }
   bool with_orientation() const { return with_orientation_; }
   AlignerModel model() const { return model_; }
-  // The homography's parameters of the levels that estimate the model's (3, 5 or 7), and all
-  // parameters in the pass's sums' order (motion, the model's, then brightness when estimated).
-  int nparam() const { return model_ == AlignerModel::LocalPlane ? kMotionParams + kAttitudeParams : nparam_; }
-  int param_count() const { return nparam() + (options_.estimate_brightness ? 2 : 0); }
   const AlignerOptions& options() const { return options_; }
 
  private:

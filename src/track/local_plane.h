@@ -43,7 +43,8 @@ class LocalPlane {
 
   const BodyAttitude& keyframe() const { return keyframe_; }
   const Eigen::Matrix2d& keyframe_covariance() const { return keyframe_cov_; }
-  double prior_sigma() const { return prior_sigma_; }
+  // The prior's covariance (prior_sigma^2 I): where nothing else is known (a Lost frame's).
+  Eigen::Matrix2d prior_covariance() const { return prior_sigma_ * prior_sigma_ * Eigen::Matrix2d::Identity(); }
 
  private:
   double prior_sigma_;

@@ -260,11 +260,6 @@ struct Tracker::Impl {
     return true;
   }
 
-  // A Lost frame's attitude: the prior's.
-  Eigen::Matrix2d lost_attitude_covariance() const {
-    return opt.local_plane_prior_sigma * opt.local_plane_prior_sigma * Eigen::Matrix2d::Identity();
-  }
-
   // The position covariance too large, or much longer along one axis than the other (texture
   // that constrains the motion in one direction only), or the heading too uncertain.
   bool weakly_constrained(const Eigen::Matrix3d& cov) const {
@@ -330,19 +325,23 @@ struct Tracker::Impl {
     if (!res->alignment_covariance.allFinite()) res->alignment_covariance = lost_covariance();
     if (opt.local_plane) {
       // The live attitude (parameters 5, 6: after the motion and the keyframe's attitude), from
-      // the last level that estimated the attitudes.
+      // the last level that estimated the attitudes: the finest (C above) unless attitude_max_width
+      // held them on the finer levels.
       res->attitude = e.att_live;
-      res->attitude_covariance = lost_attitude_covariance();
-      if (report.attitude_level >= 0) {
+      res->attitude_covariance = plane.prior_covariance();
+      const int lv = kMotionParams + 2;
+      Eigen::Matrix2d cov = Eigen::Matrix2d::Constant(NAN);
+      if (report.finest_nparam == kMotionParams + kAttitudeParams) {
+        cov = C.block(lv, lv, 2, 2);
+      } else if (report.attitude_level >= 0) {
         const int na = kMotionParams + kAttitudeParams + nb;
         const ReduceSums& sa = report.attitude_sums;
         const MatrixJ Aa = sa.JtWJ.topLeftCorner(na, na);
         const Eigen::LDLT<MatrixJ> la(Aa);
-        const MatrixJ Ca =
-            alignment_covariance_all(sa, report.attitude_stats, na, floor_s2, Aa, la, opt.covariance_step_fraction);
-        const Eigen::Matrix2d cov = Ca.block(kMotionParams + 2, kMotionParams + 2, 2, 2);
-        if (cov.allFinite()) res->attitude_covariance = cov;
+        cov = alignment_covariance_all(sa, report.attitude_stats, na, floor_s2, Aa, la, opt.covariance_step_fraction)
+                  .block(lv, lv, 2, 2);
       }
+      if (cov.allFinite()) res->attitude_covariance = cov;
     }
 
     // The images' match from the half-resolution level (or the finest, when coarser): at full
@@ -717,14 +716,14 @@ struct Tracker::Impl {
       res.motion.covariance = res.alignment_covariance = lost_covariance();
       if (opt.local_plane) {
         res.attitude = prev.att_live;
-        res.attitude_covariance = lost_attitude_covariance();
+        res.attitude_covariance = plane.prior_covariance();
       }
       pose = pose * predicted;
       ++lost_in_a_row;
       // A frame misaligned by the light fixed to the camera is not a bad frame: the keyframe and
       // the light's model are what failed, and a new keyframe takes a new model into use.
       if (can_be_keyframe && (lost_in_a_row >= 2 || !predict || why == kMisaligned)) {
-        if (opt.local_plane) plane.take_keyframe(prev.att_live, lost_attitude_covariance());
+        if (opt.local_plane) plane.take_keyframe(prev.att_live, plane.prior_covariance());
         make_keyframe(live);
         keyframe_twist_measured = false;
         res.keyframe = true;

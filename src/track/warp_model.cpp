@@ -23,6 +23,28 @@ Eigen::Matrix3d skew(const Eigen::Vector3d& v) {
   return m;
 }
 
+// The 4x4 generator of se(2) raised to the plane z = 0 for SE2::exp's coordinate i: translation
+// along x, along y, rotation about z.
+Eigen::Matrix4d planar_generator(int i) {
+  Eigen::Matrix4d gen = Eigen::Matrix4d::Zero();
+  if (i == 0) gen(0, 3) = 1.0;
+  if (i == 1) gen(1, 3) = 1.0;
+  if (i == 2) {
+    gen(0, 1) = -1.0;
+    gen(1, 0) = 1.0;
+  }
+  return gen;
+}
+
+// Parameter k's derivative from dHu, the derivative of the unnormalised homography Hu: divided by
+// s = Hu(2,2) with the quotient rule (out->H = Hu / s), and its reference-side generator.
+void set_derivative(int k, const Eigen::Matrix3d& dHu, const Eigen::Matrix3d& Hu, double s,
+                    const Eigen::Matrix3d& Hinv, MotionHomography* out) {
+  const auto i = static_cast<size_t>(k);
+  out->dH[i] = dHu / s - Hu * dHu(2, 2) / (s * s);
+  out->G[i] = Hinv * out->dH[i];
+}
+
 }  // namespace
 
 MotionHomography motion_homography(const Eigen::Matrix3d& K, const Extrinsics& e,
@@ -40,21 +62,11 @@ MotionHomography motion_homography(const Eigen::Matrix3d& K, const Extrinsics& e
   MotionHomography out;
   out.H = Hu / s;
   const Eigen::Matrix3d Hinv = out.H.inverse();
-  for (int i = 0; i < 3; ++i) {
-    // d/dx_i exp(-x) at 0 = -gen_i; gen: translation along x, along y, rotation about z.
-    Eigen::Matrix4d gen = Eigen::Matrix4d::Zero();
-    if (i == 0) gen(0, 3) = 1.0;
-    if (i == 1) gen(1, 3) = 1.0;
-    if (i == 2) {
-      gen(0, 1) = -1.0;
-      gen(1, 0) = 1.0;
-    }
-    // plane_map is linear in T, so its derivative is plane_map of the derivative (the
-    // translation part of a 4x4 derivative enters the same way).
-    const Eigen::Matrix4d dT = T_cv * (-gen) * right;
-    const Eigen::Matrix3d dHu = K * plane_map(dT, n, e.z) * Kinv;
-    out.dH[static_cast<size_t>(i)] = dHu / s - Hu * dHu(2, 2) / (s * s);
-    out.G[static_cast<size_t>(i)] = Hinv * out.dH[static_cast<size_t>(i)];
+  for (int i = 0; i < kMotionParams; ++i) {
+    // d/dx_i exp(-x) at 0 = -gen_i. plane_map is linear in T, so its derivative is plane_map of
+    // the derivative (the translation part of a 4x4 derivative enters the same way).
+    const Eigen::Matrix4d dT = T_cv * (-planar_generator(i)) * right;
+    set_derivative(i, K * plane_map(dT, n, e.z) * Kinv, Hu, s, Hinv, &out);
   }
   if (!with_orientation) return out;
   // Eqs. 21-24 (header comment): the tilt about the robot's x and y axes through the camera centre.
@@ -71,10 +83,7 @@ MotionHomography motion_homography(const Eigen::Matrix3d& K, const Extrinsics& e
     const Eigen::Matrix4d dM = T_cv * (T_inv * A - A * T_inv) * T_vc;
     const Eigen::Vector3d dn = -R_cv * Gi * Eigen::Vector3d::UnitZ();
     const Eigen::Matrix3d dP = plane_map(dM, n, e.z) - M.topRightCorner<3, 1>() * dn.transpose() / e.z;
-    const Eigen::Matrix3d dHu = K * dP * Kinv;
-    const auto k = static_cast<size_t>(kMotionParams + i);
-    out.dH[k] = dHu / s - Hu * dHu(2, 2) / (s * s);
-    out.G[k] = Hinv * out.dH[k];
+    set_derivative(kMotionParams + i, K * dP * Kinv, Hu, s, Hinv, &out);
   }
   return out;
 }
@@ -105,21 +114,8 @@ MotionHomography local_plane_homography(const Eigen::Matrix3d& K, const Extrinsi
   out.nparam = kMotionParams + kAttitudeParams;
   out.H = Hu / s;
   const Eigen::Matrix3d Hinv = out.H.inverse();
-  auto put = [&](int k, const Eigen::Matrix3d& dP) {
-    const Eigen::Matrix3d dHu = K * dP * Kinv;
-    out.dH[static_cast<size_t>(k)] = dHu / s - Hu * dHu(2, 2) / (s * s);
-    out.G[static_cast<size_t>(k)] = Hinv * out.dH[static_cast<size_t>(k)];
-  };
-  for (int i = 0; i < kMotionParams; ++i) {
-    Eigen::Matrix4d gen = Eigen::Matrix4d::Zero();
-    if (i == 0) gen(0, 3) = 1.0;
-    if (i == 1) gen(1, 3) = 1.0;
-    if (i == 2) {
-      gen(0, 1) = -1.0;
-      gen(1, 0) = 1.0;
-    }
-    put(i, plane_map(El_inv * (-gen) * T_inv * E_r, n, z));
-  }
+  auto put = [&](int k, const Eigen::Matrix3d& dP) { set_derivative(k, K * dP * Kinv, Hu, s, Hinv, &out); };
+  for (int i = 0; i < kMotionParams; ++i) put(i, plane_map(El_inv * (-planar_generator(i)) * T_inv * E_r, n, z));
   // dB/droll = [e_x]_x B, dB/dpitch = B [e_y]_x.
   const Eigen::Matrix3d ex = skew(Eigen::Vector3d::UnitX()), ey = skew(Eigen::Vector3d::UnitY());
   const Eigen::Matrix3d dBr[2] = {ex * Br, Br * ey}, dBl[2] = {ex * Bl, Bl * ey};
