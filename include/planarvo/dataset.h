@@ -141,7 +141,8 @@ PLANARVO_API planarvo_status planarvo_write_tum(const char* path, const double* 
                                                 const planarvo_se2* poses, size_t count);
 
 /* Per-frame statistics CSV (timestamp, vx, vy, omega, iterations, final_cost, inlier_fraction,
- * ms, status): the header on open, then one row per call, flushed. Written as PATH.partial and
+ * ms, status, roll, pitch, sigma_roll, sigma_pitch, mounting_changed; the last five empty unless
+ * has_attitude): the header on open, then one row per call, flushed. Written as PATH.partial and
  * renamed onto PATH by planarvo_stats_writer_close, so PATH is complete or untouched:
  * planarvo_stats_writer_discard (after an error, say) removes the partial file and leaves an
  * existing PATH as it was; a crash leaves the rows written so far in PATH.partial. */
@@ -153,6 +154,11 @@ typedef struct planarvo_frame_stats {
   double final_cost, inlier_fraction;
   double ms;             /* engine time for the frame */
   const char* status;    /* "first", "ok", "degraded", "lost", ... */
+  /* With the local plane (planarvo_track_result): non-zero has_attitude writes the body's attitude
+   * (radians) with its standard deviations, and mounting_changed (0 or 1). */
+  int32_t has_attitude;
+  double roll, pitch, sigma_roll, sigma_pitch;
+  int32_t mounting_changed;
 } planarvo_frame_stats;
 PLANARVO_API planarvo_status planarvo_stats_writer_open(const char* path, planarvo_stats_writer** writer);
 PLANARVO_API planarvo_status planarvo_stats_writer_add(planarvo_stats_writer* writer,

@@ -382,11 +382,27 @@ typedef struct planarvo_tracker_options {
    * .pitch), for a car whose body leans in turns and pitches over bumps; the extrinsics are then
    * the camera's mounting on the body at rest. Default 0 (a rigid body). local_plane_prior_sigma:
    * the standard deviation, radians, of the prior that holds the attitude at the mounting where the
-   * images do not say otherwise; default 0.01745 (1 degree); must be positive and finite. Unread
+   * images do not say otherwise; default 0.008727 (0.5 degree); must be positive and finite. Unread
    * (so off) for older struct_size. */
   int32_t local_plane;
   double local_plane_prior_sigma;
+  /* Online recalibration, with local_plane: a step in the body's attitude that persists (the camera's
+   * mounting knocked, a bracket bent) as opposed to the body's lean in turns and over bumps, which
+   * passes. A planarvo_mounting_response: PLANARVO_MOUNTING_RECALIBRATE (the default) reports the
+   * change in the frame that confirms it (planarvo_track_result.mounting_changed) and tracks on with
+   * the mounting changed by it (the camera turned about its centre: its height kept);
+   * PLANARVO_MOUNTING_REPORT only reports it and keeps the mounting given; PLANARVO_MOUNTING_IGNORE
+   * does not watch. mounting_min_step: the smallest change reported, radians; default 0.01745 (1
+   * degree); positive and finite. Unread (so RECALIBRATE, 1 degree) for older struct_size. */
+  int32_t on_mounting_change;
+  double mounting_min_step;
 } planarvo_tracker_options;
+
+typedef enum planarvo_mounting_response {
+  PLANARVO_MOUNTING_IGNORE = 0,
+  PLANARVO_MOUNTING_REPORT = 1,
+  PLANARVO_MOUNTING_RECALIBRATE = 2
+} planarvo_mounting_response;
 
 typedef enum planarvo_track_status {
   PLANARVO_TRACK_FIRST = 0,    /* the first frame: it becomes the keyframe, no motion */
@@ -415,6 +431,24 @@ typedef struct planarvo_track_result {
    * otherwise. Written only when struct_size covers them. */
   double roll, pitch;
   double attitude_covariance[4];
+  /* With planarvo_tracker_options.local_plane: the mounting this frame was tracked with (the
+   * extrinsics given, or the last recalibration's). mounting_changed is non-zero when this frame
+   * confirmed a change of the mounting: mounting_change_time is when the new attitude began
+   * (seconds, a frame's timestamp), mounting_step the step in the body's roll and pitch (radians, the
+   * attitude as roll and pitch above) with its standard deviations, and changed_mounting the
+   * mounting it implies: the extrinsics with the camera turned about its centre by the step (in use
+   * from the next frame with PLANARVO_MOUNTING_RECALIBRATE). The height is not watched: the images
+   * of a plane fix it only with the scale of the motion. Written only when struct_size covers them. */
+  planarvo_extrinsics mounting;
+  /* Non-zero when the images separated the attitude from the motion (its variance below half the
+   * prior's); 0 while the car has not moved since the start (the attitude holds at the mounting)
+   * and on LOST frames. */
+  int32_t attitude_observed;
+  int32_t mounting_changed;
+  double mounting_change_time;
+  double mounting_step[2];
+  double mounting_step_sigma[2];
+  planarvo_extrinsics changed_mounting;
 } planarvo_track_result;
 
 PLANARVO_API void planarvo_tracker_options_init(planarvo_tracker_options* options);

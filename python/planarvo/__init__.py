@@ -28,7 +28,7 @@ from ._output import StatsWriter, write_tum
 from ._posegraph import PosegraphInit, SolverSummary, posegraph_optimize
 from ._se2 import SE2
 from ._simulate import MotionProfile, SimOptions, default_texture, simulate
-from ._tracking import Residuals, Tracker, TrackerOptions, TrackResult, TrackStatus
+from ._tracking import MountingChange, MountingResponse, Residuals, Tracker, TrackerOptions, TrackResult, TrackStatus
 from ._native import lib as _lib
 
 __version__ = _lib.planarvo_version_string().decode()
@@ -36,7 +36,7 @@ __version__ = _lib.planarvo_version_string().decode()
 __all__ = ["EXTRINSICS_NAMES", "CalibrationMethod", "CalibrationOptions", "CalibrationResult",
     "CalibrationStatus", "Camera", "CameraCalibrationOptions", "CameraCalibrationResult", "CameraCalibrator",
     "Context", "Dataset", "DatasetInfo", "DeviceInfo", "Error", "Extrinsics", "FrameData", "MotionAccuracy",
-    "Mosaic", "MosaicInfo", "MotionPair", "MotionProfile", "PosegraphInit", "ReadoutSource", "Residuals", "RobustLoss", "RollPitch",
+    "Mosaic", "MosaicInfo", "MotionPair", "MotionProfile", "MountingChange", "MountingResponse", "PosegraphInit", "ReadoutSource", "Residuals", "RobustLoss", "RollPitch",
     "RollPitchOptions",
     "RollPitchResult", "SE2", "SimOptions", "SolverSummary", "StatsWriter", "Status", "Tracker",
     "TrackerOptions", "TrackResult", "TrackStatus", "bag_topics", "calibrate", "calibrate_dataset", "compose_extrinsics",

@@ -89,7 +89,8 @@ class FrameData(ctypes.Structure):
 class FrameStats(ctypes.Structure):
     _fields_ = [("timestamp", c_double), ("vx", c_double), ("vy", c_double), ("omega", c_double),
                 ("iterations", c_int32), ("final_cost", c_double), ("inlier_fraction", c_double), ("ms", c_double),
-                ("status", c_char_p)]
+                ("status", c_char_p), ("has_attitude", c_int32), ("roll", c_double), ("pitch", c_double),
+                ("sigma_roll", c_double), ("sigma_pitch", c_double), ("mounting_changed", c_int32)]
 
 
 class SimOptions(ctypes.Structure):
@@ -108,7 +109,8 @@ class TrackerOptions(ctypes.Structure):
     _fields_ = [("struct_size", c_size_t), ("levels", c_int32), ("finest_level", c_int32),
                 ("max_iterations", c_int32), ("keyframe_overlap", c_double), ("estimate_brightness", c_int32),
                 ("level0_subsample", c_int32), ("flat_field", c_char_p), ("local_plane", c_int32),
-                ("local_plane_prior_sigma", c_double)]
+                ("local_plane_prior_sigma", c_double), ("on_mounting_change", c_int32),
+                ("mounting_min_step", c_double)]
 
 
 class TrackResult(ctypes.Structure):
@@ -116,7 +118,10 @@ class TrackResult(ctypes.Structure):
                 ("covariance", c_double * 9), ("pose", SE2), ("iterations", c_int32 * 8), ("levels_used", c_int32),
                 ("final_cost", c_double), ("inlier_fraction", c_double), ("overlap", c_double),
                 ("keyframe", c_int32), ("ms", c_double), ("roll", c_double), ("pitch", c_double),
-                ("attitude_covariance", c_double * 4)]
+                ("attitude_covariance", c_double * 4), ("mounting", Extrinsics), ("attitude_observed", c_int32),
+                ("mounting_changed", c_int32),
+                ("mounting_change_time", c_double), ("mounting_step", c_double * 2),
+                ("mounting_step_sigma", c_double * 2), ("changed_mounting", Extrinsics)]
 
 
 class MotionAccuracy(ctypes.Structure):

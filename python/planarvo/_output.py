@@ -2,7 +2,7 @@
 from __future__ import annotations
 
 import ctypes
-from typing import Any, Sequence
+from typing import Any, Optional, Sequence
 
 import numpy as np
 
@@ -37,10 +37,18 @@ class StatsWriter(_Handle):
         self._own(h)
 
     def add(self, timestamp: float, vx: float, vy: float, omega: float, iterations: int, final_cost: float,
-            inlier_fraction: float, ms: float, status: str) -> None:
+            inlier_fraction: float, ms: float, status: str, attitude: Optional[Sequence[float]] = None,
+            mounting_changed: bool = False) -> None:
         """One row: the robot-frame velocity over the interval ending at the frame, and the
-        tracker's figures for it (status "first", "ok", "degraded", "lost", ...)."""
-        row = N.FrameStats(timestamp, vx, vy, omega, iterations, final_cost, inlier_fraction, ms, status.encode())
+        tracker's figures for it (status "first", "ok", "degraded", "lost", ...). With the local
+        plane, attitude = (roll, pitch, sigma_roll, sigma_pitch) in radians (TrackResult.roll,
+        .pitch and the square roots of attitude_covariance's diagonal) and mounting_changed;
+        without, those columns stay empty."""
+        a = (0.0, 0.0, 0.0, 0.0) if attitude is None else tuple(float(v) for v in attitude)
+        if len(a) != 4:
+            raise ValueError("attitude must be (roll, pitch, sigma_roll, sigma_pitch)")
+        row = N.FrameStats(timestamp, vx, vy, omega, iterations, final_cost, inlier_fraction, ms, status.encode(),
+                           attitude is not None, *a, bool(mounting_changed))
         _check(lib.planarvo_stats_writer_add(self._h(), ctypes.byref(row)))
 
     def close(self) -> None:

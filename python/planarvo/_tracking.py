@@ -27,6 +27,28 @@ class TrackStatus(enum.IntEnum):
     LOST = 3
 
 
+class MountingResponse(enum.IntEnum):
+    """What the tracker does when the local plane finds the camera's mounting changed
+    (planarvo_mounting_response)."""
+    IGNORE = 0       # not watched
+    REPORT = 1       # reported (TrackResult.mounting_change); the extrinsics given are kept
+    RECALIBRATE = 2  # reported, and tracking goes on with the mounting changed by it
+
+
+@dataclass
+class MountingChange:
+    """A change of the camera's mounting confirmed by a frame: time, when the new attitude began
+    (seconds); step_roll, step_pitch, the step in the body's attitude (radians) with their standard
+    deviations; mounting, the extrinsics it implies (the camera turned about its centre, the height
+    kept)."""
+    time: float
+    step_roll: float
+    step_pitch: float
+    sigma_roll: float
+    sigma_pitch: float
+    mounting: Extrinsics
+
+
 @dataclass
 class TrackerOptions:
     """planarvo_tracker_options; None keeps the library's default (see planarvo.h)."""
@@ -46,6 +68,11 @@ class TrackerOptions:
     # radians, the prior holding the attitude at the mounting where the images say nothing.
     local_plane: Optional[bool] = None
     local_plane_prior_sigma: Optional[float] = None
+    # With the local plane, online recalibration: what a step in the body's attitude that persists
+    # (the camera's mounting knocked) does (default RECALIBRATE), and the smallest step reported
+    # (radians, default 1 degree).
+    on_mounting_change: Optional[MountingResponse] = None
+    mounting_min_step: Optional[float] = None
 
 
 def _tracker_options(options: Optional[TrackerOptions]) -> N.TrackerOptions:
@@ -61,8 +88,11 @@ class TrackResult:
     covariance: (3, 3) of motion (x, y, theta); pose: relative to the first frame; ms: the
     engine's time for the frame (upload, undistortion, pyramid, tracking). With
     TrackerOptions.local_plane: roll, pitch (radians), the body's rotation relative to the local
-    ground plane, R_plane_body = Rx(roll) Ry(pitch), and attitude_covariance (2, 2); zeros
-    otherwise."""
+    ground plane, R_plane_body = Rx(roll) Ry(pitch), and attitude_covariance (2, 2), zeros
+    otherwise; attitude_observed, whether the images separated it from the motion (not while the
+    car has not yet moved: it holds at the mounting); mounting, the extrinsics the frame was tracked
+    with, and mounting_change when this frame confirmed a change of the camera's mounting (None
+    otherwise)."""
     status: TrackStatus
     reason: str
     motion: SE2
@@ -78,6 +108,9 @@ class TrackResult:
     roll: float = 0.0
     pitch: float = 0.0
     attitude_covariance: np.ndarray = field(default_factory=lambda: np.zeros((2, 2)))
+    mounting: Optional[Extrinsics] = None
+    mounting_change: Optional[MountingChange] = None
+    attitude_observed: bool = False
 
 
 @dataclass
@@ -102,6 +135,13 @@ class Residuals:
     def outliers(self) -> np.ndarray:
         """Pixels the robust norm down-weighted (|r| > threshold)."""
         return (self.weight > 0) & (self.weight < 1)
+
+
+def _mounting_change(r: N.TrackResult) -> Optional[MountingChange]:
+    if not r.mounting_changed:
+        return None
+    return MountingChange(r.mounting_change_time, r.mounting_step[0], r.mounting_step[1], r.mounting_step_sigma[0],
+                          r.mounting_step_sigma[1], Extrinsics._from_c(r.changed_mounting))
 
 
 class Tracker(_Handle):
@@ -136,7 +176,8 @@ class Tracker(_Handle):
                            np.frombuffer(r.covariance, dtype=np.float64).reshape(3, 3).copy(),
                            SE2(r.pose.x, r.pose.y, r.pose.theta), tuple(r.iterations), r.levels_used,
                            r.final_cost, r.inlier_fraction, r.overlap, bool(r.keyframe), r.ms, r.roll, r.pitch,
-                           np.frombuffer(r.attitude_covariance, dtype=np.float64).reshape(2, 2).copy())
+                           np.frombuffer(r.attitude_covariance, dtype=np.float64).reshape(2, 2).copy(),
+                           Extrinsics._from_c(r.mounting), _mounting_change(r), bool(r.attitude_observed))
 
     def residuals(self, level: int = 0) -> Residuals:
         """The last tracked frame's residuals against the keyframe it was aligned with, at pyramid

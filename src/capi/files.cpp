@@ -150,6 +150,12 @@ PLANARVO_API planarvo_status planarvo_stats_writer_add(planarvo_stats_writer* wr
     r.inlier_fraction = row->inlier_fraction;
     r.ms = row->ms;
     r.status = row->status ? row->status : "";
+    r.has_attitude = row->has_attitude != 0;
+    r.roll = row->roll;
+    r.pitch = row->pitch;
+    r.sigma_roll = row->sigma_roll;
+    r.sigma_pitch = row->sigma_pitch;
+    r.mounting_changed = row->mounting_changed != 0;
     writer->writer->add(r);
   });
 }

@@ -109,6 +109,20 @@ planarvo::track::TrackerOptions tracker_options_from_c(const planarvo_tracker_op
               "planarvo_tracker_options.local_plane_prior_sigma must be a positive, finite number of radians");
       o.local_plane_prior_sigma = options->local_plane_prior_sigma;
     }
+    if (options->struct_size >= offsetof(planarvo_tracker_options, mounting_min_step) + sizeof(double)) {
+      using Response = planarvo::track::TrackerOptions::MountingResponse;
+      switch (options->on_mounting_change) {
+        case PLANARVO_MOUNTING_IGNORE: o.on_mounting_change = Response::Ignore; break;
+        case PLANARVO_MOUNTING_REPORT: o.on_mounting_change = Response::Report; break;
+        case PLANARVO_MOUNTING_RECALIBRATE: o.on_mounting_change = Response::Recalibrate; break;
+        default:
+          planarvo::throw_invalid_argument(
+              "planarvo_tracker_options.on_mounting_change must be PLANARVO_MOUNTING_IGNORE, _REPORT or _RECALIBRATE");
+      }
+      require(std::isfinite(options->mounting_min_step) && options->mounting_min_step > 0,
+              "planarvo_tracker_options.mounting_min_step must be a positive, finite number of radians");
+      o.mounting_watch.min_step = options->mounting_min_step;
+    }
   }
   return o;
 }
@@ -129,6 +143,11 @@ PLANARVO_API void planarvo_tracker_options_init(planarvo_tracker_options* o) {
   o->estimate_brightness = d.estimate_brightness ? 1 : 0;
   o->local_plane = d.local_plane ? 1 : 0;
   o->local_plane_prior_sigma = d.local_plane_prior_sigma;
+  using Response = planarvo::track::TrackerOptions::MountingResponse;
+  o->on_mounting_change = d.on_mounting_change == Response::Ignore   ? PLANARVO_MOUNTING_IGNORE
+                          : d.on_mounting_change == Response::Report ? PLANARVO_MOUNTING_REPORT
+                                                                     : PLANARVO_MOUNTING_RECALIBRATE;
+  o->mounting_min_step = d.mounting_watch.min_step;
 }
 
 PLANARVO_API planarvo_status planarvo_tracker_create(planarvo_context* context, const planarvo_camera* camera,
@@ -194,6 +213,17 @@ PLANARVO_API planarvo_status planarvo_tracker_track(planarvo_tracker* tracker, c
     out.roll = r.attitude.roll;
     out.pitch = r.attitude.pitch;
     planarvo::capi::matrix_to_c<2>(r.attitude_covariance, out.attitude_covariance);
+    out.mounting = planarvo::capi::to_c(r.mounting);
+    out.attitude_observed = r.attitude_observed ? 1 : 0;
+    out.mounting_changed = r.mounting_changed ? 1 : 0;
+    if (r.mounting_changed) {
+      out.mounting_change_time = r.mounting_change.time;
+      out.mounting_step[0] = r.mounting_change.step.roll;
+      out.mounting_step[1] = r.mounting_change.step.pitch;
+      out.mounting_step_sigma[0] = r.mounting_change.sigma(0);
+      out.mounting_step_sigma[1] = r.mounting_change.sigma(1);
+      out.changed_mounting = planarvo::capi::to_c(r.changed_mounting);
+    }
     std::memcpy(result, &out, std::min(result->struct_size, sizeof out));
   });
 }

@@ -83,6 +83,7 @@ void count(const planarvo_track_result& r, TrackRun* run) {
   if (r.status == PLANARVO_TRACK_OK || r.status == PLANARVO_TRACK_FIRST) ++run->ok;
   if (r.status == PLANARVO_TRACK_DEGRADED) ++run->degraded;
   if (r.status == PLANARVO_TRACK_LOST) ++run->lost;
+  if (r.status != PLANARVO_TRACK_LOST && !r.attitude_observed) ++run->attitude_unobserved;
 }
 
 // Status group of an interval for the accuracy by status: 0 Ok (First cannot end one), 1
@@ -139,6 +140,23 @@ void evaluate(const Tracked& k, TrackRun* run) {
   run->has_accuracy = true;
 }
 
+// The warning line for a change of the mounting: when, by how much, and what was done.
+std::string mounting_warning(const planarvo_track_result& r, double origin, double t, int32_t response) {
+  const planarvo_extrinsics& m = r.changed_mounting;
+  char line[640];
+  std::snprintf(line, sizeof line,
+                "planarvo track: warning: the camera's mounting changed at t = %.3f s (found at %.3f s): the body's "
+                "attitude stepped by roll %+.2f +- %.2f deg, pitch %+.2f +- %.2f deg and held; %s %.4f,%.4f,%.4f,"
+                "%.3f,%.3f,%.3f (x,y,z m; roll,pitch,yaw deg; the height kept)",
+                origin + r.mounting_change_time, origin + t, r.mounting_step[0] / kDeg, r.mounting_step_sigma[0] / kDeg,
+                r.mounting_step[1] / kDeg, r.mounting_step_sigma[1] / kDeg,
+                response == PLANARVO_MOUNTING_RECALIBRATE ? "tracking on with the mounting"
+                                                          : "kept the mounting given (--mounting-change report); the "
+                                                            "images say",
+                m.x, m.y, m.z, m.roll / kDeg, m.pitch / kDeg, m.yaw / kDeg);
+  return line;
+}
+
 }  // namespace
 
 TrackRun track_dataset(planarvo_context* ctx, planarvo_dataset* ds, const planarvo_extrinsics& extrinsics,
@@ -162,6 +180,7 @@ TrackRun track_dataset(planarvo_context* ctx, planarvo_dataset* ds, const planar
   Tracked k;
   std::vector<planarvo_motion_pair> pairs;
   planarvo_frame_data previous{};  // the last tracked frame's
+  planarvo_extrinsics mounting = extrinsics;  // as the images last said
   const auto n = static_cast<size_t>(info.frame_count);
   for (size_t i = 0; i < n; ++i) {
     if (progress) Progress::callback(progress, static_cast<double>(i) / static_cast<double>(n), "tracking");
@@ -187,10 +206,25 @@ TrackRun track_dataset(planarvo_context* ctx, planarvo_dataset* ds, const planar
     r.struct_size = sizeof r;
     check(planarvo_tracker_track(tracker.get(), &img, fd.timestamp, &r));
     count(r, &run);
+    if (r.mounting_changed) {
+      ++run.mounting_changes;
+      mounting = r.changed_mounting;
+      const std::string warning = mounting_warning(r, origin, fd.timestamp, options.on_mounting_change);
+      if (progress) progress->warn(warning);
+      else std::fprintf(stderr, "%s\n", warning.c_str());
+    }
     const bool first = k.t.empty();
     if (stats) {
       planarvo_frame_stats row = stats_row(fd, first ? 0 : fd.timestamp - k.t.back(), r);
       row.timestamp += origin;
+      if (options.local_plane) {
+        row.has_attitude = 1;
+        row.roll = r.roll;
+        row.pitch = r.pitch;
+        row.sigma_roll = std::sqrt(std::max(0.0, r.attitude_covariance[0]));
+        row.sigma_pitch = std::sqrt(std::max(0.0, r.attitude_covariance[3]));
+        row.mounting_changed = r.mounting_changed;
+      }
       check(planarvo_stats_writer_add(stats.get(), &row));
     }
     planarvo_motion_pair p;
@@ -213,6 +247,13 @@ TrackRun track_dataset(planarvo_context* ctx, planarvo_dataset* ds, const planar
     check(planarvo_write_tum(outputs.trajectory.c_str(), stamps.data(), k.pose.data(), k.t.size()));
   }
   if (!outputs.plane.empty()) check(planarvo_write_plane(outputs.plane.c_str(), k.plane.data(), k.plane.size()));
+  if (!outputs.mounting.empty()) {
+    const std::string note = run.mounting_changes > 0
+                                 ? "the mounting after the last change the local plane found while tracking"
+                                 : "the mounting given: no change found while tracking";
+    check(planarvo_extrinsics_save(outputs.mounting.c_str(), &mounting, nullptr, nullptr, "track --local-plane",
+                                   note.c_str()));
+  }
   if (!outputs.motions.empty()) check(planarvo_motion_pairs_save(outputs.motions.c_str(), pairs.data(), pairs.size()));
   if (!outputs.flat_field.empty()) {
     const planarvo_status s = planarvo_tracker_save_flat_field(tracker.get(), outputs.flat_field.c_str());
@@ -261,6 +302,13 @@ void print_track_run(const TrackRun& run) {
               "tracking)\n",
               run.engine_ms / std::max<int64_t>(run.frames, 1), 1000.0 * static_cast<double>(run.frames) / run.engine_ms,
               median);
+  if (run.has_lean && run.attitude_unobserved > 0)
+    std::printf("the body's attitude was not observed on %lld frame(s) (the car had not yet moved: it holds at the "
+                "mounting given)\n",
+                static_cast<long long>(run.attitude_unobserved));
+  if (run.mounting_changes > 0)
+    std::printf("the camera's mounting changed %lld time(s) while tracking (see the warnings)\n",
+                static_cast<long long>(run.mounting_changes));
   if (run.has_lean) {
     const planarvo_line_fit &r = run.lean.roll_per_yaw_rate, &p = run.lean.pitch_per_acceleration;
     std::printf("body lean (local plane), fitted over %d frames: roll %.4f +- %.4f deg per deg/s of yaw rate (R^2 "
@@ -321,9 +369,17 @@ int cmd_track(int argc, char** argv) {
                           "motion (a car whose body leans in turns and pitches over bumps; the extrinsics are the "
                           "camera's mounting on the body at rest)", "off: a rigid body"},
       {"plane-prior", "DEG", "with --local-plane: the standard deviation of the prior that holds the attitude at the "
-                             "mounting where the images do not say otherwise", "1"},
+                             "mounting where the images do not say otherwise", "0.5"},
       {"plane-out", "FILE", "with --local-plane: write the body's attitude per frame (t roll pitch sigma_roll "
                             "sigma_pitch, radians) to FILE", ""},
+      {"mounting-change", "MODE", "with --local-plane: what a change of the camera's mounting (a step in the body's "
+                                  "attitude that persists, unlike its lean in turns and over bumps) does, besides a "
+                                  "warning: recalibrate (track on with the mounting changed by it: the camera turned "
+                                  "about its centre, its height kept), report (keep the extrinsics given) or ignore "
+                                  "(not watched)", "recalibrate"},
+      {"mounting-step", "DEG", "with --local-plane: the smallest change of the mounting reported", "1"},
+      {"mounting-out", "FILE", "with --local-plane: write the camera's mounting as the drive ended (extrinsics YAML: "
+                               "the last change found, or the extrinsics given)", ""},
       {"quiet", "", "no progress bar", ""},
       {"help", "", "show this help", ""}};
   for (auto& b : bag_options()) specs.push_back(b);
@@ -341,7 +397,7 @@ int cmd_track(int argc, char** argv) {
   args.expect_positionals(1, "DATASET, the data set folder or a bag");
   const std::string dir = args.positionals()[0];
   // The options first: a usage error is reported before any file is read.
-  args.expect_output_files({"output", "stats", "motions-out", "save-flat-field", "plane-out"});
+  args.expect_output_files({"output", "stats", "motions-out", "save-flat-field", "plane-out", "mounting-out"});
   planarvo_tracker_options o;
   planarvo_tracker_options_init(&o);
   o.levels = args.get_int_in("levels", o.levels, 1, 8);
@@ -349,9 +405,23 @@ int cmd_track(int argc, char** argv) {
   o.max_iterations = args.get_int_in("max-iterations", 0, 1, 1000);
   o.level0_subsample = args.get_int_in("level0-subsample", 0, 1, 8);
   o.local_plane = args.has("local-plane") ? 1 : 0;
-  if ((args.has("plane-out") || args.has("plane-prior")) && !o.local_plane)
-    throw UsageError(std::string(args.has("plane-out") ? "--plane-out" : "--plane-prior") +
-                     " needs --local-plane: without it the body is taken as rigid and has no attitude to write");
+  for (const char* name : {"plane-out", "plane-prior", "mounting-change", "mounting-step", "mounting-out"})
+    if (args.has(name) && !o.local_plane)
+      throw UsageError(std::string("--") + name +
+                       " needs --local-plane: without it the body is taken as rigid and the camera's attitude to the "
+                       "ground is not measured");
+  if (args.has("mounting-change")) {
+    const std::string mode = args.get("mounting-change");
+    if (mode == "recalibrate") o.on_mounting_change = PLANARVO_MOUNTING_RECALIBRATE;
+    else if (mode == "report") o.on_mounting_change = PLANARVO_MOUNTING_REPORT;
+    else if (mode == "ignore") o.on_mounting_change = PLANARVO_MOUNTING_IGNORE;
+    else throw UsageError("--mounting-change must be recalibrate, report or ignore, not " + mode);
+  }
+  if (args.has("mounting-step")) {
+    const double step = args.get_double("mounting-step", 1.0);
+    if (!(step > 0.0 && step <= 45.0)) throw UsageError("--mounting-step must be a positive number of degrees (up to 45)");
+    o.mounting_min_step = step * kDeg;
+  }
   if (args.has("plane-prior")) {
     const double sigma = args.get_double("plane-prior", 1.0);
     if (!(sigma > 0.0 && sigma <= 90.0)) throw UsageError("--plane-prior must be a positive number of degrees (up to 90)");
@@ -370,7 +440,7 @@ int cmd_track(int argc, char** argv) {
   DatasetPtr ds = open_dataset(dir, args, false, &progress, args.has("skip-bad-frames"));
   apply_roi(roi, ds.get());
   apply_readout(readout, ds.get());
-  const TrackRun run = track_dataset(ctx.get(), ds.get(), e, o, {args.get("output"), args.get("stats"), args.get("motions-out"), args.has("skip-bad-frames"), args.get("save-flat-field"), args.get("plane-out")}, &progress);
+  const TrackRun run = track_dataset(ctx.get(), ds.get(), e, o, {args.get("output"), args.get("stats"), args.get("motions-out"), args.has("skip-bad-frames"), args.get("save-flat-field"), args.get("plane-out"), args.get("mounting-out")}, &progress);
   progress.finish();
   std::printf("tracked %s on %s\n", dir.c_str(), device_name(ctx.get()).c_str());
   print_track_run(run);

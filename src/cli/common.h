@@ -105,6 +105,11 @@ struct TrackRun {
   // With the local plane: the vehicle's lean fitted over the frames not lost.
   bool has_lean = false;
   planarvo_body_lean lean{};
+  // Changes of the camera's mounting found (planarvo_track_result.mounting_changed), each warned of
+  // as it came.
+  int64_t mounting_changes = 0;
+  // Frames (not Lost) whose attitude the images did not separate from the motion.
+  int64_t attitude_unobserved = 0;
 };
 struct TrackOutputs {
   std::string trajectory, stats;  // "" for none
@@ -118,6 +123,9 @@ struct TrackOutputs {
   std::string flat_field;
   // The local plane's attitude per tracked frame (plane.txt), "" for none.
   std::string plane;
+  // The camera's mounting as the drive ended (extrinsics YAML: the one given, or the last change
+  // of it the local plane found), "" for none.
+  std::string mounting;
 };
 TrackRun track_dataset(planarvo_context* ctx, planarvo_dataset* ds, const planarvo_extrinsics& extrinsics,
                        const planarvo_tracker_options& options, const TrackOutputs& outputs, Progress* progress);

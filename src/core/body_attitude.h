@@ -21,4 +21,18 @@ struct BodyAttitude {
 // T = [R_plane_body 0; 0 1] T_vc of the mounting. The mounting exactly when a is zero.
 Extrinsics on_plane(const Extrinsics& mounting, const BodyAttitude& a);
 
+// The roll and pitch of R = Rz(yaw) Rx(roll) Ry(pitch): the attitude that puts the plane's normal
+// where R does (a yaw about the normal changes no view of the plane).
+BodyAttitude attitude_of(const Eigen::Matrix3d& R);
+
+// A mounting knocked: the camera turned about its own centre by the rotation `step` expressed in
+// the body's axes, so that a body at attitude `step` with the old mounting sees the ground as a
+// body at rest does with the new one (the same orientation; the camera's centre, its height
+// included, kept). T = [R(step) R_vc | t_vc].
+Extrinsics turned_mounting(const Extrinsics& mounting, const BodyAttitude& step);
+
+// An attitude measured against a mounting, re-expressed against that mounting turned by `step`
+// (turned_mounting): R(a') = R(a) R(step)^T.
+BodyAttitude relative_to_turned(const BodyAttitude& a, const BodyAttitude& step);
+
 }  // namespace planarvo

@@ -31,7 +31,14 @@ void StatsWriter::add(const FrameStats& r) {
   for (double v : {r.vx, r.vy, r.omega}) line += ',' + format_exact(v);
   line += ',' + std::to_string(r.iterations);
   for (double v : {r.final_cost, r.inlier_fraction, r.ms}) line += ',' + format_exact(v);
-  line += ',' + csv_field(r.status) + '\n';
+  line += ',' + csv_field(r.status);
+  if (r.has_attitude) {
+    for (double v : {r.roll, r.pitch, r.sigma_roll, r.sigma_pitch}) line += ',' + format_exact(v);
+    line += r.mounting_changed ? ",1" : ",0";
+  } else {
+    line += ",,,,,";
+  }
+  line += '\n';
   out_.write(line);
   out_.flush();
 }

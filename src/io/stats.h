@@ -18,6 +18,12 @@ struct FrameStats {
   double inlier_fraction = 0.0;
   double ms = 0.0;     // engine time for the frame (upload, undistortion, pyramid, tracking)
   std::string status;  // e.g. "ok", "first", "lost"; quoted in the file when it needs to be
+  // With the local plane: the body's attitude relative to the local ground plane (radians,
+  // R_plane_body = Rx(roll) Ry(pitch)) with its standard deviations, and whether this frame found
+  // the camera's mounting changed. Empty fields without it (has_attitude false).
+  bool has_attitude = false;
+  double roll = 0.0, pitch = 0.0, sigma_roll = 0.0, sigma_pitch = 0.0;
+  bool mounting_changed = false;
 };
 
 // Writes the header at construction and one flushed row per add(). Every failure is Error(Io)
@@ -25,7 +31,8 @@ struct FrameStats {
 class StatsWriter {
  public:
   static constexpr const char* kHeader =
-      "timestamp,vx,vy,omega,iterations,final_cost,inlier_fraction,ms,status";
+      "timestamp,vx,vy,omega,iterations,final_cost,inlier_fraction,ms,status,roll,pitch,sigma_roll,sigma_pitch,"
+      "mounting_changed";
 
   explicit StatsWriter(const std::string& path);
   void add(const FrameStats& row);

@@ -41,6 +41,10 @@ class LocalPlane {
   // the prior's.
   void take_keyframe(const BodyAttitude& attitude, const Eigen::Matrix2d& covariance);
 
+  // The mounting was turned by `step` (core/body_attitude.h, turned_mounting): the keyframe's
+  // attitude re-expressed against it, its covariance kept.
+  void mounting_turned(const BodyAttitude& step) { keyframe_ = relative_to_turned(keyframe_, step); }
+
   const BodyAttitude& keyframe() const { return keyframe_; }
   const Eigen::Matrix2d& keyframe_covariance() const { return keyframe_cov_; }
   // The prior's covariance (prior_sigma^2 I): where nothing else is known (a Lost frame's).

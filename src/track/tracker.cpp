@@ -142,6 +142,7 @@ struct Tracker::Impl {
   std::array<double, kMaxLevels> sigma{};  // the robust scale per level, from frame to frame
   std::vector<AlignmentPair> pairs = std::vector<AlignmentPair>(1);
   LocalPlane plane;  // TrackerOptions::local_plane: the keyframe's attitude and its covariance
+  MountingWatch watch;  // TrackerOptions::on_mounting_change (with the local plane)
   AlignmentReport report;
   // The last frame's final alignment for residuals() (has_last), or why there is none (missing;
   // nullptr: no frame aligned since the first), and the residual image made from it (cached,
@@ -163,7 +164,7 @@ struct Tracker::Impl {
       : rt(r), camera(validated_tracker_camera(c, e, o)), ext(e), opt(o),
         aligner(r, c.K(), o, o.local_plane ? AlignerModel::LocalPlane : AlignerModel::Motion), selector(r),
         light_gate(camera.K(), camera.width, camera.height, e, o.learn_motion_px, o.max_texture_residual),
-        plane(o.local_plane_prior_sigma) {
+        plane(o.local_plane_prior_sigma), watch(o.mounting_watch) {
     readout_twist = ReadoutTwist(camera.mean_row_time());
     // The flat field is read now, so that a bad file fails at once rather than at the first frame.
     if (!opt.flat_field.empty() && opt.photometric.enabled) {
@@ -199,6 +200,7 @@ struct Tracker::Impl {
     prev_covariance.setZero();
     prev_tilt.setZero();
     plane.reset();
+    watch.reset();
     keyframe_shear_assumed = false;
     velocity.setZero();
     readout_twist.reset();
@@ -342,6 +344,8 @@ struct Tracker::Impl {
                   .block(lv, lv, 2, 2);
       }
       if (cov.allFinite()) res->attitude_covariance = cov;
+      // Observed when the images know it better than the prior alone does.
+      res->attitude_observed = res->attitude_covariance.diagonal().maxCoeff() < 0.5 * plane.prior_covariance()(0, 0);
     }
 
     // The images' match from the half-resolution level (or the finest, when coarser): at full
@@ -659,6 +663,26 @@ struct Tracker::Impl {
     return r;
   }
 
+  // A tracked frame's attitude to the mounting watch; a change it confirms is reported, and when
+  // recalibrating the mounting is turned by it and the attitudes carried on are re-expressed.
+  void watch_mounting(double t, double dt, FrameResult* res, Estimate* est) {
+    using Response = TrackerOptions::MountingResponse;
+    if (!opt.local_plane || opt.on_mounting_change == Response::Ignore) return;
+    const std::optional<MountingChange> change =
+        watch.add(t, dt, res->motion.value, res->attitude, res->attitude_covariance);
+    if (!change) return;
+    res->mounting_changed = true;
+    res->mounting_change = *change;
+    res->changed_mounting = turned_mounting(ext, change->step);
+    if (opt.on_mounting_change != Response::Recalibrate) return;
+    ext = res->changed_mounting;
+    est->att_ref = relative_to_turned(est->att_ref, change->step);
+    est->att_live = relative_to_turned(est->att_live, change->step);
+    res->attitude = est->att_live;
+    plane.mounting_turned(change->step);
+    watch.mounting_changed(change->step);
+  }
+
   bool right_size(const Pyramid& live) const {
     if (live.num_levels() < 1) return false;
     for (int l = 0; l < live.num_levels(); ++l) {
@@ -675,6 +699,7 @@ struct Tracker::Impl {
     forget_alignment(kNotAligned);
     FrameResult res;
     res.motion.covariance = lost_covariance();
+    res.mounting = ext;
     shutter_unknown = false;
 
     // Time: the interval, gaps, and the constant-velocity prediction. A timestamp that is not
@@ -844,6 +869,7 @@ struct Tracker::Impl {
     pose = pose * res.motion.value;
     if (dt > 0.0) velocity = res.motion.value.log() / dt;
     if (has_live_c) readout_twist.commit(live_c, live_tc);
+    watch_mounting(t, dt, &res, &est);
     since_good = 0.0;
     lost_in_a_row = 0;
     if (res.overlap < opt.keyframe_overlap || log_scale_change(camera.K(), ext, est.T, camera.region()) > opt.keyframe_scale_change) {

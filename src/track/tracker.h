@@ -20,6 +20,7 @@
 #include "image/pyramid.h"
 #include "track/aligner.h"
 #include "track/local_plane.h"
+#include "track/mounting_watch.h"
 #include "track/motion_search.h"
 #include "track/residual_image.h"
 #include "track/warp_reduce.h"
@@ -144,6 +145,14 @@ struct TrackerOptions : AlignerOptions {
   // prior is the mounting (zero) with standard deviation local_plane_prior_sigma, radians.
   bool local_plane = false;
   double local_plane_prior_sigma = 0.5 * M_PI / 180.0;
+  // Online recalibration, with the local plane (mounting_watch.h): a step in the body's attitude
+  // that persists is the camera's mounting changed (a knock), reported in the frame that confirmed
+  // it (FrameResult::mounting_change). Recalibrate: the mounting is changed by it (the camera
+  // turned about its centre: the height is kept) and tracking carries on with it; Report: only
+  // reported, the mounting given is kept; Ignore: not watched.
+  enum class MountingResponse { Ignore, Report, Recalibrate };
+  MountingResponse on_mounting_change = MountingResponse::Recalibrate;
+  MountingWatchOptions mounting_watch;
 
   static WarpReduceOptions default_kernel_options();
 };
@@ -203,6 +212,18 @@ struct FrameResult {
   // zero covariance, without the local plane (the rigid body assumed).
   BodyAttitude attitude;
   Eigen::Matrix2d attitude_covariance = Eigen::Matrix2d::Zero();
+  // The images separated the attitude from the motion: its variance is below half the prior's
+  // (local_plane_prior_sigma^2). Not while the car has not yet moved (the attitude holds at the
+  // mounting, or at the last keyframe's), nor on a Lost frame.
+  bool attitude_observed = false;
+  // The mounting this frame was tracked with (the extrinsics given, or the last recalibration's),
+  // and, when this frame confirmed a change of it (TrackerOptions::on_mounting_change), the change:
+  // its time, the step in the body's attitude with its sigma, and the mounting it implies (the
+  // one in use from the next frame on when recalibrating). With the local plane only.
+  Extrinsics mounting;
+  bool mounting_changed = false;
+  MountingChange mounting_change;
+  Extrinsics changed_mounting;
   double ms = 0;               // wall time of track(), milliseconds
   double pipeline_ms = 0;      // of which the image pipeline (camera-frame API only)
 };

@@ -198,6 +198,13 @@ struct SequenceReport {
   // errors (roll, pitch; RMS and largest over frames after the first, degrees), and RMS(error/sigma).
   double att_rms[2] = {0, 0}, att_max[2] = {0, 0}, att_nz[2] = {0, 0};
   int att_n = 0;
+  // Its mounting watch: the changes found (time, found at, distance driven in between) and the
+  // mounting as the drive ended against the truth's (sim::knocked_extrinsics).
+  struct Change {
+    double time, found, driven, roll, pitch;
+  };
+  std::vector<Change> changes;
+  Extrinsics final_mounting;
   // FrameResult::texture_residual: the largest over frames within 0.2 mm, the smallest over
   // frames more than 1 mm off (the honest-status check's margin).
   double tex_good_max = 0, tex_bad_min = HUGE_VAL;
@@ -304,6 +311,13 @@ SequenceReport run_sequence(ocl::Runtime& rt, const sim::Options& so, const trac
     rep.lost += r.status == track::FrameResult::Status::Lost;
     if (k == 0) continue;
     if (topt.local_plane) {
+      rep.final_mounting = r.mounting_changed ? r.changed_mounting : r.mounting;
+      if (r.mounting_changed) {
+        size_t from = k;
+        while (from > 0 && traj.t[from] > r.mounting_change.time + 1e-9) --from;
+        rep.changes.push_back({r.mounting_change.time, traj.t[k], traj.distance[k] - traj.distance[from],
+                               r.mounting_change.step.roll, r.mounting_change.step.pitch});
+      }
       const BodyAttitude a = sim::body_attitude(so, traj, traj.t[k]);
       const double err[2] = {r.attitude.roll - a.roll, r.attitude.pitch - a.pitch};
       for (int i = 0; i < 2; ++i) {
@@ -403,6 +417,18 @@ int bench_accuracy(const std::vector<std::string>& textures, double seconds, int
                   std::sqrt(r.att_rms[0] / r.att_n) * 180 / M_PI, r.att_max[0] * 180 / M_PI,
                   std::sqrt(r.att_rms[1] / r.att_n) * 180 / M_PI, r.att_max[1] * 180 / M_PI,
                   std::sqrt(r.att_nz[0] / r.att_n), std::sqrt(r.att_nz[1] / r.att_n));
+    if (topt.local_plane && topt.on_mounting_change != track::TrackerOptions::MountingResponse::Ignore) {
+      // The truth: the knocked mounting when the drive has a knock, else the one given.
+      const Extrinsics knocked = sim::knocked_extrinsics(so);
+      const Extrinsics& m = r.final_mounting;
+      std::printf("  mounting: %zu change(s)", r.changes.size());
+      for (const auto& c : r.changes)
+        std::printf("; from %.3f s found at %.3f s (%.3f s, %.2f m later): roll %+.3f pitch %+.3f deg", c.time, c.found,
+                    c.found - so.knock_time, c.driven, c.roll * 180 / M_PI, c.pitch * 180 / M_PI);
+      std::printf("; as the drive ended off by roll %.3f pitch %.3f yaw %.3f deg, z %.2f mm\n",
+                  (m.roll - knocked.roll) * 180 / M_PI, (m.pitch - knocked.pitch) * 180 / M_PI,
+                  std::remainder(m.yaw - knocked.yaw, 2 * M_PI) * 180 / M_PI, (m.z - knocked.z) * 1e3);
+    }
     std::printf("  texture residual (the honest-status check): largest of frames within 0.2 mm %.3f, smallest of "
                 "frames over 1 mm %.3f\n", r.tex_good_max, r.tex_bad_min);
     if (!std::isnan(r.flat_end.with_value) || !std::isnan(r.flat_2s.with_value))
@@ -773,7 +799,10 @@ int main(int argc, char** argv) {
       else if (k == "brightness") topt.estimate_brightness = v != "0";
       else if (k == "decorrelate") topt.decorrelate_noise = v != "0";
       else if (k == "plane") topt.local_plane = v != "0";
-      else if (k == "plane_width") topt.attitude_max_width = std::atoi(v.c_str());
+      else if (k == "mounting") {  // mounting=recalibrate|report|ignore
+        using R = track::TrackerOptions::MountingResponse;
+        topt.on_mounting_change = v == "ignore" ? R::Ignore : v == "report" ? R::Report : R::Recalibrate;
+      } else if (k == "plane_width") topt.attitude_max_width = std::atoi(v.c_str());
       else if (k == "plane_sigma") topt.local_plane_prior_sigma = std::atof(v.c_str()) * M_PI / 180.0;
       else if (k == "kf_scale") topt.keyframe_scale_change = std::atof(v.c_str());
       else if (k == "overlap") topt.keyframe_overlap = std::atof(v.c_str());

@@ -637,7 +637,8 @@ TEST(IoStats, HeaderRowsAndFlushedAsItGoes) {
   const std::string partial = w.temporary_path();  // where the rows go until close()
   EXPECT_EQ(partial.rfind(path + OutputFile::kSuffix + "-", 0), 0u) << partial;
   EXPECT_EQ(test::read_text(partial),
-            "timestamp,vx,vy,omega,iterations,final_cost,inlier_fraction,ms,status\n");
+            "timestamp,vx,vy,omega,iterations,final_cost,inlier_fraction,ms,status,roll,pitch,sigma_roll,"
+            "sigma_pitch,mounting_changed\n");
   EXPECT_FALSE(std::filesystem::exists(path));
   io::FrameStats r;
   r.timestamp = 12.5;
@@ -656,10 +657,21 @@ TEST(IoStats, HeaderRowsAndFlushedAsItGoes) {
   w.add(r);
   // Read while the writer is still open: the rows must already be in the partial file.
   const std::string text = test::read_text(partial);
-  EXPECT_THAT(text, HasSubstr("\n12.500000000,0.25,-0.001,0.1,17,3.5,0.875,1.25,ok\n"));
-  EXPECT_THAT(text, HasSubstr("\n12.600000000,0.25,-0.001,0.1,17,nan,0.875,1.25,\"lost, \"\"really\"\"\"\n"));
+  EXPECT_THAT(text, HasSubstr("\n12.500000000,0.25,-0.001,0.1,17,3.5,0.875,1.25,ok,,,,,\n"));
+  EXPECT_THAT(text, HasSubstr("\n12.600000000,0.25,-0.001,0.1,17,nan,0.875,1.25,\"lost, \"\"really\"\"\",,,,,\n"));
+  // With the local plane: the attitude, its sigma, and the mounting's change flag.
+  r.status = "ok";
+  r.has_attitude = true;
+  r.roll = 0.015625;
+  r.pitch = -0.25;
+  r.sigma_roll = 0.001;
+  r.sigma_pitch = 0.002;
+  r.mounting_changed = true;
+  w.add(r);
+  const std::string all = test::read_text(partial);
+  EXPECT_THAT(all, HasSubstr(",1.25,ok,0.015625,-0.25,0.001,0.002,1\n"));
   w.close();
-  EXPECT_EQ(test::read_text(path), text);
+  EXPECT_EQ(test::read_text(path), all);
   EXPECT_FALSE(std::filesystem::exists(partial));
 }
 

@@ -34,7 +34,9 @@ def _parser() -> argparse.ArgumentParser:
     sub = ap.add_subparsers(dest="command", metavar="{track,calibration,outliers,report,mosaic}")
     t = sub.add_parser("track", help="trajectory, velocity, velocity histogram and tracking figures",
                        description="trajectory.FMT, velocity.FMT, velocity_hist.FMT (needs ground truth) and "
-                       "tracking.FMT (needs --stats) from a data set and the trajectory that track wrote.")
+                       "tracking.FMT (needs --stats) from a data set and the trajectory that track wrote; with the "
+                       "statistics of track --local-plane also body_roll.FMT (the roll against the yaw rate, the "
+                       "paper's Figure 18) and body_pitch.FMT (the pitch over time, its Figure 19).")
     t.add_argument("dataset", metavar="DATASET", help="the data set folder, bag or MCAP file that was tracked")
     t.add_argument("--trajectory", required=True, help="the TUM trajectory from planarvo track -o")
     t.add_argument("--stats", help="the per-frame statistics CSV from planarvo track --stats")

@@ -14,6 +14,8 @@ import numpy as np
 from ._errors import InputError
 
 STATS_COLUMNS = ("timestamp", "vx", "vy", "omega", "iterations", "final_cost", "inlier_fraction", "ms", "status")
+# Written since the local plane: the body's attitude (empty fields without it).
+ATTITUDE_COLUMNS = ("roll", "pitch", "sigma_roll", "sigma_pitch", "mounting_changed")
 EXTRINSICS_NAMES = ("x", "y", "z", "roll", "pitch", "yaw")
 
 
@@ -76,21 +78,25 @@ def read_stats(path: str) -> Stats:
             rows = list(csv.reader(f))
     except OSError as e:
         raise InputError("cannot read the statistics %s: %s" % (path, e.strerror)) from None
-    if not rows or tuple(c.strip() for c in rows[0]) != STATS_COLUMNS:
-        raise InputError("%s: the first line is not the statistics header %s" % (path, ",".join(STATS_COLUMNS)))
+    header = tuple(c.strip() for c in rows[0]) if rows else ()
+    if header not in (STATS_COLUMNS, STATS_COLUMNS + ATTITUDE_COLUMNS):
+        raise InputError("%s: the first line is not the statistics header %s" % (path, ",".join(STATS_COLUMNS + ATTITUDE_COLUMNS)))
     body = [r for r in rows[1:] if r]
     if not body:
         raise InputError("%s: no rows" % path)
     for n, r in enumerate(body, 2):
-        if len(r) != len(STATS_COLUMNS):
-            raise InputError("%s line %d: expected %d fields, found %d" % (path, n, len(STATS_COLUMNS), len(r)))
+        if len(r) != len(header):
+            raise InputError("%s line %d: expected %d fields, found %d" % (path, n, len(header), len(r)))
     cols: Dict[str, np.ndarray] = {}
-    for k, name in enumerate(STATS_COLUMNS[:-1]):
+    for k, name in enumerate(header):
+        if name == "status":
+            cols[name] = np.array([r[k].strip() for r in body])
+            continue
         try:
-            cols[name] = np.array([float(r[k]) for r in body])
+            # An empty attitude field: not measured (NaN).
+            cols[name] = np.array([float(r[k]) if r[k].strip() or name in STATS_COLUMNS else np.nan for r in body])
         except ValueError:
             raise InputError("%s: column %s holds something that is not a number" % (path, name)) from None
-    cols["status"] = np.array([r[-1].strip() for r in body])
     return Stats(path, cols)
 
 
@@ -197,6 +203,21 @@ def read_dataset(path: str) -> Series:
     has_gt = info.has_groundtruth and bool(np.isfinite(gt[:, 0]).any())
     return Series(path, times, odo if has_odo else None, gt if has_gt else None,
                   info.time_origin_ns * 1e-9, info.is_bag)
+
+
+def read_plane(path: str) -> Optional[np.ndarray]:
+    """A data set folder's plane.txt (the simulator's true body attitude: t roll pitch sigma_roll
+    sigma_pitch per line, # comments) as (n, 3) time, roll, pitch; None when there is none."""
+    f = os.path.join(path, "plane.txt")
+    if not os.path.isfile(f):
+        return None
+    try:
+        a = np.loadtxt(f, comments="#", ndmin=2)
+    except ValueError as e:
+        raise InputError("%s: %s" % (f, e)) from None
+    if a.shape[1] < 3 or not len(a):
+        raise InputError("%s: expected lines of t roll pitch sigma_roll sigma_pitch" % f)
+    return a[:, :3]
 
 
 def degrees(rad) -> np.ndarray:

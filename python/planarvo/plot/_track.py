@@ -1,4 +1,5 @@
-"""`plot track`: the trajectory, velocity, velocity-histogram and tracking figures of a run."""
+"""`plot track`: the trajectory, velocity, velocity-histogram and tracking figures of a run, and
+with the local plane the body's roll against the yaw rate and its pitch over time."""
 from __future__ import annotations
 
 import sys
@@ -7,7 +8,7 @@ from typing import List, Optional, Sequence
 import numpy as np
 
 from ._errors import InputError
-from ._io import read_dataset, read_stats, read_tum
+from ._io import read_dataset, read_plane, read_stats, read_tum
 from ._motion import match_frames, velocities
 
 
@@ -54,4 +55,10 @@ def plot_track(dataset: str, trajectory: str, stats: Optional[str], out_dir: str
     if st is not None:
         from . import _tracking
         written += _tracking.tracking_figure(st, st["timestamp"] - series.time_origin_s, out_dir, formats)
+        from . import _plane
+        if _plane.has_attitude(st):
+            truth = read_plane(dataset) if not series.is_bag else None
+            written += _plane.lean_figure(st, truth, out_dir, formats)
+            written += _plane.pitch_figure(st, st["timestamp"] - series.time_origin_s, truth, series.time_origin_s,
+                                           out_dir, formats)
     return written

@@ -1,0 +1,205 @@
+#include "track/mounting_watch.h"
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include "track/evaluation.h"
+
+namespace planarvo::track {
+
+namespace {
+
+double median(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  const size_t m = v.size() / 2;
+  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(m), v.end());
+  double med = v[m];
+  if (v.size() % 2 == 0) med = 0.5 * (med + *std::max_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(m)));
+  return med;
+}
+
+// The normal-equivalent standard deviation of v about its median (1.4826 MAD).
+double robust_scale(const std::vector<double>& v, double med) {
+  std::vector<double> d(v.size());
+  for (size_t i = 0; i < v.size(); ++i) d[i] = std::abs(v[i] - med);
+  return 1.4826 * median(d);
+}
+
+double spread(const std::vector<double>& v) {
+  if (v.size() < 2) return 0.0;
+  double m = 0.0;
+  for (double x : v) m += x;
+  m /= static_cast<double>(v.size());
+  double s = 0.0;
+  for (double x : v) s += (x - m) * (x - m);
+  return std::sqrt(s / static_cast<double>(v.size() - 1));
+}
+
+// y = k x + c by least squares, once more without the points beyond 3 robust sigma of the first
+// line (a bump's pitch, a turn's entry while the body still settles).
+double robust_slope(const std::vector<double>& x, const std::vector<double>& y, double floor) {
+  LineFit f = fit_line(x, y);
+  std::vector<double> r(x.size());
+  for (size_t i = 0; i < x.size(); ++i) r[i] = y[i] - (f.slope * x[i] + f.offset);
+  const double s = std::max(robust_scale(r, median(r)), floor);
+  std::vector<double> xi, yi;
+  for (size_t i = 0; i < x.size(); ++i)
+    if (std::abs(r[i]) <= 3.0 * s) {
+      xi.push_back(x[i]);
+      yi.push_back(y[i]);
+    }
+  if (xi.size() >= 10) f = fit_line(xi, yi);
+  return std::isfinite(f.slope) ? f.slope : 0.0;
+}
+
+}  // namespace
+
+void MountingWatch::reset() {
+  samples_.clear();
+  level_ = BodyAttitude();
+  k_roll_ = 0.0;
+  lean_known_ = false;
+  since_[0] = since_[1] = -HUGE_VAL;
+  distance_ = 0.0;
+  has_speed_ = false;
+}
+
+void MountingWatch::mounting_changed(const BodyAttitude& step) {
+  level_.roll -= step.roll;
+  level_.pitch -= step.pitch;
+  for (Sample& s : samples_) {
+    if (s.t >= since_[0]) s.roll -= step.roll;  // measured with the mounting as it now is
+    if (s.t >= since_[1]) s.pitch -= step.pitch;
+  }
+}
+
+std::optional<MountingChange> MountingWatch::add(double t, double dt, const SE2& motion, const BodyAttitude& attitude,
+                                                 const Eigen::Matrix2d& covariance) {
+  if (!(dt > 0.0) || !std::isfinite(t) || !std::isfinite(attitude.roll + attitude.pitch)) {
+    has_speed_ = false;
+    return std::nullopt;
+  }
+  const double v = motion.x / dt;
+  Sample s;
+  s.t = t;
+  distance_ += std::hypot(motion.x, motion.y);
+  s.s = distance_;
+  s.w = motion.theta / dt;
+  s.a = has_speed_ ? (v - last_speed_) / dt : 0.0;
+  last_speed_ = v;
+  has_speed_ = true;
+  s.roll = attitude.roll;
+  s.pitch = attitude.pitch;
+  s.var_roll = std::isfinite(covariance(0, 0)) ? covariance(0, 0) : 0.0;
+  s.var_pitch = std::isfinite(covariance(1, 1)) ? covariance(1, 1) : 0.0;
+  samples_.push_back(s);
+  return test();
+}
+
+void MountingWatch::fit_lean(size_t end) {
+  std::vector<double> w, roll;
+  for (size_t i = 0; i < end; ++i) {
+    if (samples_[i].t < since_[0]) continue;  // before the roll's last change: another level
+    w.push_back(samples_[i].w);
+    roll.push_back(samples_[i].roll);
+  }
+  if (w.size() >= 30 && spread(w) >= opt_.min_yaw_rate_spread) {
+    k_roll_ = robust_slope(w, roll, 0.02 * M_PI / 180.0);
+    lean_known_ = true;
+  }
+}
+
+std::optional<MountingChange> MountingWatch::test() {
+  // The window: the most recent samples over window_metres and window_seconds.
+  const Sample& last = samples_.back();
+  size_t begin = samples_.size();
+  while (begin > 0) {
+    --begin;
+    if (last.s - samples_[begin].s >= opt_.window_metres && last.t - samples_[begin].t >= opt_.window_seconds) break;
+    if (begin == 0) return std::nullopt;  // not yet a whole window
+  }
+  // The history before it: at most history_seconds, and per angle since its last change.
+  while (samples_.front().t < std::max(std::min(since_[0], since_[1]), samples_[begin].t - opt_.history_seconds)) {
+    samples_.pop_front();
+    --begin;
+  }
+  fit_lean(begin);
+
+  const size_t n = samples_.size();
+  auto residual = [&](const Sample& s, int angle) { return angle == 0 ? s.roll - k_roll_ * s.w : s.pitch; };
+  auto in_history = [&](size_t i, int angle) { return i < begin && samples_[i].t >= since_[angle]; };
+  MountingChange change;
+  bool stepped[2] = {false, false};  // held a new level by min_step at least
+  bool judged[2] = {false, false};   // steady and comparable: its step is measured
+  double steps[2] = {0.0, 0.0}, medians[2] = {0.0, 0.0}, bases[2] = {0.0, 0.0};
+  for (int angle = 0; angle < 2; ++angle) {
+    std::vector<double> win, hist, x_win, x_hist;
+    double var_w = 0.0, var_h = 0.0;
+    for (size_t i = 0; i < n; ++i) {
+      const double var = angle == 0 ? samples_[i].var_roll : samples_[i].var_pitch;
+      const double x = angle == 0 ? samples_[i].w : samples_[i].a;
+      if (i >= begin) {
+        x_win.push_back(x);
+        win.push_back(residual(samples_[i], angle));
+        var_w += var;
+      } else if (in_history(i, angle)) {
+        x_hist.push_back(x);
+        hist.push_back(residual(samples_[i], angle));
+        var_h += var;
+      }
+    }
+    const double med = median(win);
+    double worst = 0.0;
+    for (double r : win) worst = std::max(worst, std::abs(r - med));
+    const bool has_history = hist.size() >= 10;
+    // A window driven otherwise than the history (a turn after a straight, braking after cruising)
+    // may lean by its own drive: no level to compare with, unless the roll's slope is known.
+    const double x_spread = angle == 0 ? opt_.min_yaw_rate_spread : opt_.min_acceleration_spread;
+    const double x_base = has_history ? median(x_hist) : 0.0;
+    const bool comparable = (angle == 0 && lean_known_) || std::abs(median(x_win) - x_base) <= x_spread;
+    bases[angle] = has_history ? median(hist) : (angle == 0 ? level_.roll : level_.pitch);
+    medians[angle] = med;
+    steps[angle] = med - bases[angle];
+    const double nw = static_cast<double>(win.size());
+    const double sw = robust_scale(win, med);
+    double var = (sw * sw + var_w / nw) / nw;
+    if (has_history) {
+      const double nh = static_cast<double>(hist.size());
+      const double sh = robust_scale(hist, bases[angle]);
+      var += (sh * sh + var_h / nh) / nh;
+    }
+    change.sigma(angle) = std::sqrt(var);
+    judged[angle] = worst <= opt_.steady_tolerance && comparable;
+    stepped[angle] = judged[angle] && std::abs(steps[angle]) >= opt_.min_step;
+  }
+  if (!stepped[0] && !stepped[1]) return std::nullopt;
+
+  // When the new level began: after the last frame before the window that was still at the old one
+  // (frames at neither, a bump's, are passed over).
+  size_t first = begin;
+  int at_old = 0;  // consecutive frames at the old level (a bump passing through it is not one)
+  for (size_t i = begin; i-- > 0 && at_old < 5;) {
+    bool old = true;
+    for (int angle = 0; angle < 2; ++angle)
+      if (stepped[angle] && (samples_[i].t < since_[angle] ||
+                             std::abs(residual(samples_[i], angle) - bases[angle]) > opt_.steady_tolerance))
+        old = false;
+    at_old = old ? at_old + 1 : 0;
+    const int a = stepped[0] ? 0 : 1;
+    if (std::abs(residual(samples_[i], a) - medians[a]) <= opt_.steady_tolerance) first = i;
+  }
+  change.time = samples_[first].t;
+  change.detected_time = last.t;
+  // An angle that the window could not judge keeps its level and its history: unchanged.
+  change.step.roll = judged[0] ? steps[0] : 0.0;
+  change.step.pitch = judged[1] ? steps[1] : 0.0;
+  for (int angle = 0; angle < 2; ++angle) {
+    if (!judged[angle]) continue;
+    (angle == 0 ? level_.roll : level_.pitch) = medians[angle];
+    since_[angle] = change.time;
+  }
+  return change;
+}
+
+}  // namespace planarvo::track
