@@ -433,12 +433,14 @@ typedef struct planarvo_track_result {
   double attitude_covariance[4];
   /* With planarvo_tracker_options.local_plane: the mounting this frame was tracked with (the
    * extrinsics given, or the last recalibration's). mounting_changed is non-zero when this frame
-   * confirmed a change of the mounting: mounting_change_time is when the new attitude began
-   * (seconds, a frame's timestamp), mounting_step the step in the body's roll and pitch (radians, the
-   * attitude as roll and pitch above) with its standard deviations, and changed_mounting the
-   * mounting it implies: the extrinsics with the camera turned about its centre by the step (in use
-   * from the next frame with PLANARVO_MOUNTING_RECALIBRATE). The height is not watched: the images
-   * of a plane fix it only with the scale of the motion. Written only when struct_size covers them. */
+   * confirmed a change of the mounting: mounting_change_time is when it began (seconds, a frame's
+   * timestamp), mounting_step the step in the body's roll and pitch (radians, the attitude as roll
+   * and pitch above) and in the camera's height (metres) with their standard deviations, and
+   * changed_mounting the mounting it implies: the extrinsics with the camera turned about its centre
+   * by the step and raised by the height's (in use from the next frame with
+   * PLANARVO_MOUNTING_RECALIBRATE). The height is watched only with wheel odometry
+   * (planarvo_tracker_odometry): the images of a plane fix it only with the scale of the motion;
+   * its sigma is NaN when it was not judged. Written only when struct_size covers them. */
   planarvo_extrinsics mounting;
   /* Non-zero when the images separated the attitude from the motion (its variance below half the
    * prior's); 0 while the car has not moved since the start (the attitude holds at the mounting)
@@ -446,8 +448,8 @@ typedef struct planarvo_track_result {
   int32_t attitude_observed;
   int32_t mounting_changed;
   double mounting_change_time;
-  double mounting_step[2];
-  double mounting_step_sigma[2];
+  double mounting_step[3];
+  double mounting_step_sigma[3];
   planarvo_extrinsics changed_mounting;
 } planarvo_track_result;
 
@@ -471,6 +473,11 @@ PLANARVO_API planarvo_status planarvo_tracker_track(planarvo_tracker* tracker,
                                                     planarvo_track_result* result);
 /* Forgets the keyframe and the pose: the next frame is FIRST again. */
 PLANARVO_API planarvo_status planarvo_tracker_reset(planarvo_tracker* tracker);
+/* The wheel odometry's pose (any fixed odometry frame; metres, radians) at the time of the next
+ * frame to be tracked, given before planarvo_tracker_track: with the local plane, the distances
+ * tracked are compared with the wheels' to notice the camera's height changed. Frames given none
+ * are left out of that comparison. A pose that is not finite: PLANARVO_ERROR_INVALID_ARGUMENT. */
+PLANARVO_API planarvo_status planarvo_tracker_odometry(planarvo_tracker* tracker, const planarvo_se2* pose);
 /* Writes the photometric model in use (the learnt one, or the flat field given) as a flat-field
  * file that planarvo_tracker_options.flat_field reads back: a 16-bit grey PNG of the camera's size,
  * the relative brightness per distorted camera pixel (brightest 65535), written complete or not at

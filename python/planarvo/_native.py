@@ -120,8 +120,8 @@ class TrackResult(ctypes.Structure):
                 ("keyframe", c_int32), ("ms", c_double), ("roll", c_double), ("pitch", c_double),
                 ("attitude_covariance", c_double * 4), ("mounting", Extrinsics), ("attitude_observed", c_int32),
                 ("mounting_changed", c_int32),
-                ("mounting_change_time", c_double), ("mounting_step", c_double * 2),
-                ("mounting_step_sigma", c_double * 2), ("changed_mounting", Extrinsics)]
+                ("mounting_change_time", c_double), ("mounting_step", c_double * 3),
+                ("mounting_step_sigma", c_double * 3), ("changed_mounting", Extrinsics)]
 
 
 class MotionAccuracy(ctypes.Structure):
@@ -269,6 +269,7 @@ _SIGNATURES = {
     "planarvo_tracker_destroy": (None, [c_void_p]),
     "planarvo_tracker_track": (S, [c_void_p, P(Image), c_double, P(TrackResult)]),
     "planarvo_tracker_reset": (S, [c_void_p]),
+    "planarvo_tracker_odometry": (S, [c_void_p, P(SE2)]),
     "planarvo_tracker_save_flat_field": (S, [c_void_p, c_char_p]),
     "planarvo_tracker_residuals": (S, [c_void_p, c_int32, P(ctypes.c_float), P(ctypes.c_float), P(ctypes.c_float),
                                        c_size_t, P(c_int32), P(c_int32), P(c_double)]),

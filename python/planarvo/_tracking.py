@@ -37,15 +37,18 @@ class MountingResponse(enum.IntEnum):
 
 @dataclass
 class MountingChange:
-    """A change of the camera's mounting confirmed by a frame: time, when the new attitude began
-    (seconds); step_roll, step_pitch, the step in the body's attitude (radians) with their standard
-    deviations; mounting, the extrinsics it implies (the camera turned about its centre, the height
-    kept)."""
+    """A change of the camera's mounting confirmed by a frame: time, when it began (seconds);
+    step_roll, step_pitch, the step in the body's attitude (radians), and step_z, in the camera's
+    height (metres; watched only with odometry, Tracker.track's odometry), with their standard
+    deviations (sigma_z NaN when the height was not judged); mounting, the extrinsics it implies
+    (the camera turned about its centre and raised by step_z)."""
     time: float
     step_roll: float
     step_pitch: float
+    step_z: float
     sigma_roll: float
     sigma_pitch: float
+    sigma_z: float
     mounting: Extrinsics
 
 
@@ -140,8 +143,9 @@ class Residuals:
 def _mounting_change(r: N.TrackResult) -> Optional[MountingChange]:
     if not r.mounting_changed:
         return None
-    return MountingChange(r.mounting_change_time, r.mounting_step[0], r.mounting_step[1], r.mounting_step_sigma[0],
-                          r.mounting_step_sigma[1], Extrinsics._from_c(r.changed_mounting))
+    return MountingChange(r.mounting_change_time, r.mounting_step[0], r.mounting_step[1], r.mounting_step[2],
+                          r.mounting_step_sigma[0], r.mounting_step_sigma[1], r.mounting_step_sigma[2],
+                          Extrinsics._from_c(r.changed_mounting))
 
 
 class Tracker(_Handle):
@@ -163,10 +167,15 @@ class Tracker(_Handle):
         self._image = N.Image()
         self._result = N.sized(N.TrackResult)
 
-    def track(self, frame: np.ndarray, timestamp: float) -> TrackResult:
+    def track(self, frame: np.ndarray, timestamp: float, odometry: Optional[SE2] = None) -> TrackResult:
         """Tracks one frame: uint8 (H, W) grey or (H, W, 3) BGR (or float32 grey), the camera's
-        size, any row stride; timestamps in seconds, increasing. A frame that cannot be tracked
-        is not an error: the result's status is LOST or DEGRADED with the reason."""
+        size, any row stride; timestamps in seconds, increasing. odometry: the wheel odometry's
+        pose at the frame, if there is one (with the local plane, the camera's height is then
+        watched too). A frame that cannot be tracked is not an error: the result's status is LOST
+        or DEGRADED with the reason."""
+        if odometry is not None:
+            _check(lib.planarvo_tracker_odometry(self._h(), ctypes.byref(N.SE2(odometry.x, odometry.y,
+                                                                               odometry.theta))))
         image, keep = _image(frame, self.camera.width, self.camera.height, self._image)
         r = self._result
         _check(lib.planarvo_tracker_track(self._h(), ctypes.byref(image), float(timestamp), ctypes.byref(r)))

@@ -222,9 +222,19 @@ PLANARVO_API planarvo_status planarvo_tracker_track(planarvo_tracker* tracker, c
       out.mounting_step[1] = r.mounting_change.step.pitch;
       out.mounting_step_sigma[0] = r.mounting_change.sigma(0);
       out.mounting_step_sigma[1] = r.mounting_change.sigma(1);
+      out.mounting_step[2] = r.mounting_change.dz;
+      out.mounting_step_sigma[2] = r.mounting_change.sigma_z;
       out.changed_mounting = planarvo::capi::to_c(r.changed_mounting);
     }
     std::memcpy(result, &out, std::min(result->struct_size, sizeof out));
+  });
+}
+
+PLANARVO_API planarvo_status planarvo_tracker_odometry(planarvo_tracker* tracker, const planarvo_se2* pose) {
+  return guard([&] {
+    require(tracker != nullptr && pose != nullptr, "planarvo_tracker_odometry: NULL argument");
+    require(std::isfinite(pose->x + pose->y + pose->theta), "planarvo_tracker_odometry: the pose is not finite");
+    tracker->tracker->set_odometry(planarvo::capi::to_cpp(*pose));
   });
 }
 

@@ -143,13 +143,18 @@ void evaluate(const Tracked& k, TrackRun* run) {
 // The warning line for a change of the mounting: when, by how much, and what was done.
 std::string mounting_warning(const planarvo_track_result& r, double origin, double t, int32_t response) {
   const planarvo_extrinsics& m = r.changed_mounting;
+  char z[96] = "";
+  if (std::isfinite(r.mounting_step_sigma[2]))
+    std::snprintf(z, sizeof z, ", the camera's height by %+.1f +- %.1f mm (against the wheel odometry)",
+                  r.mounting_step[2] * 1e3, r.mounting_step_sigma[2] * 1e3);
+  const std::string height = z;
   char line[640];
   std::snprintf(line, sizeof line,
                 "planarvo track: warning: the camera's mounting changed at t = %.3f s (found at %.3f s): the body's "
-                "attitude stepped by roll %+.2f +- %.2f deg, pitch %+.2f +- %.2f deg and held; %s %.4f,%.4f,%.4f,"
-                "%.3f,%.3f,%.3f (x,y,z m; roll,pitch,yaw deg; the height kept)",
+                "attitude stepped by roll %+.2f +- %.2f deg, pitch %+.2f +- %.2f deg%s and held; %s %.4f,%.4f,%.4f,"
+                "%.3f,%.3f,%.3f (x,y,z m; roll,pitch,yaw deg)",
                 origin + r.mounting_change_time, origin + t, r.mounting_step[0] / kDeg, r.mounting_step_sigma[0] / kDeg,
-                r.mounting_step[1] / kDeg, r.mounting_step_sigma[1] / kDeg,
+                r.mounting_step[1] / kDeg, r.mounting_step_sigma[1] / kDeg, height.c_str(),
                 response == PLANARVO_MOUNTING_RECALIBRATE ? "tracking on with the mounting"
                                                           : "kept the mounting given (--mounting-change report); the "
                                                             "images say",
@@ -204,6 +209,7 @@ TrackRun track_dataset(planarvo_context* ctx, planarvo_dataset* ds, const planar
     check(read);
     planarvo_track_result r{};
     r.struct_size = sizeof r;
+    if (fd.has_odometry) check(planarvo_tracker_odometry(tracker.get(), &fd.odometry));
     check(planarvo_tracker_track(tracker.get(), &img, fd.timestamp, &r));
     count(r, &run);
     if (r.mounting_changed) {

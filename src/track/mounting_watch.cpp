@@ -60,22 +60,25 @@ void MountingWatch::reset() {
   level_ = BodyAttitude();
   k_roll_ = 0.0;
   lean_known_ = false;
-  since_[0] = since_[1] = -HUGE_VAL;
+  since_[0] = since_[1] = since_[2] = -HUGE_VAL;
   distance_ = 0.0;
   has_speed_ = false;
 }
 
-void MountingWatch::mounting_changed(const BodyAttitude& step) {
-  level_.roll -= step.roll;
-  level_.pitch -= step.pitch;
+void MountingWatch::mounting_changed(const MountingChange& change) {
+  level_.roll -= change.step.roll;
+  level_.pitch -= change.step.pitch;
+  const double scale = opt_.height > 0.0 ? (opt_.height + change.dz) / opt_.height : 1.0;
   for (Sample& s : samples_) {
-    if (s.t >= since_[0]) s.roll -= step.roll;  // measured with the mounting as it now is
-    if (s.t >= since_[1]) s.pitch -= step.pitch;
+    if (s.t >= since_[0]) s.roll -= change.step.roll;  // measured with the mounting as it now is
+    if (s.t >= since_[1]) s.pitch -= change.step.pitch;
+    if (s.t >= since_[2]) s.vis *= scale;
   }
+  opt_.height += change.dz;
 }
 
 std::optional<MountingChange> MountingWatch::add(double t, double dt, const SE2& motion, const BodyAttitude& attitude,
-                                                 const Eigen::Matrix2d& covariance) {
+                                                 const Eigen::Matrix2d& covariance, double odometry_distance) {
   if (!(dt > 0.0) || !std::isfinite(t) || !std::isfinite(attitude.roll + attitude.pitch)) {
     has_speed_ = false;
     return std::nullopt;
@@ -93,6 +96,8 @@ std::optional<MountingChange> MountingWatch::add(double t, double dt, const SE2&
   s.pitch = attitude.pitch;
   s.var_roll = std::isfinite(covariance(0, 0)) ? covariance(0, 0) : 0.0;
   s.var_pitch = std::isfinite(covariance(1, 1)) ? covariance(1, 1) : 0.0;
+  s.vis = std::hypot(motion.x, motion.y);
+  s.odo = std::isfinite(odometry_distance) && odometry_distance >= 0.0 ? odometry_distance : NAN;
   samples_.push_back(s);
   return test();
 }
@@ -120,14 +125,14 @@ std::optional<MountingChange> MountingWatch::test() {
     if (begin == 0) return std::nullopt;  // not yet a whole window
   }
   // The history before it: at most history_seconds, and per angle since its last change.
-  while (samples_.front().t < std::max(std::min(since_[0], since_[1]), samples_[begin].t - opt_.history_seconds)) {
+  while (samples_.front().t <
+         std::max(std::min({since_[0], since_[1], since_[2]}), samples_[begin].t - opt_.history_seconds)) {
     samples_.pop_front();
     --begin;
   }
   fit_lean(begin);
 
   const size_t n = samples_.size();
-  auto residual = [&](const Sample& s, int angle) { return angle == 0 ? s.roll - k_roll_ * s.w : s.pitch; };
   auto in_history = [&](size_t i, int angle) { return i < begin && samples_[i].t >= since_[angle]; };
   MountingChange change;
   bool stepped[2] = {false, false};  // held a new level by min_step at least
@@ -173,7 +178,7 @@ std::optional<MountingChange> MountingWatch::test() {
     judged[angle] = worst <= opt_.steady_tolerance && comparable;
     stepped[angle] = judged[angle] && std::abs(steps[angle]) >= opt_.min_step;
   }
-  if (!stepped[0] && !stepped[1]) return std::nullopt;
+  if (!stepped[0] && !stepped[1]) return test_height(bases);
 
   // When the new level began: after the last frame before the window that was still at the old one
   // (frames at neither, a bump's, are passed over).
@@ -199,6 +204,98 @@ std::optional<MountingChange> MountingWatch::test() {
     (angle == 0 ? level_.roll : level_.pitch) = medians[angle];
     since_[angle] = change.time;
   }
+  // The distances tracked before it was found were scaled by the turned camera's height error.
+  since_[2] = change.detected_time;
+  return change;
+}
+
+double MountingWatch::residual(const Sample& s, int angle) const {
+  return angle == 0 ? s.roll - k_roll_ * s.w : s.pitch;
+}
+
+std::optional<MountingChange> MountingWatch::test_height(const double levels[2]) {
+  if (!(opt_.height > 0.0)) return std::nullopt;
+  // The window: the most recent height_window_metres of wheel travel, every frame with odometry.
+  const size_t n = samples_.size();
+  size_t begin = n;
+  double odo = 0.0;
+  while (begin > 0 && odo < opt_.height_window_metres) {
+    const Sample& s = samples_[--begin];
+    if (!std::isfinite(s.odo) || s.t < since_[2]) return std::nullopt;
+    odo += s.odo;
+  }
+  if (odo < opt_.height_window_metres) return std::nullopt;
+  // Only while the attitude holds its level over the window (its median: a bump passes through
+  // it): a turned camera not yet found shows as a height.
+  for (int angle = 0; angle < 2; ++angle) {
+    std::vector<double> r;
+    for (size_t i = begin; i < n; ++i) r.push_back(residual(samples_[i], angle));
+    if (!(std::abs(median(r) - levels[angle]) < 0.5 * opt_.min_step)) return std::nullopt;
+  }
+  // The ratio of distances over [a, b) and its variance (the frames' scatter about it).
+  struct Ratio {
+    double r = NAN, var = NAN, odo = 0.0;
+  };
+  auto ratio = [&](size_t a, size_t b) {
+    Ratio q;
+    double vis = 0.0;
+    for (size_t i = a; i < b; ++i)
+      if (std::isfinite(samples_[i].odo) && samples_[i].t >= since_[2]) {
+        vis += samples_[i].vis;
+        q.odo += samples_[i].odo;
+      }
+    if (!(q.odo > 0.0)) return q;
+    q.r = vis / q.odo;
+    double ss = 0.0;
+    for (size_t i = a; i < b; ++i)
+      if (std::isfinite(samples_[i].odo) && samples_[i].t >= since_[2])
+        ss += std::pow(samples_[i].vis - q.r * samples_[i].odo, 2);
+    q.var = ss / (q.odo * q.odo);
+    return q;
+  };
+  const Ratio hist = ratio(0, begin);
+  if (hist.odo < opt_.height_history_metres) return std::nullopt;
+  const Ratio win = ratio(begin, n);
+  size_t mid = begin;
+  for (double o = 0.0; mid < n && o < 0.5 * win.odo; ++mid) o += samples_[mid].odo;
+  const Ratio first = ratio(begin, mid), second = ratio(mid, n);
+  const double d = win.r / hist.r - 1.0;
+  const double sigma_d = std::sqrt(win.var / (win.r * win.r) + hist.var / (hist.r * hist.r));
+  const bool halves = (first.r / hist.r - 1.0) * d >= 0.25 * d * d && (second.r / hist.r - 1.0) * d >= 0.25 * d * d;
+  // r = z_mounting / z_true (times the wheels' scale): the true height z r_before / r_after.
+  if (!(std::abs(opt_.height * d) >= opt_.min_height_step && std::abs(d) >= opt_.height_sigmas * sigma_d && halves))
+    return std::nullopt;
+  // When: the split of the frames since the last change that best tells two ratios apart; the
+  // change is measured across it.
+  MountingChange change;
+  change.detected_time = samples_.back().t;
+  double best = -1.0, vis_a = 0.0, odo_a = 0.0, vis_all = 0.0, odo_all = 0.0;
+  size_t split = begin;
+  for (const Sample& s : samples_)
+    if (std::isfinite(s.odo) && s.t >= since_[2]) {
+      vis_all += s.vis;
+      odo_all += s.odo;
+    }
+  for (size_t i = 0; i < n; ++i) {
+    const Sample& s = samples_[i];
+    if (!std::isfinite(s.odo) || s.t < since_[2]) continue;
+    const double odo_b = odo_all - odo_a;
+    if (odo_a > 0.0 && odo_b > 0.0) {
+      const double score = std::abs(vis_a / odo_a - (vis_all - vis_a) / odo_b) * std::sqrt(odo_a * odo_b / odo_all);
+      if (score > best) {
+        best = score;
+        split = i;
+      }
+    }
+    vis_a += s.vis;
+    odo_a += s.odo;
+  }
+  const Ratio before = ratio(0, split), after = ratio(split, n);
+  change.time = samples_[split].t;
+  change.dz = opt_.height * (before.r / after.r - 1.0);
+  change.sigma_z = opt_.height * before.r / after.r *
+                   std::sqrt(after.var / (after.r * after.r) + before.var / (before.r * before.r));
+  since_[2] = change.time;
   return change;
 }
 

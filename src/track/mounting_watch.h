@@ -21,8 +21,17 @@
 // measured in metres so that a slow car's bump is judged over the same stretch of road as a fast
 // one's; standing still adds nothing to it (the plane is not observed then).
 //
-// Height is not in the test: the images of a plane fix the camera's height only relative to the
-// scale of the motion, which without wheel odometry is the mounting's height itself.
+// Height. The images of a plane fix the camera's height only with the scale of the motion: without
+// wheel odometry the mounting's height is all there is. With it (add()'s odometry distance), the
+// ratio of the distance tracked to the wheels' distance is the mounting's height over the true one
+// times the wheels' scale: a step in it that holds is the height changed. Judged over the most
+// recent height_window_metres of wheel travel against the history since the last change (at least
+// height_history_metres): a change when the window's ratio differs by at least min_height_step (as
+// a height) and height_sigmas of its standard deviation (from the frames' scatter about it), both
+// halves of the window on the same side by at least half of it, and the attitude's median over the
+// window at its level (a turned camera not yet found shows as a height: the local plane turns the
+// body about the ground, which moves the camera). The change is then measured across the split of
+// the frames since the last change that best tells two ratios apart (its time).
 #pragma once
 #include <cmath>
 #include <deque>
@@ -46,6 +55,12 @@ struct MountingWatchOptions {
   // acceleration (m/s^2) is further than this from the history's median is not compared.
   double min_yaw_rate_spread = 2.0 * M_PI / 180.0;
   double min_acceleration_spread = 0.5;
+  // The height (with odometry): the mounting's height (metres; 0: not watched), and the test's.
+  double height = 0.0;
+  double min_height_step = 0.005;
+  double height_window_metres = 3.0;
+  double height_history_metres = 2.0;
+  double height_sigmas = 5.0;
 };
 
 // A change of the mounting, in the body's attitude: the attitude measured against the mounting
@@ -55,6 +70,9 @@ struct MountingChange {
   double detected_time = 0.0;  // the frame that confirmed it
   BodyAttitude step;
   Eigen::Vector2d sigma = Eigen::Vector2d::Zero();  // roll, pitch
+  // The height's change (metres) and its standard deviation; NaN sigma when not judged (no
+  // odometry, or this change is the attitude's).
+  double dz = 0.0, sigma_z = NAN;
 };
 
 class MountingWatch {
@@ -65,12 +83,13 @@ class MountingWatch {
   // yaw rate, the speed and the acceleration), its attitude and the attitude's covariance.
   // Frames that were not tracked are not given (a gap: the acceleration restarts). Returns the
   // change this frame confirmed, if any; the level then moves to the new attitude.
+  // odometry_distance: the wheels' distance over the same interval (metres), NaN when there is none.
   std::optional<MountingChange> add(double t, double dt, const SE2& motion, const BodyAttitude& attitude,
-                                    const Eigen::Matrix2d& covariance);
+                                    const Eigen::Matrix2d& covariance, double odometry_distance = NAN);
 
-  // The caller changed the mounting by `step` (the change just reported): attitudes measured from
-  // now on are `step` lower.
-  void mounting_changed(const BodyAttitude& step);
+  // The caller changed the mounting as `change` says (the change just reported): attitudes measured
+  // from now on are its step lower, distances tracked (z + dz) / z longer.
+  void mounting_changed(const MountingChange& change);
 
   // The lean's slope in use: roll per yaw rate (s).
   double roll_per_yaw_rate() const { return k_roll_; }
@@ -83,13 +102,17 @@ class MountingWatch {
     double w, a;        // yaw rate, acceleration
     double roll, pitch;
     double var_roll, var_pitch;  // the attitude's own variances
+    double vis, odo;             // distance tracked and the wheels' (NaN: no odometry)
   };
   void fit_lean(size_t end);
   std::optional<MountingChange> test();
+  std::optional<MountingChange> test_height(const double levels[2]);
+  // The roll less the lean its yaw rate explains (angle 0), the pitch (1).
+  double residual(const Sample& s, int angle) const;
 
   MountingWatchOptions opt_;
   std::deque<Sample> samples_;  // the window and at most history_seconds before it
-  double since_[2] = {-HUGE_VAL, -HUGE_VAL};  // per angle: its last change (its history begins)
+  double since_[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};  // roll, pitch, height: the last change (the history's start)
   BodyAttitude level_;          // the expected attitude before any history (the mounting's)
   double k_roll_ = 0.0;       // roll per yaw rate, fitted robustly over the history
   bool lean_known_ = false;   // k_roll_ fitted (else zero)

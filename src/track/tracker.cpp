@@ -143,6 +143,10 @@ struct Tracker::Impl {
   std::vector<AlignmentPair> pairs = std::vector<AlignmentPair>(1);
   LocalPlane plane;  // TrackerOptions::local_plane: the keyframe's attitude and its covariance
   MountingWatch watch;  // TrackerOptions::on_mounting_change (with the local plane)
+  // Tracker::set_odometry: the wheels' pose at the frame about to be tracked and at the last one,
+  // and the distance between them (NaN without both).
+  std::optional<SE2> next_odometry, last_odometry;
+  double odometry_distance = NAN;
   AlignmentReport report;
   // The last frame's final alignment for residuals() (has_last), or why there is none (missing;
   // nullptr: no frame aligned since the first), and the residual image made from it (cached,
@@ -164,7 +168,7 @@ struct Tracker::Impl {
       : rt(r), camera(validated_tracker_camera(c, e, o)), ext(e), opt(o),
         aligner(r, c.K(), o, o.local_plane ? AlignerModel::LocalPlane : AlignerModel::Motion), selector(r),
         light_gate(camera.K(), camera.width, camera.height, e, o.learn_motion_px, o.max_texture_residual),
-        plane(o.local_plane_prior_sigma), watch(o.mounting_watch) {
+        plane(o.local_plane_prior_sigma), watch(watch_options(o, e)) {
     readout_twist = ReadoutTwist(camera.mean_row_time());
     // The flat field is read now, so that a bad file fails at once rather than at the first frame.
     if (!opt.flat_field.empty() && opt.photometric.enabled) {
@@ -175,6 +179,12 @@ struct Tracker::Impl {
           opt.photometric);
     }
     reset();
+  }
+
+  static MountingWatchOptions watch_options(const TrackerOptions& o, const Extrinsics& e) {
+    MountingWatchOptions w = o.mounting_watch;
+    w.height = e.z;
+    return w;
   }
 
   // The model in use when it is not the identity: the known one, or a learnt one.
@@ -201,6 +211,7 @@ struct Tracker::Impl {
     prev_tilt.setZero();
     plane.reset();
     watch.reset();
+    last_odometry.reset();
     keyframe_shear_assumed = false;
     velocity.setZero();
     readout_twist.reset();
@@ -669,18 +680,19 @@ struct Tracker::Impl {
     using Response = TrackerOptions::MountingResponse;
     if (!opt.local_plane || opt.on_mounting_change == Response::Ignore) return;
     const std::optional<MountingChange> change =
-        watch.add(t, dt, res->motion.value, res->attitude, res->attitude_covariance);
+        watch.add(t, dt, res->motion.value, res->attitude, res->attitude_covariance, odometry_distance);
     if (!change) return;
     res->mounting_changed = true;
     res->mounting_change = *change;
     res->changed_mounting = turned_mounting(ext, change->step);
+    res->changed_mounting.z += change->dz;
     if (opt.on_mounting_change != Response::Recalibrate) return;
     ext = res->changed_mounting;
     est->att_ref = relative_to_turned(est->att_ref, change->step);
     est->att_live = relative_to_turned(est->att_live, change->step);
     res->attitude = est->att_live;
     plane.mounting_turned(change->step);
-    watch.mounting_changed(change->step);
+    watch.mounting_changed(*change);
   }
 
   bool right_size(const Pyramid& live) const {
@@ -700,6 +712,14 @@ struct Tracker::Impl {
     FrameResult res;
     res.motion.covariance = lost_covariance();
     res.mounting = ext;
+    if (next_odometry && last_odometry) {
+      const SE2 d = last_odometry->inverse() * *next_odometry;
+      odometry_distance = std::hypot(d.x, d.y);
+    } else {
+      odometry_distance = NAN;
+    }
+    last_odometry = next_odometry;
+    next_odometry.reset();
     shutter_unknown = false;
 
     // Time: the interval, gaps, and the constant-velocity prediction. A timestamp that is not
@@ -899,6 +919,7 @@ FrameResult Tracker::track(const uint8_t* gray, int width, int height, size_t st
   return impl_->track_gray(gray, width, height, stride, timestamp);
 }
 void Tracker::reset() { impl_->reset(); }
+void Tracker::set_odometry(const SE2& pose) { impl_->next_odometry = pose; }
 ResidualImage Tracker::residuals(int level) { return impl_->residuals(level); }
 const SE2& Tracker::pose() const { return impl_->pose; }
 const TrackerOptions& Tracker::options() const { return impl_->opt; }

@@ -268,6 +268,12 @@ class Tracker {
   // or for a level out of range. With track(Pyramid), the live pyramid must still hold the frame.
   ResidualImage residuals(int level = 0);
 
+  // The wheel odometry's pose at the frame about to be tracked (any fixed odometry frame), before
+  // track(): with the local plane, the mounting watch compares the distances tracked with the
+  // wheels' to find the camera's height changed (mounting_watch.h). Frames given none are left out
+  // of that comparison.
+  void set_odometry(const SE2& pose);
+
   // Forgets the keyframe, the pose, the velocity and the residual scales.
   void reset();
   // The accumulated robot pose relative to the first frame (product of the motions).

@@ -39,14 +39,20 @@ struct Outcome {
   std::vector<MountingChange> changes;
 };
 
-// Feeds one drive's frames to a watch; the attitude is stepped by `knock` from knock_time on.
-Outcome watch_drive(const sim::Options& o, const BodyAttitude& knock, double knock_time, unsigned noise_seed) {
+// Feeds one drive's frames to a watch with the simulator's wheel odometry (1 % noise per wheel and
+// frame); the attitude is stepped by `knock` and the camera's height by knock_dz from knock_time on.
+// The distances tracked are the true ones times the height the watch has over the true height.
+Outcome watch_drive(const sim::Options& o, const BodyAttitude& knock, double knock_time, unsigned noise_seed,
+                    double knock_dz = 0.0) {
   const sim::Trajectory tr = sim::generate_trajectory(o);
   std::mt19937 rng(noise_seed);
   std::normal_distribution<double> white(0.0, 0.03 * kDeg);
-  MountingWatch watch;
+  MountingWatchOptions wo;
+  wo.height = o.extrinsics.z;
+  MountingWatch watch(wo);
   Outcome out;
   BodyAttitude absorbed;
+  double absorbed_dz = 0.0;
   const Eigen::Matrix2d cov = std::pow(0.03 * kDeg, 2) * Eigen::Matrix2d::Identity();
   for (size_t k = 1; k < tr.t.size(); ++k) {
     const double t = tr.t[k];
@@ -54,18 +60,25 @@ Outcome watch_drive(const sim::Options& o, const BodyAttitude& knock, double kno
     // The local plane's error: white, and a wander of 0.1 degrees over seconds.
     a.roll += white(rng) + 0.1 * kDeg * std::sin(0.9 * t + noise_seed);
     a.pitch += white(rng) + 0.1 * kDeg * std::cos(0.7 * t + noise_seed);
+    const double dz = t >= knock_time ? knock_dz : 0.0;
     if (t >= knock_time) {
       a.roll += knock.roll;
       a.pitch += knock.pitch;
     }
     a.roll -= absorbed.roll;  // measured against the mounting recalibrated so far
     a.pitch -= absorbed.pitch;
-    const SE2 motion = tr.pose[k - 1].inverse() * tr.pose[k];
-    if (std::optional<MountingChange> c = watch.add(t, tr.t[k] - tr.t[k - 1], motion, a, cov)) {
+    SE2 motion = tr.pose[k - 1].inverse() * tr.pose[k];
+    const double scale = (o.extrinsics.z + absorbed_dz) / (o.extrinsics.z + dz);
+    motion.x *= scale;
+    motion.y *= scale;
+    const SE2 wheels = tr.odometry[k - 1].inverse() * tr.odometry[k];
+    if (std::optional<MountingChange> c =
+            watch.add(t, tr.t[k] - tr.t[k - 1], motion, a, cov, std::hypot(wheels.x, wheels.y))) {
       out.changes.push_back(*c);
-      watch.mounting_changed(c->step);  // recalibrated: what follows is against the new mounting
+      watch.mounting_changed(*c);  // recalibrated: what follows is against the new mounting
       absorbed.roll += c->step.roll;
       absorbed.pitch += c->step.pitch;
+      absorbed_dz += c->dz;
     }
   }
   return out;
@@ -154,6 +167,33 @@ TEST(MountingWatch, AKnockIsFoundOnceAWindowHoldsItAndMeasured) {
     }
   EXPECT_EQ(found, 12);
   std::printf("knocks found within 1 s: %d of 12\n", within_a_second);
+}
+
+TEST(MountingWatch, AHeightChangeIsFoundAgainstTheWheelsAndMeasured) {
+  int within_a_second = 0;
+  for (int seed = 1; seed <= 4; ++seed)
+    for (double dz : {0.01, -0.01}) {
+      const sim::Options o = drive(seed, 10.0, 3.0);
+      const double knock_time = 7.0 + 0.37 * seed;
+      const Outcome out = watch_drive(o, BodyAttitude(), knock_time, static_cast<unsigned>(200 + seed), dz);
+      ASSERT_EQ(out.changes.size(), 1u) << "seed " << seed << " dz " << dz;
+      const MountingChange& c = out.changes[0];
+      EXPECT_NEAR(c.dz, dz, 0.002) << "seed " << seed;
+      EXPECT_GT(c.sigma_z, 0.0);
+      EXPECT_LT(c.sigma_z, 0.002);
+      EXPECT_EQ(c.step.roll, 0.0);
+      EXPECT_EQ(c.step.pitch, 0.0);
+      EXPECT_NEAR(c.time, knock_time, 0.5) << "seed " << seed;
+      // Found once the window (3 m of wheel travel) lies after it, and both its halves show it.
+      const sim::Trajectory tr = sim::generate_trajectory(o);
+      size_t k = 0;
+      while (tr.t[k] < knock_time) ++k;
+      const double s0 = tr.distance[k];
+      while (k + 1 < tr.t.size() && tr.distance[k] - s0 < 3.5) ++k;
+      EXPECT_LE(c.detected_time, tr.t[k]) << "seed " << seed;
+      within_a_second += c.detected_time - knock_time <= 1.0;
+    }
+  std::printf("height changes found within 1 s: %d of 8\n", within_a_second);
 }
 
 TEST(BodyAttitude, ATurnedMountingSeesTheGroundAsTheKnockedBodyDid) {

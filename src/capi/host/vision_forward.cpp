@@ -201,6 +201,11 @@ PLANARVO_API planarvo_status planarvo_tracker_track(planarvo_tracker* tracker, c
   return fn ? fn(tracker, image, timestamp, result) : PLANARVO_ERROR_INTERNAL;
 }
 
+PLANARVO_API planarvo_status planarvo_tracker_odometry(planarvo_tracker* tracker, const planarvo_se2* pose) {
+  PLANARVO_FORWARD(planarvo_tracker_odometry);
+  return fn ? fn(tracker, pose) : PLANARVO_ERROR_INTERNAL;
+}
+
 PLANARVO_API planarvo_status planarvo_tracker_reset(planarvo_tracker* tracker) {
   PLANARVO_FORWARD(planarvo_tracker_reset);
   return fn ? fn(tracker) : PLANARVO_ERROR_INTERNAL;
