@@ -1,7 +1,7 @@
 # ROS 1 (roscpp) for planarvo_node (ros/), found without catkin: roscpp through its pkg-config
 # file, the message packages (header-only generated code) by their headers. Debian 12's packages:
 # libroscpp-dev, libsensor-msgs-dev, libnav-msgs-dev, libgeometry-msgs-dev, libtf2-msgs-dev,
-# libstd-msgs-dev (scripts/install-deps.sh). Sets PLANARVO_ROS_FOUND and, when found, the imported
+# libstd-msgs-dev, libdiagnostic-msgs-dev (scripts/install-deps.sh). Sets PLANARVO_ROS_FOUND and, when found, the imported
 # target PlanarvoROS::roscpp with the include directories of the messages.
 set(PLANARVO_ROS_FOUND OFF)
 if(NOT PLANARVO_ROS)
@@ -18,7 +18,7 @@ if(NOT PLANARVO_ROSCPP_FOUND)
 endif()
 set(PLANARVO_ROS_MESSAGE_INCLUDE_DIRS "")
 foreach(header sensor_msgs/Image.h sensor_msgs/CameraInfo.h nav_msgs/Odometry.h geometry_msgs/TransformStamped.h
-               tf2_msgs/TFMessage.h std_msgs/String.h)
+               tf2_msgs/TFMessage.h std_msgs/String.h diagnostic_msgs/DiagnosticArray.h)
   string(MAKE_C_IDENTIFIER "PLANARVO_ROS_${header}" var)
   find_path(${var} ${header})
   if(${var})

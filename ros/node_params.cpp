@@ -84,6 +84,8 @@ bool read_params(const ros::NodeHandle& nh, NodeParams* p) {
   int levels = t.levels, finest = t.finest_level, subsample = t.level0_subsample, iterations = t.max_iterations;
   bool local_plane = t.local_plane != 0;
   double plane_prior_deg = t.local_plane_prior_sigma * 180.0 / M_PI;
+  double mounting_step_deg = t.mounting_min_step * 180.0 / M_PI;
+  std::string mounting_change = "recalibrate";
   bool ok = get_text(nh, "camera", &p->camera) && get_text(nh, "extrinsics", &p->extrinsics) &&
             get_text(nh, "device", &p->device) && get_text(nh, "cache_dir", &p->cache_dir) &&
             get_text(nh, "kernel_binaries", &p->kernel_binaries) &&
@@ -95,6 +97,8 @@ bool read_params(const ros::NodeHandle& nh, NodeParams* p) {
             get_double(nh, "exposure_time", -1.0, 1.0, &p->exposure_time) &&
             get_int(nh, "max_iterations", 0, 1000, &iterations) && get_bool(nh, "local_plane", &local_plane) &&
             get_double(nh, "local_plane_prior_deg", 1e-6, 90.0, &plane_prior_deg) &&
+            get_text(nh, "mounting_change", &mounting_change) &&
+            get_double(nh, "mounting_step_deg", 1e-3, 45.0, &mounting_step_deg) &&
             get_double(nh, "keyframe_overlap", 0.0, 1.0, &t.keyframe_overlap) &&
             get_int(nh, "queue_size", 1, 100000, &p->queue_size) &&
             get_int(nh, "max_pending", 1, 100000, &p->max_pending) &&
@@ -111,6 +115,15 @@ bool read_params(const ros::NodeHandle& nh, NodeParams* p) {
   t.max_iterations = iterations;
   t.local_plane = local_plane ? 1 : 0;
   t.local_plane_prior_sigma = plane_prior_deg * M_PI / 180.0;
+  t.mounting_min_step = mounting_step_deg * M_PI / 180.0;
+  if (mounting_change == "recalibrate") t.on_mounting_change = PLANARVO_MOUNTING_RECALIBRATE;
+  else if (mounting_change == "report") t.on_mounting_change = PLANARVO_MOUNTING_REPORT;
+  else if (mounting_change == "ignore") t.on_mounting_change = PLANARVO_MOUNTING_IGNORE;
+  else {
+    ROS_FATAL("planarvo_node: ~mounting_change must be recalibrate, report or ignore, not \"%s\"",
+              mounting_change.c_str());
+    return false;
+  }
   if (p->calibrate && p->calibration_output.empty()) {
     ROS_FATAL("planarvo_node: ~calibrate is true but ~calibration_output (the extrinsics file to write) is not set");
     return false;

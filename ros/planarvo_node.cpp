@@ -19,6 +19,7 @@
 #include <string>
 #include <vector>
 
+#include <diagnostic_msgs/DiagnosticArray.h>
 #include <nav_msgs/Odometry.h>
 #include <planarvo/planarvo.h>
 #include <ros/ros.h>
@@ -57,6 +58,7 @@ class Node {
         extrinsics_(extrinsics),
         publisher_(nh, params.odom_frame, params.base_frame, params.publish_tf) {
     counts_topic_ = pnh.advertise<std_msgs::String>("counts", 1, true);
+    if (params.tracker.local_plane) diagnostics_ = nh.advertise<diagnostic_msgs::DiagnosticArray>("/diagnostics", 10);
   }
 
   void on_image(const sensor_msgs::ImageConstPtr& m) {
@@ -261,6 +263,7 @@ class Node {
     if (r.status == PLANARVO_TRACK_LOST || r.status == PLANARVO_TRACK_DEGRADED)
       ROS_WARN_THROTTLE(5, "planarvo_node: frame at t = %.3f s %s: %s", t,
                         r.status == PLANARVO_TRACK_LOST ? "lost" : "degraded", r.reason ? r.reason : "");
+    if (r.mounting_changed) report_mounting_change(stamp, r);
     publisher_.publish(stamp, r, have_last_ ? t - last_t_ : 0.0);
     have_last_ = true;
     last_t_ = t;
@@ -275,6 +278,49 @@ class Node {
     counts_.process_ms.add(ms);
     counts_.engine_ms.add(r.ms);
     counts_.max_latency_ms = std::max(counts_.max_latency_ms, latency);
+  }
+
+  // The local plane found the camera's mounting changed: a warning, and a WARN diagnostic (the ROS
+  // convention rqt_runtime_monitor and /diagnostics aggregators read) with the change and the
+  // mounting now in use.
+  void report_mounting_change(const ros::Time& stamp, const planarvo_track_result& r) {
+    constexpr double kDeg = M_PI / 180.0;
+    const planarvo_extrinsics& m = r.changed_mounting;
+    const bool recalibrated = params_.tracker.on_mounting_change == PLANARVO_MOUNTING_RECALIBRATE;
+    ROS_WARN("planarvo_node: the camera's mounting changed at t = %.3f s: the body's attitude stepped by roll %+.2f "
+             "+- %.2f deg, pitch %+.2f +- %.2f deg and held; %s %.4f,%.4f,%.4f,%.3f,%.3f,%.3f (x,y,z m; "
+             "roll,pitch,yaw deg)",
+             r.mounting_change_time, r.mounting_step[0] / kDeg, r.mounting_step_sigma[0] / kDeg,
+             r.mounting_step[1] / kDeg, r.mounting_step_sigma[1] / kDeg,
+             recalibrated ? "tracking on with the mounting" : "keeping the mounting given (~mounting_change report); "
+                                                              "the images say",
+             m.x, m.y, m.z, m.roll / kDeg, m.pitch / kDeg, m.yaw / kDeg);
+    diagnostic_msgs::DiagnosticArray a;
+    a.header.stamp = stamp;
+    diagnostic_msgs::DiagnosticStatus d;
+    d.level = diagnostic_msgs::DiagnosticStatus::WARN;
+    d.name = "planarvo_node: camera mounting";
+    d.hardware_id = params_.base_frame;
+    d.message = recalibrated ? "mounting changed: recalibrated" : "mounting changed: reported only";
+    auto kv = [&d](const char* key, double value) {
+      diagnostic_msgs::KeyValue k;
+      k.key = key;
+      k.value = std::to_string(value);
+      d.values.push_back(k);
+    };
+    kv("change_time_s", r.mounting_change_time);
+    kv("roll_step_deg", r.mounting_step[0] / kDeg);
+    kv("roll_step_sigma_deg", r.mounting_step_sigma[0] / kDeg);
+    kv("pitch_step_deg", r.mounting_step[1] / kDeg);
+    kv("pitch_step_sigma_deg", r.mounting_step_sigma[1] / kDeg);
+    kv("x_m", m.x);
+    kv("y_m", m.y);
+    kv("z_m", m.z);
+    kv("roll_deg", m.roll / kDeg);
+    kv("pitch_deg", m.pitch / kDeg);
+    kv("yaw_deg", m.yaw / kDeg);
+    a.status.push_back(d);
+    diagnostics_.publish(a);
   }
 
   void reject(const sensor_msgs::Image& m, const std::string& why) {
@@ -326,6 +372,7 @@ class Node {
   std::optional<planarvo_extrinsics> extrinsics_;
   std::unique_ptr<planarvo_tracker, TrackerDeleter> tracker_;
   OdometryPublisher publisher_;
+  ros::Publisher diagnostics_;  // with the local plane: a change of the camera's mounting
   ros::Publisher counts_topic_;
   std::vector<uint8_t> buffer_;
   bool started_ = false, have_origin_ = false, have_last_ = false, have_calibration_origin_ = false;

@@ -29,6 +29,7 @@ if [ "${PLANARVO_BENCH_DEPS:-0}" = 1 ]; then packages+=(libceres-dev); fi
 # and the bag writer, rospy with the message modules the test reads.
 packages+=(
   libroscpp-dev libstd-msgs-dev libsensor-msgs-dev libnav-msgs-dev libgeometry-msgs-dev libtf2-msgs-dev
+  libdiagnostic-msgs-dev python3-diagnostic-msgs
   python3-roslaunch python3-rosbag python3-rospy python3-yaml python3-sensor-msgs python3-nav-msgs python3-tf2-msgs
 )
 

@@ -232,7 +232,10 @@ std::optional<MountingChange> MountingWatch::test_height(const double levels[2])
     for (size_t i = begin; i < n; ++i) r.push_back(residual(samples_[i], angle));
     if (!(std::abs(median(r) - levels[angle]) < 0.5 * opt_.min_step)) return std::nullopt;
   }
-  // The ratio of distances over [a, b) and its variance (the frames' scatter about it).
+  // The ratio of distances over [a, b) and its variance (the frames' scatter about it), over the
+  // frames that moved (a frame standing still adds the tracker's noise to the distance tracked and
+  // nothing to the wheels').
+  auto counts = [&](const Sample& s) { return s.odo >= opt_.height_min_travel && s.t >= since_[2]; };
   struct Ratio {
     double r = NAN, var = NAN, odo = 0.0;
   };
@@ -240,7 +243,7 @@ std::optional<MountingChange> MountingWatch::test_height(const double levels[2])
     Ratio q;
     double vis = 0.0;
     for (size_t i = a; i < b; ++i)
-      if (std::isfinite(samples_[i].odo) && samples_[i].t >= since_[2]) {
+      if (counts(samples_[i])) {
         vis += samples_[i].vis;
         q.odo += samples_[i].odo;
       }
@@ -248,8 +251,7 @@ std::optional<MountingChange> MountingWatch::test_height(const double levels[2])
     q.r = vis / q.odo;
     double ss = 0.0;
     for (size_t i = a; i < b; ++i)
-      if (std::isfinite(samples_[i].odo) && samples_[i].t >= since_[2])
-        ss += std::pow(samples_[i].vis - q.r * samples_[i].odo, 2);
+      if (counts(samples_[i])) ss += std::pow(samples_[i].vis - q.r * samples_[i].odo, 2);
     q.var = ss / (q.odo * q.odo);
     return q;
   };
@@ -272,15 +274,16 @@ std::optional<MountingChange> MountingWatch::test_height(const double levels[2])
   double best = -1.0, vis_a = 0.0, odo_a = 0.0, vis_all = 0.0, odo_all = 0.0;
   size_t split = begin;
   for (const Sample& s : samples_)
-    if (std::isfinite(s.odo) && s.t >= since_[2]) {
+    if (counts(s)) {
       vis_all += s.vis;
       odo_all += s.odo;
     }
   for (size_t i = 0; i < n; ++i) {
     const Sample& s = samples_[i];
-    if (!std::isfinite(s.odo) || s.t < since_[2]) continue;
+    if (!counts(s)) continue;
     const double odo_b = odo_all - odo_a;
-    if (odo_a > 0.0 && odo_b > 0.0) {
+    // Each side long enough to measure a ratio on.
+    if (odo_a >= 0.5 * opt_.height_history_metres && odo_b >= 0.5 * opt_.height_window_metres) {
       const double score = std::abs(vis_a / odo_a - (vis_all - vis_a) / odo_b) * std::sqrt(odo_a * odo_b / odo_all);
       if (score > best) {
         best = score;

@@ -61,6 +61,7 @@ struct MountingWatchOptions {
   double height_window_metres = 3.0;
   double height_history_metres = 2.0;
   double height_sigmas = 5.0;
+  double height_min_travel = 0.005;  // metres of wheel travel in a frame for it to count
 };
 
 // A change of the mounting, in the body's attitude: the attitude measured against the mounting

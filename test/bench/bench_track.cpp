@@ -201,7 +201,7 @@ struct SequenceReport {
   // Its mounting watch: the changes found (time, found at, distance driven in between) and the
   // mounting as the drive ended against the truth's (sim::knocked_extrinsics).
   struct Change {
-    double time, found, driven, roll, pitch;
+    double time, found, driven, roll, pitch, dz;
   };
   std::vector<Change> changes;
   Extrinsics final_mounting;
@@ -284,6 +284,8 @@ SequenceReport run_sequence(ocl::Runtime& rt, const sim::Options& so, const trac
     if (const char* pb = std::getenv("BENCH_PREBLUR"); pb && std::atof(pb) > 0.0)
       cv::GaussianBlur(img, img, cv::Size(0, 0), std::atof(pb));
     const double c0 = cpu_ms();
+    // The simulator's wheel odometry (1 % noise per wheel and frame): the mounting watch's height.
+    if (topt.local_plane) tracker.set_odometry(traj.odometry[k]);
     const track::FrameResult r = tracker.track(img.data, img.cols, img.rows, img.step, traj.t[k]);
     rep.cpu_frame += cpu_ms() - c0;
     if (!lighting.empty()) {
@@ -316,7 +318,7 @@ SequenceReport run_sequence(ocl::Runtime& rt, const sim::Options& so, const trac
         size_t from = k;
         while (from > 0 && traj.t[from] > r.mounting_change.time + 1e-9) --from;
         rep.changes.push_back({r.mounting_change.time, traj.t[k], traj.distance[k] - traj.distance[from],
-                               r.mounting_change.step.roll, r.mounting_change.step.pitch});
+                               r.mounting_change.step.roll, r.mounting_change.step.pitch, r.mounting_change.dz});
       }
       const BodyAttitude a = sim::body_attitude(so, traj, traj.t[k]);
       const double err[2] = {r.attitude.roll - a.roll, r.attitude.pitch - a.pitch};
@@ -423,8 +425,8 @@ int bench_accuracy(const std::vector<std::string>& textures, double seconds, int
       const Extrinsics& m = r.final_mounting;
       std::printf("  mounting: %zu change(s)", r.changes.size());
       for (const auto& c : r.changes)
-        std::printf("; from %.3f s found at %.3f s (%.3f s, %.2f m later): roll %+.3f pitch %+.3f deg", c.time, c.found,
-                    c.found - so.knock_time, c.driven, c.roll * 180 / M_PI, c.pitch * 180 / M_PI);
+        std::printf("; from %.3f s found at %.3f s (%.3f s, %.2f m later): roll %+.3f pitch %+.3f deg z %+.2f mm", c.time,
+                    c.found, c.found - so.knock_time, c.driven, c.roll * 180 / M_PI, c.pitch * 180 / M_PI, c.dz * 1e3);
       std::printf("; as the drive ended off by roll %.3f pitch %.3f yaw %.3f deg, z %.2f mm\n",
                   (m.roll - knocked.roll) * 180 / M_PI, (m.pitch - knocked.pitch) * 180 / M_PI,
                   std::remainder(m.yaw - knocked.yaw, 2 * M_PI) * 180 / M_PI, (m.z - knocked.z) * 1e3);

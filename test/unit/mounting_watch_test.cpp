@@ -69,8 +69,9 @@ Outcome watch_drive(const sim::Options& o, const BodyAttitude& knock, double kno
     a.pitch -= absorbed.pitch;
     SE2 motion = tr.pose[k - 1].inverse() * tr.pose[k];
     const double scale = (o.extrinsics.z + absorbed_dz) / (o.extrinsics.z + dz);
-    motion.x *= scale;
-    motion.y *= scale;
+    // The tracker's error (0.03 mm a frame, which standing still makes a distance of its own).
+    motion.x = motion.x * scale + 3e-5 * white(rng) / (0.03 * kDeg);
+    motion.y = motion.y * scale + 3e-5 * white(rng) / (0.03 * kDeg);
     const SE2 wheels = tr.odometry[k - 1].inverse() * tr.odometry[k];
     if (std::optional<MountingChange> c =
             watch.add(t, tr.t[k] - tr.t[k - 1], motion, a, cov, std::hypot(wheels.x, wheels.y))) {
