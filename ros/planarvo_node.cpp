@@ -309,10 +309,13 @@ class Node {
       d.values.push_back(k);
     };
     kv("change_time_s", r.mounting_change_time);
+    kv("refinement", r.mounting_refinement);
     kv("roll_step_deg", r.mounting_step[0] / kDeg);
     kv("roll_step_sigma_deg", r.mounting_step_sigma[0] / kDeg);
     kv("pitch_step_deg", r.mounting_step[1] / kDeg);
     kv("pitch_step_sigma_deg", r.mounting_step_sigma[1] / kDeg);
+    kv("yaw_step_deg", r.mounting_step[2] / kDeg);
+    kv("yaw_step_sigma_deg", r.mounting_step_sigma[2] / kDeg);
     kv("x_m", m.x);
     kv("y_m", m.y);
     kv("z_m", m.z);

@@ -435,21 +435,25 @@ typedef struct planarvo_track_result {
    * extrinsics given, or the last recalibration's). mounting_changed is non-zero when this frame
    * confirmed a change of the mounting: mounting_change_time is when it began (seconds, a frame's
    * timestamp), mounting_step the step in the body's roll and pitch (radians, the attitude as roll
-   * and pitch above) and in the camera's height (metres) with their standard deviations, and
-   * changed_mounting the mounting it implies: the extrinsics with the camera turned about its centre
-   * by the step and raised by the height's (in use from the next frame with
-   * PLANARVO_MOUNTING_RECALIBRATE). The height is watched only with wheel odometry
-   * (planarvo_tracker_odometry): the images of a plane fix it only with the scale of the motion;
-   * its sigma is NaN when it was not judged. Written only when struct_size covers them. */
+   * and pitch above), the turn about the body's vertical that came with it (radians, from the
+   * direction of travel: a car's is straight ahead) and the camera's height (metres), with their
+   * standard deviations, and changed_mounting the mounting it implies: the extrinsics with the
+   * camera turned about its centre by the steps and raised by the height's (in use from the next
+   * frame with PLANARVO_MOUNTING_RECALIBRATE). The height is watched only with wheel odometry
+   * (planarvo_tracker_odometry): the images of a plane fix it only with the scale of the motion. A
+   * sigma is NaN when that part was not judged. Written only when struct_size covers them. */
   planarvo_extrinsics mounting;
   /* Non-zero when the images separated the attitude from the motion (its variance below half the
    * prior's); 0 while the car has not moved since the start (the attitude holds at the mounting)
    * and on LOST frames. */
   int32_t attitude_observed;
   int32_t mounting_changed;
+  /* Non-zero with mounting_changed when this is the refinement of the last change taken into use:
+   * what was left of it, measured over the first frames tracked with it. */
+  int32_t mounting_refinement;
   double mounting_change_time;
-  double mounting_step[3];
-  double mounting_step_sigma[3];
+  double mounting_step[4];        /* roll, pitch, yaw, z */
+  double mounting_step_sigma[4];
   planarvo_extrinsics changed_mounting;
 } planarvo_track_result;
 

@@ -119,9 +119,9 @@ class TrackResult(ctypes.Structure):
                 ("final_cost", c_double), ("inlier_fraction", c_double), ("overlap", c_double),
                 ("keyframe", c_int32), ("ms", c_double), ("roll", c_double), ("pitch", c_double),
                 ("attitude_covariance", c_double * 4), ("mounting", Extrinsics), ("attitude_observed", c_int32),
-                ("mounting_changed", c_int32),
-                ("mounting_change_time", c_double), ("mounting_step", c_double * 3),
-                ("mounting_step_sigma", c_double * 3), ("changed_mounting", Extrinsics)]
+                ("mounting_changed", c_int32), ("mounting_refinement", c_int32),
+                ("mounting_change_time", c_double), ("mounting_step", c_double * 4),
+                ("mounting_step_sigma", c_double * 4), ("changed_mounting", Extrinsics)]
 
 
 class MotionAccuracy(ctypes.Structure):

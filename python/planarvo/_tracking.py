@@ -38,18 +38,22 @@ class MountingResponse(enum.IntEnum):
 @dataclass
 class MountingChange:
     """A change of the camera's mounting confirmed by a frame: time, when it began (seconds);
-    step_roll, step_pitch, the step in the body's attitude (radians), and step_z, in the camera's
-    height (metres; watched only with odometry, Tracker.track's odometry), with their standard
-    deviations (sigma_z NaN when the height was not judged); mounting, the extrinsics it implies
+    step_roll, step_pitch, the step in the body's attitude (radians), step_yaw, the turn about the
+    body's vertical that came with it (radians, from the direction of travel), and step_z, in the
+    camera's height (metres; watched only with odometry, Tracker.track's odometry), with their
+    standard deviations (NaN for a part that was not judged); mounting, the extrinsics it implies
     (the camera turned about its centre and raised by step_z)."""
     time: float
     step_roll: float
     step_pitch: float
+    step_yaw: float
     step_z: float
     sigma_roll: float
     sigma_pitch: float
+    sigma_yaw: float
     sigma_z: float
     mounting: Extrinsics
+    refinement: bool = False  # what was left of the last change taken into use, measured with it
 
 
 @dataclass
@@ -143,9 +147,8 @@ class Residuals:
 def _mounting_change(r: N.TrackResult) -> Optional[MountingChange]:
     if not r.mounting_changed:
         return None
-    return MountingChange(r.mounting_change_time, r.mounting_step[0], r.mounting_step[1], r.mounting_step[2],
-                          r.mounting_step_sigma[0], r.mounting_step_sigma[1], r.mounting_step_sigma[2],
-                          Extrinsics._from_c(r.changed_mounting))
+    return MountingChange(r.mounting_change_time, *r.mounting_step, *r.mounting_step_sigma,
+                          Extrinsics._from_c(r.changed_mounting), bool(r.mounting_refinement))
 
 
 class Tracker(_Handle):

@@ -217,13 +217,16 @@ PLANARVO_API planarvo_status planarvo_tracker_track(planarvo_tracker* tracker, c
     out.attitude_observed = r.attitude_observed ? 1 : 0;
     out.mounting_changed = r.mounting_changed ? 1 : 0;
     if (r.mounting_changed) {
+      out.mounting_refinement = r.mounting_change.refinement ? 1 : 0;
       out.mounting_change_time = r.mounting_change.time;
       out.mounting_step[0] = r.mounting_change.step.roll;
       out.mounting_step[1] = r.mounting_change.step.pitch;
       out.mounting_step_sigma[0] = r.mounting_change.sigma(0);
       out.mounting_step_sigma[1] = r.mounting_change.sigma(1);
-      out.mounting_step[2] = r.mounting_change.dz;
-      out.mounting_step_sigma[2] = r.mounting_change.sigma_z;
+      out.mounting_step[2] = r.mounting_change.dyaw;
+      out.mounting_step_sigma[2] = r.mounting_change.sigma_yaw;
+      out.mounting_step[3] = r.mounting_change.dz;
+      out.mounting_step_sigma[3] = r.mounting_change.sigma_z;
       out.changed_mounting = planarvo::capi::to_c(r.changed_mounting);
     }
     std::memcpy(result, &out, std::min(result->struct_size, sizeof out));

@@ -2,6 +2,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -143,17 +144,23 @@ void evaluate(const Tracked& k, TrackRun* run) {
 // The warning line for a change of the mounting: when, by how much, and what was done.
 std::string mounting_warning(const planarvo_track_result& r, double origin, double t, int32_t response) {
   const planarvo_extrinsics& m = r.changed_mounting;
-  char z[96] = "";
+  char z[200] = "";
   if (std::isfinite(r.mounting_step_sigma[2]))
-    std::snprintf(z, sizeof z, ", the camera's height by %+.1f +- %.1f mm (against the wheel odometry)",
-                  r.mounting_step[2] * 1e3, r.mounting_step_sigma[2] * 1e3);
+    std::snprintf(z, sizeof z, ", yaw %+.2f +- %.2f deg (the direction of travel)", r.mounting_step[2] / kDeg,
+                  r.mounting_step_sigma[2] / kDeg);
+  if (std::isfinite(r.mounting_step_sigma[3]))
+    std::snprintf(z + std::strlen(z), sizeof z - std::strlen(z),
+                  ", the camera's height by %+.1f +- %.1f mm (against the wheel odometry)", r.mounting_step[3] * 1e3,
+                  r.mounting_step_sigma[3] * 1e3);
   const std::string height = z;
   char line[640];
   std::snprintf(line, sizeof line,
-                "planarvo track: warning: the camera's mounting changed at t = %.3f s (found at %.3f s): the body's "
+                "planarvo track: warning: the camera's mounting changed at t = %.3f s (%s at %.3f s): the body's "
                 "attitude stepped by roll %+.2f +- %.2f deg, pitch %+.2f +- %.2f deg%s and held; %s %.4f,%.4f,%.4f,"
                 "%.3f,%.3f,%.3f (x,y,z m; roll,pitch,yaw deg)",
-                origin + r.mounting_change_time, origin + t, r.mounting_step[0] / kDeg, r.mounting_step_sigma[0] / kDeg,
+                origin + r.mounting_change_time,
+                r.mounting_refinement ? "measured once more with the recalibrated mounting" : "found", origin + t,
+                r.mounting_step[0] / kDeg, r.mounting_step_sigma[0] / kDeg,
                 r.mounting_step[1] / kDeg, r.mounting_step_sigma[1] / kDeg, height.c_str(),
                 response == PLANARVO_MOUNTING_RECALIBRATE ? "tracking on with the mounting"
                                                           : "kept the mounting given (--mounting-change report); the "

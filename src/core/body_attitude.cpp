@@ -28,14 +28,16 @@ BodyAttitude attitude_of(const Eigen::Matrix3d& R) {
   return a;
 }
 
-Extrinsics turned_mounting(const Extrinsics& mounting, const BodyAttitude& step) {
+Extrinsics turned_mounting(const Extrinsics& mounting, const BodyAttitude& step, double yaw) {
   Eigen::Matrix4d T = mounting.T_vc();
-  T.topLeftCorner<3, 3>() = step.R_plane_body() * mounting.R_vc();
+  T.topLeftCorner<3, 3>() =
+      Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix() * step.R_plane_body() * mounting.R_vc();
   return Extrinsics::from_matrix(T);
 }
 
-BodyAttitude relative_to_turned(const BodyAttitude& a, const BodyAttitude& step) {
-  return attitude_of(a.R_plane_body() * step.R_plane_body().transpose());
+BodyAttitude relative_to_turned(const BodyAttitude& a, const BodyAttitude& step, double yaw) {
+  return attitude_of(a.R_plane_body() * step.R_plane_body().transpose() *
+                     Eigen::AngleAxisd(-yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix());
 }
 
 }  // namespace planarvo

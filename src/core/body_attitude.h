@@ -28,11 +28,11 @@ BodyAttitude attitude_of(const Eigen::Matrix3d& R);
 // A mounting knocked: the camera turned about its own centre by the rotation `step` expressed in
 // the body's axes, so that a body at attitude `step` with the old mounting sees the ground as a
 // body at rest does with the new one (the same orientation; the camera's centre, its height
-// included, kept). T = [R(step) R_vc | t_vc].
-Extrinsics turned_mounting(const Extrinsics& mounting, const BodyAttitude& step);
+// included, kept), and by `yaw` about the body's vertical. T = [Rz(yaw) R(step) R_vc | t_vc].
+Extrinsics turned_mounting(const Extrinsics& mounting, const BodyAttitude& step, double yaw = 0.0);
 
 // An attitude measured against a mounting, re-expressed against that mounting turned by `step`
-// (turned_mounting): R(a') = R(a) R(step)^T.
-BodyAttitude relative_to_turned(const BodyAttitude& a, const BodyAttitude& step);
+// and `yaw` (turned_mounting): R(a') = R(a) R(step)^T Rz(yaw)^T, its roll and pitch.
+BodyAttitude relative_to_turned(const BodyAttitude& a, const BodyAttitude& step, double yaw = 0.0);
 
 }  // namespace planarvo

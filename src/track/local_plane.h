@@ -41,9 +41,9 @@ class LocalPlane {
   // the prior's.
   void take_keyframe(const BodyAttitude& attitude, const Eigen::Matrix2d& covariance);
 
-  // The mounting was turned by `step` (core/body_attitude.h, turned_mounting): the keyframe's
-  // attitude re-expressed against it, its covariance kept.
-  void mounting_turned(const BodyAttitude& step) { keyframe_ = relative_to_turned(keyframe_, step); }
+  // The mounting was turned by `step` and `yaw` (core/body_attitude.h, turned_mounting): the
+  // keyframe's attitude re-expressed against it, its covariance kept.
+  void mounting_turned(const BodyAttitude& step, double yaw) { keyframe_ = relative_to_turned(keyframe_, step, yaw); }
 
   const BodyAttitude& keyframe() const { return keyframe_; }
   const Eigen::Matrix2d& keyframe_covariance() const { return keyframe_cov_; }

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <vector>
 
+#include <Eigen/Cholesky>
+
 #include "track/evaluation.h"
 
 namespace planarvo::track {
@@ -60,12 +62,24 @@ void MountingWatch::reset() {
   level_ = BodyAttitude();
   k_roll_ = 0.0;
   lean_known_ = false;
-  since_[0] = since_[1] = since_[2] = -HUGE_VAL;
+  since_[0] = since_[1] = since_[2] = since_[3] = -HUGE_VAL;
+  refining_[0] = refining_[1] = false;
   distance_ = 0.0;
   has_speed_ = false;
 }
 
 void MountingWatch::mounting_changed(const MountingChange& change) {
+  // A change the caller took into use is measured once more from frames tracked with it: the
+  // frames before it was found were tracked with the camera turned and the body's model not (the
+  // local plane turns the body about the ground), which biases their attitude a little.
+  if (!change.refinement && (change.step.roll != 0.0 || change.step.pitch != 0.0)) {
+    refining_[0] = change.step.roll != 0.0;
+    refining_[1] = change.step.pitch != 0.0;
+    refine_base_[0] = last_bases_[0];
+    refine_base_[1] = last_bases_[1];
+    refine_after_ = change.detected_time;
+    refine_time_ = change.time;
+  }
   level_.roll -= change.step.roll;
   level_.pitch -= change.step.pitch;
   const double scale = opt_.height > 0.0 ? (opt_.height + change.dz) / opt_.height : 1.0;
@@ -73,6 +87,7 @@ void MountingWatch::mounting_changed(const MountingChange& change) {
     if (s.t >= since_[0]) s.roll -= change.step.roll;  // measured with the mounting as it now is
     if (s.t >= since_[1]) s.pitch -= change.step.pitch;
     if (s.t >= since_[2]) s.vis *= scale;
+    if (s.t >= since_[3]) s.heading += change.dyaw;
   }
   opt_.height += change.dz;
 }
@@ -97,6 +112,13 @@ std::optional<MountingChange> MountingWatch::add(double t, double dt, const SE2&
   s.var_roll = std::isfinite(covariance(0, 0)) ? covariance(0, 0) : 0.0;
   s.var_pitch = std::isfinite(covariance(1, 1)) ? covariance(1, 1) : 0.0;
   s.vis = std::hypot(motion.x, motion.y);
+  // The direction of travel in the robot frame (backwards turned round), less the half of the
+  // frame's turn that an arc's chord has: zero for a car (its origin on the rear axle) whatever it
+  // turns; NaN when it hardly moves.
+  s.heading = std::abs(motion.x) >= opt_.min_heading_speed * dt
+                  ? std::atan2(motion.x > 0 ? motion.y : -motion.y, std::abs(motion.x)) - 0.5 * motion.theta *
+                                                                                         (motion.x > 0 ? 1.0 : -1.0)
+                  : NAN;
   s.odo = std::isfinite(odometry_distance) && odometry_distance >= 0.0 ? odometry_distance : NAN;
   samples_.push_back(s);
   return test();
@@ -126,7 +148,7 @@ std::optional<MountingChange> MountingWatch::test() {
   }
   // The history before it: at most history_seconds, and per angle since its last change.
   while (samples_.front().t <
-         std::max(std::min({since_[0], since_[1], since_[2]}), samples_[begin].t - opt_.history_seconds)) {
+         std::max(std::min({since_[0], since_[1], since_[2], since_[3]}), samples_[begin].t - opt_.history_seconds)) {
     samples_.pop_front();
     --begin;
   }
@@ -178,6 +200,7 @@ std::optional<MountingChange> MountingWatch::test() {
     judged[angle] = worst <= opt_.steady_tolerance && comparable;
     stepped[angle] = judged[angle] && std::abs(steps[angle]) >= opt_.min_step;
   }
+  if (std::optional<MountingChange> r = refine(begin, judged, medians, change.sigma)) return r;
   if (!stepped[0] && !stepped[1]) return test_height(bases);
 
   // When the new level began: after the last frame before the window that was still at the old one
@@ -196,17 +219,108 @@ std::optional<MountingChange> MountingWatch::test() {
   }
   change.time = samples_[first].t;
   change.detected_time = last.t;
+  last_bases_[0] = bases[0];
+  last_bases_[1] = bases[1];
+
+  // The roll's step and the lean's slope together (roll = c + k omega + step after the change, by
+  // least squares over the frames since the roll's last change): a window in a turn the history
+  // did not drive would otherwise carry the slope's error times the yaw rate.
+  if (judged[0]) joint_roll_step(first, &steps[0], &change.sigma(0));
   // An angle that the window could not judge keeps its level and its history: unchanged.
   change.step.roll = judged[0] ? steps[0] : 0.0;
   change.step.pitch = judged[1] ? steps[1] : 0.0;
+  measure_yaw(begin, first, &change);
   for (int angle = 0; angle < 2; ++angle) {
     if (!judged[angle]) continue;
     (angle == 0 ? level_.roll : level_.pitch) = medians[angle];
     since_[angle] = change.time;
   }
-  // The distances tracked before it was found were scaled by the turned camera's height error.
+  // The distances tracked before it was found were scaled by the turned camera's height error, and
+  // the directions turned by its yaw.
   since_[2] = change.detected_time;
+  if (std::isfinite(change.sigma_yaw)) since_[3] = change.detected_time;
   return change;
+}
+
+void MountingWatch::joint_roll_step(size_t first, double* step, double* sigma) {
+  // Least squares, then once more without the frames beyond 3 robust sigma of the first fit (the
+  // frames where a turn begins or ends, whose roll lags the yaw rate of their interval).
+  std::vector<size_t> used;
+  for (size_t i = 0; i < samples_.size(); ++i)
+    if (samples_[i].t >= since_[0]) used.push_back(i);
+  Eigen::Vector3d p = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d cov = Eigen::Matrix3d::Constant(NAN);
+  auto x_of = [&](size_t i) { return Eigen::Vector3d(1.0, samples_[i].w, i >= first ? 1.0 : 0.0); };
+  for (int pass = 0; pass < 2; ++pass) {
+    if (used.size() < 20) return;
+    Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
+    Eigen::Vector3d b = Eigen::Vector3d::Zero();
+    for (size_t i : used) {
+      A += x_of(i) * x_of(i).transpose();
+      b += x_of(i) * samples_[i].roll;
+    }
+    const Eigen::LDLT<Eigen::Matrix3d> ldlt(A);
+    if (ldlt.info() != Eigen::Success || !(ldlt.rcond() > 1e-9)) return;
+    p = ldlt.solve(b);
+    std::vector<double> r;
+    for (size_t i : used) r.push_back(samples_[i].roll - x_of(i).dot(p));
+    const double scale = std::max(robust_scale(r, 0.0), 0.02 * M_PI / 180.0);
+    double ss = 0.0;
+    for (double v : r) ss += v * v;
+    cov = ss / static_cast<double>(used.size() - 3) * ldlt.solve(Eigen::Matrix3d::Identity());
+    std::vector<size_t> kept;
+    for (size_t j = 0; j < used.size(); ++j)
+      if (std::abs(r[j]) <= 3.0 * scale) kept.push_back(used[j]);
+    used = kept;
+  }
+  if (!p.allFinite() || !(cov(2, 2) >= 0.0)) return;
+  *step = p(2);
+  *sigma = std::sqrt(cov(2, 2));
+  if (std::sqrt(cov(1, 1)) < 0.01) {  // the slope known to 0.01 (deg per deg/s): the fit's from now on
+    k_roll_ = p(1);
+    lean_known_ = true;
+  }
+}
+
+void MountingWatch::measure_yaw(size_t begin, size_t first, MountingChange* change) const {
+  // The turn about the vertical that came with the tilt (a camera tilted forward and knocked about
+  // its own axis turns about the body's vertical too): the direction of travel tracked in the
+  // window against its history before the change. The mounting's yaw changed by d turns the
+  // tracked direction by -d.
+  std::vector<double> win, hist;
+  for (size_t i = begin; i < samples_.size(); ++i)
+    if (std::isfinite(samples_[i].heading)) win.push_back(samples_[i].heading);
+  for (size_t i = 0; i < first; ++i)
+    if (std::isfinite(samples_[i].heading) && samples_[i].t >= since_[3]) hist.push_back(samples_[i].heading);
+  if (win.size() < 5 || hist.size() < 10) return;
+  const double mw = median(win), mh = median(hist);
+  const double sw = robust_scale(win, mw), sh = robust_scale(hist, mh);
+  change->dyaw = -(mw - mh);
+  change->sigma_yaw = std::sqrt(sw * sw / static_cast<double>(win.size()) + sh * sh / static_cast<double>(hist.size()));
+}
+
+std::optional<MountingChange> MountingWatch::refine(size_t begin, const bool judged[2], const double medians[2],
+                                                    const Eigen::Vector2d& sigma) {
+  if (!(refining_[0] || refining_[1]) || samples_[begin].t < refine_after_) return std::nullopt;
+  MountingChange r;
+  bool any = false;
+  for (int angle = 0; angle < 2; ++angle) {
+    if (!refining_[angle] || !judged[angle]) continue;
+    refining_[angle] = false;
+    const double step = medians[angle] - refine_base_[angle];
+    if (!(std::abs(step) >= opt_.min_refinement && std::abs(step) >= 3.0 * sigma(angle))) continue;
+    (angle == 0 ? r.step.roll : r.step.pitch) = step;
+    r.sigma(angle) = sigma(angle);
+    (angle == 0 ? level_.roll : level_.pitch) = medians[angle];
+    since_[angle] = refine_after_;
+    any = true;
+  }
+  if (!any) return std::nullopt;
+  r.refinement = true;
+  r.time = refine_time_;
+  r.detected_time = samples_.back().t;
+  since_[2] = r.detected_time;
+  return r;
 }
 
 double MountingWatch::residual(const Sample& s, int angle) const {

@@ -62,6 +62,11 @@ struct MountingWatchOptions {
   double height_history_metres = 2.0;
   double height_sigmas = 5.0;
   double height_min_travel = 0.005;  // metres of wheel travel in a frame for it to count
+  // The direction of travel (an attitude change's yaw) from frames at this speed at least, m/s.
+  double min_heading_speed = 0.3;
+  // A change taken into use is measured once more over the first window tracked with it; what is
+  // left of it, when at least this (radians) and 3 sigma, is reported as its refinement.
+  double min_refinement = 0.05 * M_PI / 180.0;
 };
 
 // A change of the mounting, in the body's attitude: the attitude measured against the mounting
@@ -74,6 +79,14 @@ struct MountingChange {
   // The height's change (metres) and its standard deviation; NaN sigma when not judged (no
   // odometry, or this change is the attitude's).
   double dz = 0.0, sigma_z = NAN;
+  // With an attitude change: the turn about the body's vertical that came with it (radians; a
+  // camera tilted forward and knocked about its own axis turns about the vertical too), from the
+  // direction of travel tracked (a car's is straight ahead: its origin on the rear axle) before and
+  // after; NaN sigma (and 0) when there were too few frames moving to tell.
+  double dyaw = 0.0, sigma_yaw = NAN;
+  // A refinement of the last change taken into use (MountingWatch::mounting_changed): the step
+  // left after it, measured from the first window tracked with it (time: the change's).
+  bool refinement = false;
 };
 
 class MountingWatch {
@@ -89,7 +102,7 @@ class MountingWatch {
                                     const Eigen::Matrix2d& covariance, double odometry_distance = NAN);
 
   // The caller changed the mounting as `change` says (the change just reported): attitudes measured
-  // from now on are its step lower, distances tracked (z + dz) / z longer.
+  // from now on are its step lower, distances tracked (z + dz) / z longer, directions dyaw turned.
   void mounting_changed(const MountingChange& change);
 
   // The lean's slope in use: roll per yaw rate (s).
@@ -104,17 +117,31 @@ class MountingWatch {
     double roll, pitch;
     double var_roll, var_pitch;  // the attitude's own variances
     double vis, odo;             // distance tracked and the wheels' (NaN: no odometry)
+    double heading;              // the direction of travel, robot frame (NaN: hardly moving)
   };
   void fit_lean(size_t end);
   std::optional<MountingChange> test();
   std::optional<MountingChange> test_height(const double levels[2]);
+  // An attitude change's yaw: the window [begin, end) against the history before `first`.
+  void measure_yaw(size_t begin, size_t first, MountingChange* change) const;
+  // The roll's step at sample `first` fitted with the lean's slope (and its sigma).
+  void joint_roll_step(size_t first, double* step, double* sigma);
+  // After a change taken into use: the first judged window after it against the level before it.
+  std::optional<MountingChange> refine(size_t begin, const bool judged[2], const double medians[2],
+                                       const Eigen::Vector2d& sigma);
   // The roll less the lean its yaw rate explains (angle 0), the pitch (1).
   double residual(const Sample& s, int angle) const;
 
   MountingWatchOptions opt_;
   std::deque<Sample> samples_;  // the window and at most history_seconds before it
-  double since_[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};  // roll, pitch, height: the last change (the history's start)
+  // Roll, pitch, height, the direction of travel: the last change (the history's start).
+  double since_[4] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
   BodyAttitude level_;          // the expected attitude before any history (the mounting's)
+  // The refinement of the last change taken into use (mounting_changed): per angle, whether it is
+  // due and the level before the change; after when (its detection) and the change's time.
+  bool refining_[2] = {false, false};
+  double refine_base_[2] = {0.0, 0.0}, last_bases_[2] = {0.0, 0.0};
+  double refine_after_ = 0.0, refine_time_ = 0.0;
   double k_roll_ = 0.0;       // roll per yaw rate, fitted robustly over the history
   bool lean_known_ = false;   // k_roll_ fitted (else zero)
   double distance_ = 0.0;

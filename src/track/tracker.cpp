@@ -678,20 +678,21 @@ struct Tracker::Impl {
   // recalibrating the mounting is turned by it and the attitudes carried on are re-expressed.
   void watch_mounting(double t, double dt, FrameResult* res, Estimate* est) {
     using Response = TrackerOptions::MountingResponse;
-    if (!opt.local_plane || opt.on_mounting_change == Response::Ignore) return;
+    // A frame whose attitude the images did not observe says nothing about the mounting.
+    if (!opt.local_plane || opt.on_mounting_change == Response::Ignore || !res->attitude_observed) return;
     const std::optional<MountingChange> change =
         watch.add(t, dt, res->motion.value, res->attitude, res->attitude_covariance, odometry_distance);
     if (!change) return;
     res->mounting_changed = true;
     res->mounting_change = *change;
-    res->changed_mounting = turned_mounting(ext, change->step);
+    res->changed_mounting = turned_mounting(ext, change->step, change->dyaw);
     res->changed_mounting.z += change->dz;
     if (opt.on_mounting_change != Response::Recalibrate) return;
     ext = res->changed_mounting;
-    est->att_ref = relative_to_turned(est->att_ref, change->step);
-    est->att_live = relative_to_turned(est->att_live, change->step);
+    est->att_ref = relative_to_turned(est->att_ref, change->step, change->dyaw);
+    est->att_live = relative_to_turned(est->att_live, change->step, change->dyaw);
     res->attitude = est->att_live;
-    plane.mounting_turned(change->step);
+    plane.mounting_turned(change->step, change->dyaw);
     watch.mounting_changed(*change);
   }
 
