@@ -118,9 +118,14 @@ def test_stats_writer(tmp_path):
         w.add(0.0, 0.0, 0.0, 0.0, 0, 0.0, 1.0, 3.5, "first")
         w.add(0.1, 0.5, -0.01, 0.2, 7, 0.25, 0.9, 4.25, "ok")
         assert not path.exists()  # written as stats.csv.partial until closed
+        w.add(0.2, 0.5, -0.01, 0.2, 7, 0.25, 0.9, 4.25, "ok", attitude=(0.015625, -0.25, 0.001, 0.002),
+              mounting_changed=True)
     lines = path.read_text().splitlines()
-    assert lines[0].startswith("timestamp") and len(lines) == 3
-    assert lines[2].split(",")[-1] == "ok" and float(lines[2].split(",")[1]) == 0.5
+    assert lines[0].startswith("timestamp") and len(lines) == 4
+    assert lines[0].split(",")[9:] == ["roll", "pitch", "sigma_roll", "sigma_pitch", "mounting_changed"]
+    assert lines[2].split(",")[8] == "ok" and float(lines[2].split(",")[1]) == 0.5
+    assert lines[2].split(",")[9:] == [""] * 5  # no attitude: empty
+    assert [float(v) for v in lines[3].split(",")[9:]] == [0.015625, -0.25, 0.001, 0.002, 1.0]
     # An exception inside the block discards: the complete file stays as it was.
     with pytest.raises(RuntimeError):
         with planarvo.StatsWriter(path) as w:

@@ -117,6 +117,38 @@ def test_track_figures_are_written(drive, tmp_path):
         assert os.path.getsize(tmp_path / "out" / (name + ".svg")) > 1000
 
 
+def test_local_plane_figures_from_the_attitude_columns(drive, tmp_path):
+    """Statistics with the attitude columns (track --local-plane) are read as written, and the
+    figures of the paper's Figures 18-19 are drawn from them; without the columns (the test
+    above), or with them empty, has_attitude is false."""
+    t, gt = groundtruth(drive)
+    write_tum(tmp_path / "traj.txt", t, gt)
+    omega = 0.3 * np.sin(t)
+    roll = -0.07 * omega + 0.001 * np.cos(7 * t)
+    with open(tmp_path / "stats.csv", "w") as f:
+        f.write("timestamp,vx,vy,omega,iterations,final_cost,inlier_fraction,ms,status,roll,pitch,sigma_roll,"
+                "sigma_pitch,mounting_changed\n")
+        for k, ti in enumerate(t):
+            f.write("%.9f,0,0,%.9f,3,0.5,0.9,7.5,ok,%.9f,%.9f,0.001,0.001,%d\n" % (ti, omega[k], roll[k], 0.01 * k,
+                                                                                   int(k == 4)))
+    st = _io.read_stats(str(tmp_path / "stats.csv"))
+    np.testing.assert_allclose(st["roll"], roll, atol=1e-9)
+    assert st["mounting_changed"].sum() == 1
+    from planarvo.plot import _plane
+    assert _plane.has_attitude(st)
+    empty = tmp_path / "empty.csv"
+    with open(empty, "w") as f:
+        f.write("timestamp,vx,vy,omega,iterations,final_cost,inlier_fraction,ms,status,roll,pitch,sigma_roll,"
+                "sigma_pitch,mounting_changed\n0.0,0,0,0,0,0,0,7.5,first,,,,,\n")
+    assert not _plane.has_attitude(_io.read_stats(str(empty)))
+    r = run_plot("track", drive, "--trajectory", tmp_path / "traj.txt", "--stats", tmp_path / "stats.csv",
+                 "--out-dir", tmp_path / "out")
+    assert r.returncode == 0, r.stderr
+    from planarvo.plot import _style
+    png_ok(tmp_path / "out" / "body_roll.png", round(_style.WIDTH_IN * _style.DPI), round(4.2 * _style.DPI))
+    png_ok(tmp_path / "out" / "body_pitch.png", round(_style.WIDTH_IN * _style.DPI), round(3.6 * _style.DPI))
+
+
 def test_without_ground_truth_the_histogram_is_left_out(drive, tmp_path):
     d = tmp_path / "nogt"
     shutil.copytree(drive, d)

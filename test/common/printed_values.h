@@ -72,10 +72,11 @@ inline std::vector<std::vector<std::string>> read_csv(const std::string& path, b
   if (header) std::getline(in, line);
   while (std::getline(in, line)) {
     if (line.empty() || line[0] == '#') continue;
-    std::vector<std::string> fields;
-    std::istringstream s(line);
-    std::string f;
-    while (std::getline(s, f, ',')) fields.push_back(f);
+    std::vector<std::string> fields;  // every field, a trailing empty one too
+    size_t start = 0;
+    for (size_t comma; (comma = line.find(',', start)) != std::string::npos; start = comma + 1)
+      fields.push_back(line.substr(start, comma - start));
+    fields.push_back(line.substr(start));
     rows.push_back(fields);
   }
   return rows;

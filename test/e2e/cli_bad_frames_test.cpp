@@ -29,13 +29,9 @@ std::string quoted(const fs::path& p) { return "\"" + p.string() + "\""; }
 
 // The timestamps of the statistics rows whose status (the last column) is `status`.
 std::vector<double> stats_times(const fs::path& csv, const std::string& status) {
-  std::ifstream in(csv);
-  std::string line;
   std::vector<double> times;
-  std::getline(in, line);  // header
-  while (std::getline(in, line))
-    if (line.size() > status.size() && line.compare(line.size() - status.size(), status.size(), status) == 0)
-      times.push_back(std::stod(line.substr(0, line.find(','))));
+  for (const std::vector<std::string>& row : test::read_csv(csv.string()))
+    if (row.size() > 8 && row[8] == status) times.push_back(std::stod(row[0]));
   return times;
 }
 

@@ -720,7 +720,7 @@ TEST(IoWriters, TwoWritersOfOneFileLeaveOneWholeFile) {
   b.add(r);
   b.close();
   const std::string header = std::string(io::StatsWriter::kHeader) + "\n";
-  const std::string row_b = "0.000000000,0,0,0,0,0,0,0,b\n";
+  const std::string row_b = "0.000000000,0,0,0,0,0,0,0,b,,,,,\n";
   EXPECT_EQ(test::read_text(path), header + row_b + row_b);
   EXPECT_EQ(std::distance(std::filesystem::directory_iterator(dir.path()), std::filesystem::directory_iterator()), 1);
 }
