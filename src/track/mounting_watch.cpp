@@ -339,13 +339,13 @@ std::optional<MountingChange> MountingWatch::test_height(const double levels[2])
     odo += s.odo;
   }
   if (odo < opt_.height_window_metres) return std::nullopt;
-  // Only while the attitude holds its level over the window (its median: a bump passes through
-  // it): a turned camera not yet found shows as a height.
-  for (int angle = 0; angle < 2; ++angle) {
-    std::vector<double> r;
-    for (size_t i = begin; i < n; ++i) r.push_back(residual(samples_[i], angle));
-    if (!(std::abs(median(r) - levels[angle]) < 0.5 * opt_.min_step)) return std::nullopt;
-  }
+  // Only while the attitude holds its level at every frame of the window: a turned camera not yet
+  // found shows as a height (the local plane turns the body about the ground, which moves the
+  // camera). A bump in the window waits for the next stretch without one. The roll only once the
+  // lean's slope is known (before, a turn's lean would hold the test off).
+  for (size_t i = begin; i < n; ++i)
+    for (int angle = lean_known_ ? 0 : 1; angle < 2; ++angle)
+      if (!(std::abs(residual(samples_[i], angle) - levels[angle]) < 0.5 * opt_.min_step)) return std::nullopt;
   // The ratio of distances over [a, b) and its variance (the frames' scatter about it), over the
   // frames that moved (a frame standing still adds the tracker's noise to the distance tracked and
   // nothing to the wheels').

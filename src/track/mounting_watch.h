@@ -28,9 +28,10 @@
 // recent height_window_metres of wheel travel against the history since the last change (at least
 // height_history_metres): a change when the window's ratio differs by at least min_height_step (as
 // a height) and height_sigmas of its standard deviation (from the frames' scatter about it), both
-// halves of the window on the same side by at least half of it, and the attitude's median over the
-// window at its level (a turned camera not yet found shows as a height: the local plane turns the
-// body about the ground, which moves the camera). The change is then measured across the split of
+// halves of the window on the same side by at least half of it, and the attitude within half of
+// min_step of its level at every frame of the window (a turned camera not yet found shows as a
+// height: the local plane turns the body about the ground, which moves the camera; a bump makes the
+// test wait for a stretch without one). The change is then measured across the split of
 // the frames since the last change that best tells two ratios apart (its time).
 #pragma once
 #include <cmath>

@@ -193,8 +193,10 @@ TEST(LocalPlane, AKnockedMountingIsFoundAndRecalibrated) {
   for (int which = 0; which < 2; ++which) {
     sim::Options so = car(true);
     so.bump_spacing = 10.0;
-    // The height is judged over 3 m of wheel travel against at least 2 m before.
+    // The height is judged over 3 m of wheel travel without a bump, against at least 2 m before: its
+    // drive has no bumps (the unit tests and the bench have them).
     so.seconds = which == 0 ? 5.0 : 7.0;
+    if (which == 1) so.bumps = 0.0;
     const Knocked ref = track_knocked(rt, render(rt, so));
     EXPECT_TRUE(ref.changes.empty()) << which;
     so.knock_time = which == 0 ? 2.0 : 3.5;
