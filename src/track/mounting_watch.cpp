@@ -101,7 +101,8 @@ std::optional<MountingChange> MountingWatch::add(double t, double dt, const SE2&
   const double v = motion.x / dt;
   Sample s;
   s.t = t;
-  distance_ += std::hypot(motion.x, motion.y);
+  s.vis = std::hypot(motion.x, motion.y);
+  distance_ += s.vis;
   s.s = distance_;
   s.w = motion.theta / dt;
   s.a = has_speed_ ? (v - last_speed_) / dt : 0.0;
@@ -111,7 +112,6 @@ std::optional<MountingChange> MountingWatch::add(double t, double dt, const SE2&
   s.pitch = attitude.pitch;
   s.var_roll = std::isfinite(covariance(0, 0)) ? covariance(0, 0) : 0.0;
   s.var_pitch = std::isfinite(covariance(1, 1)) ? covariance(1, 1) : 0.0;
-  s.vis = std::hypot(motion.x, motion.y);
   // The direction of travel in the robot frame (backwards turned round), less the half of the
   // frame's turn that an arc's chord has: zero for a car (its origin on the rear axle) whatever it
   // turns; NaN when it hardly moves.

@@ -106,9 +106,6 @@ class MountingWatch {
   // from now on are its step lower, distances tracked (z + dz) / z longer, directions dyaw turned.
   void mounting_changed(const MountingChange& change);
 
-  // The lean's slope in use: roll per yaw rate (s).
-  double roll_per_yaw_rate() const { return k_roll_; }
-
   void reset();
 
  private:
