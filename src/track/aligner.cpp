@@ -203,7 +203,10 @@ Aligner::Aligner(ocl::Runtime& runtime, const Eigen::Matrix3d& K, const AlignerO
   }
   for (int b : options.select_blocks)
     if (b >= 2) select_passes(b, nparam_);
-  if (options.finest_level < 0 && options.auto_finer_block >= 2) select_passes(options.auto_finer_block, nparam_);
+  if (options.finest_level < 0 && options.auto_finer_block >= 2) {
+    select_passes(options.auto_finer_block, nparam_);
+    if (options.auto_coarse_block >= 2) select_passes(options.auto_coarse_block, nparam_);
+  }
 }
 
 std::array<std::unique_ptr<WarpReduce>, 2>& Aligner::select_passes(int block, int nparam) {
@@ -232,6 +235,9 @@ AlignmentLevels Aligner::levels(const Pyramid& reference, const Pyramid& live) c
            live.levels[static_cast<size_t>(finest + 1)].width >= options_.min_finest_width)
       ++finest;
     if (finest > 0 && options_.auto_finer_block >= 1) {
+      // A itself subsampled (auto_coarse_block) when the level below it is.
+      int& a = r.select_block[static_cast<size_t>(finest)];
+      if (a < 2 && options_.auto_finer_block >= 2 && options_.auto_coarse_block >= 2) a = options_.auto_coarse_block;
       --finest;
       int& b = r.select_block[static_cast<size_t>(finest)];
       if (b < 2) b = options_.auto_finer_block >= 2 ? options_.auto_finer_block : 0;

@@ -47,10 +47,14 @@ struct AlignerOptions {
   // (select_blocks, subsample_prior): at 640x480 level 1 and then level 0 at 1/9, 1.4 times the
   // time of stopping at level 1 for 0.6-0.9 of its RMS error and 0.3-1.0 of its worst frame
   // (src/track/README.md, "The default"); at 320x240 level 0 on every pixel. auto_finer_block 1:
-  // the level below A on every pixel; 0: stop at A.
+  // the level below A on every pixel; 0: stop at A. When the level below A is subsampled, A is
+  // too, on one pixel per auto_coarse_block x auto_coarse_block block (2: at 640x480 level 1 at
+  // 1/4 with level 2 as its prior, 0.6 of the time for the same RMS error, src/track/README.md
+  // "Speed"); 0 or 1: A on every pixel.
   int finest_level = -1;
   int min_finest_width = 320;
   int auto_finer_block = 3;
+  int auto_coarse_block = 2;
   // Gauss-Newton steps per level, index = level (each step costs one fused pass per pair at that
   // level except the last, which is applied without checking when it is below convergence_px).
   std::array<int, kMaxLevels> max_iterations = {2, 6, 10, 12, 12, 12, 12, 12};

@@ -44,6 +44,8 @@ CameraModel validated_tracker_camera(const CameraModel& c, const Extrinsics& e, 
     if (b < 0 || b > 16) throw_invalid_argument("TrackerOptions::select_blocks must be 0..16");
   if (o.auto_finer_block < 0 || o.auto_finer_block > 16)
     throw_invalid_argument("TrackerOptions::auto_finer_block must be 0..16");
+  if (o.auto_coarse_block < 0 || o.auto_coarse_block > 16)
+    throw_invalid_argument("TrackerOptions::auto_coarse_block must be 0..16");
   if (!(o.rolling_shutter_tolerance_px > 0.0))
     throw_invalid_argument("TrackerOptions::rolling_shutter_tolerance_px must be positive");
   if (!(o.keyframe_scale_change > 0.0))

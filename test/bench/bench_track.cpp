@@ -2,7 +2,7 @@
 //   bench_track kernel   [width height]   the fused pass per work-group shape / pixels per
 //                                          work-item / lanes / fast math, median ms per pass
 //   bench_track kernel w h wx wy pix hist fast lanes [rounds]   one configuration
-//   bench_track speed [w h] [seconds] [rounds]   ms per frame through the camera-frame API
+//   bench_track speed [w h] [seconds] [rounds] [configs]   ms per frame through the camera-frame API
 //                                          (median, mean, and the p99 and maximum over the median)
 //   bench_track accuracy [key=value...]     simulated sequences tracked against ground truth
 //       (seconds, w, h, seed, motion=mixed|straight|circle|spin, levels, finest, refine_kf, conv,
@@ -51,6 +51,7 @@
 #include "track/warp_model.h"
 #include "track/warp_reduce.h"
 #include "../unit/track_test_pyramid.h"
+#include "bench_ecc.h"
 #include "bench_scene.h"
 
 using namespace planarvo;
@@ -640,92 +641,209 @@ int bench_nees(const std::vector<std::string>& textures, const std::vector<int>&
   return 0;
 }
 
-// Speed: frames rendered once into memory, then tracked repeatedly with each configuration,
-// the configurations interleaved so that load from other processes spreads over all of them.
-int bench_speed(int width, int height, double seconds, int rounds) {
-  ocl::Runtime rt;
-  std::printf("device: %s\n", rt.device_info().device_name.c_str());
-  const sim::Options so = Scene().options("asphalt_01.png", seconds, width, height, 1);
-  const sim::Trajectory traj = sim::generate_trajectory(so);
-  const std::vector<cv::Mat> global_frames = bench::render_sequence(rt, so, traj);
-  // The same drive through a rolling shutter read out over 25 ms.
-  sim::Options rolling = so;
-  rolling.readout_time = rolling.camera.rolling_shutter_readout = 0.025;
-  const std::vector<cv::Mat> rolling_frames = bench::render_sequence(rt, rolling, traj);
-  struct Config {
-    const char* name;
-    track::TrackerOptions opt;
-    int shutter = 0;  // 0: the global shutter's frames; 1: the rolling shutter's, told; 2: not told
-  };
-  std::vector<Config> configs;
-  {
-    track::TrackerOptions o;
-    configs.push_back({"default (level 1, level 0 at 1/9)", o});
-    configs.push_back({"rolling shutter 25 ms", o, 1});
-    configs.push_back({"rolling 25 ms, not told", o, 2});
-    o.photometric.enabled = false;
-    configs.push_back({"default without the photometric model", o});
-    o.photometric.enabled = true;
-    o.prefilter = false;
-    configs.push_back({"default without the prefilter", o});
-    o.prefilter = true;
-    o.kernel.lanes = 1;  // the fused pass one pixel at a time, as before float8
-    configs.push_back({"default, per-pixel pass", o});
-    track::TrackerOptions h;
-    h.finest_level = 1;
-    configs.push_back({"half resolution (finest 1)", h});
-    h.refine_keyframes = true;
-    configs.push_back({"finest 1 + refine keyframes", h});
-    track::TrackerOptions f;
-    f.finest_level = 0;
-    configs.push_back({"full resolution (finest 0)", f});
-    f.kernel.lanes = 1;
-    configs.push_back({"finest 0, per-pixel pass", f});
-    f.kernel.lanes = 8;
-    f.select_blocks[0] = 4;
-    configs.push_back({"level 0 at 1/16 + prior", f});
-    f.select_blocks[0] = 2;
-    configs.push_back({"level 0 at 1/4 + prior", f});
-    track::TrackerOptions l3;
-    l3.levels = 3;
-    configs.push_back({"3 levels", l3});
-  }
-  struct Stats {
-    std::vector<double> frame, pipe, track;
-    double cpu = 0, passes = 0;
-    int n = 0;
-  };
-  std::vector<Stats> stats(configs.size());
+// Speed: each scene's frames rendered once into memory, then tracked repeatedly with each
+// configuration, the configurations interleaved so that load from other processes spreads over
+// all of them; then OpenCV's ECC on pairs of the same frames. Scenes: "mixed" (asphalt_01, the
+// mixed drive, every configuration), "fast" (the same texture at 1.5 m/s and 2.5 rad/s) and "car"
+// (a rear camera 0.9 m up, 45 degrees down, a car at 3 m/s), the last two with the default and
+// the code before issue 28 only.
+struct SpeedConfig {
+  const char* name;
+  track::TrackerOptions opt;
+  int shutter = 0;  // 0: the global shutter's frames; 1: the rolling shutter's, told; 2: not told
+};
+
+std::vector<SpeedConfig> speed_configs() {
+  std::vector<SpeedConfig> configs;
+  track::TrackerOptions o;
+  configs.push_back({"default", o});
+  track::TrackerOptions before = o;  // level 1 on every pixel
+  before.auto_coarse_block = 0;
+  configs.push_back({"before issue 28", before});
+  configs.push_back({"rolling shutter 25 ms", o, 1});
+  configs.push_back({"rolling 25 ms, not told", o, 2});
+  o.photometric.enabled = false;
+  configs.push_back({"no photometric model", o});
+  o.photometric.enabled = true;
+  o.prefilter = false;
+  configs.push_back({"no prefilter", o});
+  o.prefilter = true;
+  o.kernel.lanes = 1;  // the fused pass one pixel at a time, as before float8
+  configs.push_back({"per-pixel pass", o});
+  track::TrackerOptions h;
+  h.finest_level = 1;
+  configs.push_back({"half resolution (finest 1)", h});
+  h.refine_keyframes = true;
+  configs.push_back({"finest 1 + refine keyframes", h});
+  track::TrackerOptions f;
+  f.finest_level = 0;
+  configs.push_back({"full resolution (finest 0)", f});
+  f.select_blocks[0] = 4;
+  configs.push_back({"level 0 at 1/16 + prior", f});
+  f.select_blocks[0] = 2;
+  configs.push_back({"level 0 at 1/4 + prior", f});
+  track::TrackerOptions l3;
+  l3.levels = 3;
+  configs.push_back({"3 levels", l3});
+  return configs;
+}
+
+struct SpeedStats {
+  std::vector<double> frame, pipe, track, rest, err_mm;
+  std::array<std::vector<double>, track::kMaxLevels> level;
+  std::array<double, track::kMaxLevels> level_passes{};
+  double cpu = 0, passes = 0;
+  int n = 0, lost = 0;
+};
+
+// Tracks `frames` with the configurations (all rounds, interleaved) and prints their table.
+void speed_table(ocl::Runtime& rt, const std::string& scene, const sim::Options& so, const sim::Trajectory& traj,
+                 const std::vector<cv::Mat>& global_frames, const sim::Options* rolling,
+                 const std::vector<cv::Mat>* rolling_frames, const std::vector<SpeedConfig>& configs, int rounds,
+                 std::vector<SpeedStats>* out) {
+  std::vector<SpeedStats>& stats = *out;
+  stats.assign(configs.size(), SpeedStats());
   for (int round = 0; round < rounds; ++round)
     for (size_t c = 0; c < configs.size(); ++c) {
-      const std::vector<cv::Mat>& frames = configs[c].shutter ? rolling_frames : global_frames;
-      track::Tracker tracker(rt, configs[c].shutter == 1 ? rolling.camera : so.camera, so.extrinsics, configs[c].opt);
+      if (configs[c].shutter && !rolling_frames) continue;
+      const std::vector<cv::Mat>& frames = configs[c].shutter ? *rolling_frames : global_frames;
+      track::Tracker tracker(rt, configs[c].shutter == 1 ? rolling->camera : so.camera, so.extrinsics, configs[c].opt);
       for (size_t k = 0; k < frames.size(); ++k) {
         const double c0 = cpu_ms();
         const track::FrameResult r = tracker.track(frames[k].data, frames[k].cols, frames[k].rows, frames[k].step, traj.t[k]);
         if (k == 0) continue;  // the first frame builds the pipeline
-        stats[c].cpu += cpu_ms() - c0;
-        stats[c].frame.push_back(r.ms);
-        stats[c].pipe.push_back(r.pipeline_ms);
-        stats[c].track.push_back(r.ms - r.pipeline_ms);
-        for (int p : r.iterations) stats[c].passes += p;
-        ++stats[c].n;
+        SpeedStats& st = stats[c];
+        st.cpu += cpu_ms() - c0;
+        st.frame.push_back(r.ms);
+        st.pipe.push_back(r.pipeline_ms);
+        st.track.push_back(r.ms - r.pipeline_ms);
+        for (int p : r.iterations) st.passes += p;
+        double in_levels = 0;
+        for (size_t l = 0; l < track::kMaxLevels; ++l) {
+          st.level[l].push_back(r.level_ms[l]);
+          st.level_passes[l] += r.iterations[l];
+          in_levels += r.level_ms[l];
+        }
+        st.rest.push_back(r.ms - r.pipeline_ms - in_levels);
+        if (r.status == track::FrameResult::Status::Lost) {
+          ++st.lost;
+        } else if (round == 0) {
+          const SE2 truth = traj.pose[k - 1].inverse() * traj.pose[k];
+          st.err_mm.push_back(1000.0 * std::hypot(r.motion.value.x - truth.x, r.motion.value.y - truth.y));
+        }
+        ++st.n;
       }
     }
-  std::printf("%dx%d, %zu frames of asphalt_01 (mixed motion) x %d rounds, camera-frame API (upload, undistortion, "
-              "pyramid, tracking)\n", width, height, global_frames.size(), rounds);
-  std::printf("%-26s %9s %9s %9s %9s %9s %8s %7s %7s %7s\n", "configuration", "med_frame", "mean_frame", "med_pipe",
-              "med_track", "cpu/frame", "passes", "fps", "p99/md", "max/md");
+  std::printf("\nscene %s: %dx%d, %zu frames x %d rounds, camera-frame API (upload, undistortion, pyramid, "
+              "tracking); rms_mm: per-frame translation error against the truth\n",
+              scene.c_str(), so.camera.width, so.camera.height, global_frames.size(), rounds);
+  std::printf("%-28s %9s %9s %9s %9s %9s %8s %7s %7s %7s %8s %5s\n", "configuration", "med_frame", "mean_frame",
+              "med_pipe", "med_track", "cpu/frame", "passes", "fps", "p99/md", "max/md", "rms_mm", "lost");
   for (size_t c = 0; c < configs.size(); ++c) {
-    const Stats& s = stats[c];
-    double mean = 0;
-    for (double v : s.frame) mean += v;
-    mean /= std::max<size_t>(1, s.frame.size());
-    const Tail t = tail(s.frame);
-    std::printf("%-26s %9.2f %9.2f %9.2f %9.2f %9.2f %8.2f %7.0f %7.2f %7.2f\n", configs[c].name, t.median, mean,
-                median(s.pipe), median(s.track), s.cpu / s.n, s.passes / s.n, 1000.0 / mean, t.p99_over_median,
-                t.max_over_median);
+    const SpeedStats& st = stats[c];
+    if (st.n == 0) continue;
+    double mean = 0, ss = 0;
+    for (double v : st.frame) mean += v;
+    mean /= std::max<size_t>(1, st.frame.size());
+    for (double e : st.err_mm) ss += e * e;
+    const Tail t = tail(st.frame);
+    std::printf("%-28s %9.2f %9.2f %9.2f %9.2f %9.2f %8.2f %7.0f %7.2f %7.2f %8.4f %5d\n", configs[c].name, t.median,
+                mean, median(st.pipe), median(st.track), st.cpu / st.n, st.passes / st.n, 1000.0 / mean,
+                t.p99_over_median, t.max_over_median, std::sqrt(ss / std::max<size_t>(1, st.err_mm.size())),
+                st.lost / rounds);
   }
+  std::printf("where the tracking time goes (medians, ms; passes per frame in brackets; rest: outside the levels)\n");
+  std::printf("%-28s", "configuration");
+  for (int l = 3; l >= 0; --l) std::printf("   level %d      ", l);
+  std::printf("%8s\n", "rest");
+  for (size_t c = 0; c < configs.size(); ++c) {
+    const SpeedStats& st = stats[c];
+    if (st.n == 0) continue;
+    std::printf("%-28s", configs[c].name);
+    for (int l = 3; l >= 0; --l)
+      std::printf(" %6.2f (%5.2f)  ", median(st.level[static_cast<size_t>(l)]),
+                  st.level_passes[static_cast<size_t>(l)] / st.n);
+    std::printf("%8.2f\n", median(st.rest));
+  }
+  std::fflush(stdout);
+}
+
+// OpenCV's ECC (homography, 3 levels, bench_ecc.h) on `pairs` pairs (k, k+1) spread over the
+// frames, undistorted with cv::remap first (not timed): the median time per pair.
+double ecc_median_ms(const sim::Options& so, const std::vector<cv::Mat>& frames, int pairs) {
+  const int w = so.camera.width, h = so.camera.height;
+  const UndistortMap umap = compute_undistort_map(so.camera);
+  const cv::Mat map_x(h, w, CV_32F, const_cast<float*>(umap.map_x.data()));
+  const cv::Mat map_y(h, w, CV_32F, const_cast<float*>(umap.map_y.data()));
+  const cv::Mat mask = cv::Mat(h, w, CV_8U, const_cast<uint8_t*>(umap.valid.data())) * 255;
+  auto undistort = [&](const cv::Mat& g) {
+    cv::Mat f, u;
+    g.convertTo(f, CV_32F);
+    cv::remap(f, u, map_x, map_y, cv::INTER_LINEAR, cv::BORDER_CONSTANT, 0);
+    return u;
+  };
+  std::vector<double> ms;
+  const size_t n = frames.size();
+  for (int i = 0; i < pairs; ++i) {
+    const size_t k = 1 + static_cast<size_t>(i) * (n - 3) / static_cast<size_t>(std::max(1, pairs - 1));
+    const cv::Mat a = undistort(frames[k]), b = undistort(frames[k + 1]);
+    cv::Mat H;
+    const double t0 = bench::now_ms();
+    bench::ecc_pair(a, b, mask, 3, &H);
+    ms.push_back(bench::now_ms() - t0);
+  }
+  return median(ms);
+}
+
+int bench_speed(int width, int height, double seconds, int rounds, const std::string& only) {
+  ocl::Runtime rt;
+  std::printf("device: %s\n", rt.device_info().device_name.c_str());
+  std::vector<SpeedConfig> configs = speed_configs();
+  if (!only.empty()) {  // a comma-separated list of configuration numbers (from 0)
+    std::vector<SpeedConfig> kept;
+    for (const std::string& i : bench::split(only)) kept.push_back(configs.at(static_cast<size_t>(std::atoi(i.c_str()))));
+    configs = kept;
+  }
+  const std::vector<SpeedConfig> all = speed_configs();
+  const std::vector<SpeedConfig> two(all.begin(), all.begin() + 2);  // the default and before
+  struct SceneSpec {
+    const char* name;
+    Scene scene;
+  };
+  std::vector<SceneSpec> scenes(3);
+  scenes[0].name = "mixed";
+  scenes[1].name = "fast";
+  scenes[1].scene.speed = 1.5;
+  scenes[1].scene.turn = 2.5;
+  scenes[2].name = "car";
+  scenes[2].scene.parse("ext", "0,0,0.9,0,45,0");
+  scenes[2].scene.parse("motion", "car");
+  scenes[2].scene.speed = 3.0;
+  std::vector<std::string> summary;
+  for (size_t i = 0; i < scenes.size(); ++i) {
+    const sim::Options so = scenes[i].scene.options("asphalt_01.png", seconds, width, height, 1);
+    const sim::Trajectory traj = sim::generate_trajectory(so);
+    const std::vector<cv::Mat> frames = bench::render_sequence(rt, so, traj);
+    std::vector<SpeedStats> stats;
+    if (i == 0) {
+      // The same drive through a rolling shutter read out over 25 ms.
+      sim::Options rolling = so;
+      rolling.readout_time = rolling.camera.rolling_shutter_readout = 0.025;
+      const std::vector<cv::Mat> rolling_frames = bench::render_sequence(rt, rolling, traj);
+      speed_table(rt, scenes[i].name, so, traj, frames, &rolling, &rolling_frames, configs, rounds, &stats);
+    } else {
+      speed_table(rt, scenes[i].name, so, traj, frames, nullptr, nullptr, two, rounds, &stats);
+    }
+    const double ecc = ecc_median_ms(so, frames, 20);
+    const double def = tail(stats[0].frame).median;
+    char line[200];
+    std::snprintf(line, sizeof line, "%-6s  ECC %8.1f ms per pair (median of 20)   %s %6.2f ms   ECC / %s %6.1fx",
+                  scenes[i].name, ecc, configs[0].name, def, configs[0].name, ecc / std::max(1e-9, def));
+    std::printf("%s\n", line);
+    summary.push_back(line);
+  }
+  std::printf("\nOpenCV ECC (homography, 3 levels, on frames undistorted beforehand) on the same frames:\n");
+  for (const std::string& l : summary) std::printf("%s\n", l.c_str());
   return 0;
 }
 
@@ -745,7 +863,8 @@ int main(int argc, char** argv) {
   if (mode == "speed") {
     // bench_track speed [w h] [seconds] [rounds]
     const int w = argc > 3 ? std::atoi(argv[2]) : 640, h = argc > 3 ? std::atoi(argv[3]) : 480;
-    return bench_speed(w, h, argc > 4 ? std::atof(argv[4]) : 5.0, argc > 5 ? std::atoi(argv[5]) : 3);
+    return bench_speed(w, h, argc > 4 ? std::atof(argv[4]) : 5.0, argc > 5 ? std::atoi(argv[5]) : 3,
+                       argc > 6 ? argv[6] : "");
   }
   if (mode == "accuracy") {
     // bench_track accuracy [key=value ...]: seconds=10 w=640 h=480 levels=4 finest=0
@@ -775,6 +894,7 @@ int main(int argc, char** argv) {
         const auto b = split(v);
         for (size_t l = 0; l < b.size() && l < topt.select_blocks.size(); ++l) topt.select_blocks[l] = std::atoi(b[l].c_str());
       }
+      else if (k == "coarse_block") topt.auto_coarse_block = std::atoi(v.c_str());
       else if (k == "prior") topt.subsample_prior = std::atoi(v.c_str()) != 0;
       else if (k == "prior_chi2") topt.prior_chi2 = std::atof(v.c_str());
       else if (k == "prefilter") topt.prefilter = v != "0";
@@ -838,6 +958,7 @@ int main(int argc, char** argv) {
       if (k == "seconds") seconds = std::atof(v.c_str());
       else if (k == "seed") seed = std::strtoull(v.c_str(), nullptr, 10);
       else if (k == "noise") noise = std::atof(v.c_str());
+      else if (k == "coarse_block") topt.auto_coarse_block = std::atoi(v.c_str());
       else if (k == "prior") topt.subsample_prior = std::atoi(v.c_str()) != 0;
       else if (k == "prior_chi2") topt.prior_chi2 = std::atof(v.c_str());
       else if (k == "prefilter") topt.prefilter = v != "0";

@@ -1,0 +1,45 @@
+// OpenCV's ECC (findTransformECC) coarse to fine, the peer the tracker is measured against by
+// bench_ecc (accuracy) and bench_track speed (time on the same frames). Header-only (each
+// bench/*.cpp is its own program).
+#pragma once
+#include <vector>
+
+#include <opencv2/imgproc.hpp>
+#include <opencv2/video/tracking.hpp>
+
+namespace planarvo::bench {
+
+// ECC coarse to fine (cv::resize INTER_AREA halvings; pixel u of level l+1 is at 2u + 0.5 of
+// level l), from the identity. A level at which OpenCV gives up (StsNoConv) keeps the estimate
+// it started from. False when the finest level gave up.
+inline bool ecc_pair(const cv::Mat& ref, const cv::Mat& live, const cv::Mat& mask, int levels, cv::Mat* H) {
+  std::vector<cv::Mat> r{ref}, l{live}, m{mask};
+  for (int i = 1; i < levels; ++i) {
+    cv::Mat a, b, c;
+    cv::resize(r.back(), a, cv::Size(), 0.5, 0.5, cv::INTER_AREA);
+    cv::resize(l.back(), b, cv::Size(), 0.5, 0.5, cv::INTER_AREA);
+    cv::resize(m.back(), c, cv::Size(), 0.5, 0.5, cv::INTER_NEAREST);
+    r.push_back(a);
+    l.push_back(b);
+    m.push_back(c);
+  }
+  cv::Mat W = cv::Mat::eye(3, 3, CV_32F);
+  const cv::Matx33f S(2, 0, 0.5f, 0, 2, 0.5f, 0, 0, 1);
+  bool ok = true;
+  for (int i = levels - 1; i >= 0; --i) {
+    const cv::Mat start = W.clone();
+    const auto k = static_cast<size_t>(i);
+    try {
+      cv::findTransformECC(r[k], l[k], W, cv::MOTION_HOMOGRAPHY,
+                           cv::TermCriteria(cv::TermCriteria::COUNT + cv::TermCriteria::EPS, 50, 1e-6), m[k], 5);
+    } catch (const cv::Exception&) {
+      W = start;
+      if (i == 0) ok = false;
+    }
+    if (i > 0) W = cv::Mat(S * cv::Matx33f(W) * S.inv());
+  }
+  *H = W;
+  return ok;
+}
+
+}  // namespace planarvo::bench
