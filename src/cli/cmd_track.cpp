@@ -360,7 +360,8 @@ int cmd_track(int argc, char** argv) {
                               "labels, as motion pairs (CSV) for calibrate --motions", ""},
       {"levels", "N", "pyramid levels", "4"},
       {"finest-level", "N", "finest pyramid level tracked (0 = full resolution)",
-       "the coarsest at least 320 px wide, then the level below it subsampled (--level0-subsample)"},
+       "the coarsest at least 320 px wide (one pixel in four), then the level below it subsampled "
+       "(--level0-subsample)"},
       {"max-iterations", "N", "cap on alignment steps per level", "per-level defaults"},
       {"level0-subsample", "B", "align the finest level (level 0 at 640x480) on one pixel per BxB block, joined with "
                                 "the level above (1: every pixel; the default 3 takes about 1.4x the time of stopping "

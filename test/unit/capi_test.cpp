@@ -528,9 +528,10 @@ TEST(CApiTracker, Level0SubsampleIsCheckedOnlyWhenTheStructHasIt) {
 }
 
 // level0_subsample's meaning at 640x480, where the automatic finest level is level 0 after
-// level 1: 0 with finest_level -1 is the same tracking as finest_level 0 with 3 (one pixel per
-// 3x3 block), 1 with -1 the same as finest_level 0 on every pixel; finest_level 1 never reaches
-// level 0.
+// level 1: 0 with finest_level -1 is the same tracking as 3 (one pixel per 3x3 block), and close
+// to finest_level 0 with 3 (which aligns level 1 on every pixel, where the automatic choice takes
+// one per 2x2 block); 1 with -1 the same as finest_level 0 on every pixel; finest_level 1 never
+// reaches level 0.
 TEST(CApiTracker, Level0SubsampleWithTheAutomaticFinestLevel) {
   planarvo_context* c = make_context();
   ScratchDir dir;
@@ -548,7 +549,8 @@ TEST(CApiTracker, Level0SubsampleWithTheAutomaticFinestLevel) {
     std::vector<planarvo_se2> motions;
     std::vector<int32_t> level0_steps;
   };
-  std::vector<Run> runs = {{-1, 0, {}, {}}, {0, 3, {}, {}}, {-1, 1, {}, {}}, {0, 0, {}, {}}, {1, 0, {}, {}}};
+  std::vector<Run> runs = {{-1, 0, {}, {}}, {0, 3, {}, {}}, {-1, 1, {}, {}},
+                           {0, 0, {}, {}},  {1, 0, {}, {}}, {-1, 3, {}, {}}};
   for (Run& run : runs) {
     planarvo_tracker_options o;
     planarvo_tracker_options_init(&o);
@@ -579,8 +581,14 @@ TEST(CApiTracker, Level0SubsampleWithTheAutomaticFinestLevel) {
       EXPECT_EQ(a.motions[i].theta, b.motions[i].theta) << i;
     }
   };
-  same(runs[0], runs[1]);
+  same(runs[0], runs[5]);
   same(runs[2], runs[3]);
+  ASSERT_EQ(runs[0].motions.size(), runs[1].motions.size());
+  for (size_t i = 0; i < runs[0].motions.size(); ++i) {
+    EXPECT_NEAR(runs[0].motions[i].x, runs[1].motions[i].x, 1e-5) << i;
+    EXPECT_NEAR(runs[0].motions[i].y, runs[1].motions[i].y, 1e-5) << i;
+    EXPECT_NEAR(runs[0].motions[i].theta, runs[1].motions[i].theta, 1e-5) << i;
+  }
   EXPECT_NE(runs[0].motions[2].x, runs[2].motions[2].x) << "1/9 and every pixel differ";
   for (size_t i = 0; i < runs[0].level0_steps.size(); ++i) {
     EXPECT_GT(runs[0].level0_steps[i], 0) << i;

@@ -3,6 +3,7 @@
 // information against the inverse of the dense covariance's tilt block; the levels it aligns
 // (AlignerOptions::finest_level's automatic rule) against the rule worked by hand.
 #include <random>
+#include <string>
 #include <vector>
 
 #include <Eigen/Dense>
@@ -113,39 +114,48 @@ Pyramid shape(int width, int height, int levels) {
   return p;
 }
 
-// finest_level -1: A = the coarsest level at least 320 px wide on every pixel, then level A - 1
-// on one pixel per 3x3 block (auto_finer_block); explicit levels and blocks are taken as given.
+// finest_level -1: A = the coarsest level at least 320 px wide, then level A - 1 on one pixel per
+// 3x3 block (auto_finer_block), and A itself then on one pixel per 2x2 block (auto_coarse_block);
+// explicit levels and blocks are taken as given.
 TEST(AlignerLevels, TheAutomaticFinestLevelIsTheOneBelowTheCoarsestAtLeast320Wide) {
   ocl::Runtime rt;
   const Eigen::Matrix3d K = Eigen::Matrix3d::Identity();
   struct Case {
-    int w, h, finest_level, auto_block, select0;
-    int want_finest, want_block_at_finest;
+    int w, h, finest_level, auto_block, coarse_block, select0, select1;
+    int want_finest, want_block_at_finest, want_block_above;
   };
   const Case cases[] = {
-      {640, 480, -1, 3, 0, 0, 3},    // A = 1: level 0 at 1/9
-      {320, 240, -1, 3, 0, 0, 0},    // A = 0: level 0 on every pixel
-      {1280, 960, -1, 3, 0, 1, 3},   // A = 2: level 1 at 1/9
-      {640, 480, -1, 0, 0, 1, 0},    // auto_finer_block 0: stop at A
-      {640, 480, -1, 1, 0, 0, 0},    // 1: level A - 1 on every pixel
-      {640, 480, -1, 3, 4, 0, 4},    // an explicit block at that level wins
-      {640, 480, 0, 3, 0, 0, 0},     // an explicit finest level: every pixel
-      {640, 480, 0, 3, 2, 0, 2},
-      {640, 480, 2, 3, 0, 2, 0},
+      {640, 480, -1, 3, 2, 0, 0, 0, 3, 2},    // A = 1 at 1/4, then level 0 at 1/9
+      {640, 480, -1, 3, 0, 0, 0, 0, 3, 0},    // auto_coarse_block 0: A on every pixel
+      {640, 480, -1, 3, 2, 0, 3, 0, 3, 3},    // an explicit block at A wins
+      {320, 240, -1, 3, 2, 0, 0, 0, 0, 0},    // A = 0: level 0 on every pixel
+      {1280, 960, -1, 3, 2, 0, 0, 1, 3, 2},   // A = 2 at 1/4, level 1 at 1/9
+      {640, 480, -1, 0, 2, 0, 0, 1, 0, 0},    // auto_finer_block 0: stop at A, on every pixel
+      {640, 480, -1, 1, 2, 0, 0, 0, 0, 0},    // 1: level A - 1 on every pixel, and A
+      {640, 480, -1, 3, 2, 4, 0, 0, 4, 2},    // an explicit block at that level wins
+      {640, 480, 0, 3, 2, 0, 0, 0, 0, 0},     // an explicit finest level: every pixel
+      {640, 480, 0, 3, 2, 2, 0, 0, 2, 0},
+      {640, 480, 2, 3, 2, 0, 0, 2, 0, 0},
   };
   for (const Case& c : cases) {
     AlignerOptions o;
     o.finest_level = c.finest_level;
     o.auto_finer_block = c.auto_block;
+    o.auto_coarse_block = c.coarse_block;
     o.select_blocks[0] = c.select0;
+    o.select_blocks[1] = c.select1;
     Aligner aligner(rt, K, o, false);
     const Pyramid p = shape(c.w, c.h, 4);
     const AlignmentLevels L = aligner.levels(p, p);
+    const std::string what = std::to_string(c.w) + "x" + std::to_string(c.h) + " finest_level " +
+                             std::to_string(c.finest_level) + " blocks " + std::to_string(c.auto_block) + ", " +
+                             std::to_string(c.coarse_block);
     EXPECT_EQ(L.coarsest, 3) << c.w;
-    EXPECT_EQ(L.finest, c.want_finest) << c.w << "x" << c.h << " finest_level " << c.finest_level << " block " << c.auto_block;
-    EXPECT_EQ(L.select_block[static_cast<size_t>(L.finest)], c.want_block_at_finest)
-        << c.w << "x" << c.h << " finest_level " << c.finest_level << " block " << c.auto_block;
-    for (int l = L.finest + 1; l <= L.coarsest; ++l) EXPECT_EQ(L.select_block[static_cast<size_t>(l)], 0) << l;
+    EXPECT_EQ(L.finest, c.want_finest) << what;
+    EXPECT_EQ(L.select_block[static_cast<size_t>(L.finest)], c.want_block_at_finest) << what;
+    const int above = L.finest + 1;
+    EXPECT_EQ(L.select_block[static_cast<size_t>(above)], c.want_block_above) << what;
+    for (int l = above + 1; l <= L.coarsest; ++l) EXPECT_EQ(L.select_block[static_cast<size_t>(l)], 0) << what << " " << l;
   }
 }
 
