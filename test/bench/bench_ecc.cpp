@@ -185,16 +185,9 @@ int main(int argc, char** argv) {
       for (size_t k = 0; k < n; ++k) res.push_back(tracker.track(frames[k].data, w, h, frames[k].step, traj.t[k]));
     }
     const Eigen::Matrix3d K = so.camera.K();
-    const UndistortMap umap = compute_undistort_map(so.camera);
-    const cv::Mat map_x(h, w, CV_32F, const_cast<float*>(umap.map_x.data()));
-    const cv::Mat map_y(h, w, CV_32F, const_cast<float*>(umap.map_y.data()));
-    const cv::Mat mask = cv::Mat(h, w, CV_8U, const_cast<uint8_t*>(umap.valid.data())) * 255;
-    auto undistort = [&](const cv::Mat& g) {
-      cv::Mat f, u;
-      g.convertTo(f, CV_32F);
-      cv::remap(f, u, map_x, map_y, cv::INTER_LINEAR, cv::BORDER_CONSTANT, 0);
-      return u;
-    };
+    const bench::EccFrames ecc_frames(so.camera);
+    const cv::Mat& mask = ecc_frames.mask;
+    auto undistort = [&](const cv::Mat& g) { return ecc_frames.undistort(g); };
     Method ecc, vo;
     for (int i = 0; i < pairs; ++i) {
       const size_t k = 1 + static_cast<size_t>(i) * (n - 3) / static_cast<size_t>(std::max(1, pairs - 1));

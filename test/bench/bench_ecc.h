@@ -2,10 +2,14 @@
 // bench_ecc (accuracy) and bench_track speed (time on the same frames). Header-only (each
 // bench/*.cpp is its own program).
 #pragma once
+#include <cstdint>
 #include <vector>
 
 #include <opencv2/imgproc.hpp>
 #include <opencv2/video/tracking.hpp>
+
+#include "image/camera.h"
+#include "image/undistort.h"
 
 namespace planarvo::bench {
 
@@ -41,5 +45,30 @@ inline bool ecc_pair(const cv::Mat& ref, const cv::Mat& live, const cv::Mat& mas
   *H = W;
   return ok;
 }
+
+// What ECC is given: a camera's frames undistorted with cv::remap (bilinear, float) and the mask
+// of the undistorted pixels that have a source.
+struct EccFrames {
+  explicit EccFrames(const CameraModel& camera)
+      : map_(compute_undistort_map(camera)),
+        map_x_(camera.height, camera.width, CV_32F, map_.map_x.data()),
+        map_y_(camera.height, camera.width, CV_32F, map_.map_y.data()),
+        mask(cv::Mat(camera.height, camera.width, CV_8U, map_.valid.data()) * 255) {}
+  EccFrames(const EccFrames&) = delete;  // the maps point into map_
+  EccFrames& operator=(const EccFrames&) = delete;
+  cv::Mat undistort(const cv::Mat& gray) const {
+    cv::Mat f, u;
+    gray.convertTo(f, CV_32F);
+    cv::remap(f, u, map_x_, map_y_, cv::INTER_LINEAR, cv::BORDER_CONSTANT, 0);
+    return u;
+  }
+
+ private:
+  UndistortMap map_;
+  cv::Mat map_x_, map_y_;
+
+ public:
+  cv::Mat mask;
+};
 
 }  // namespace planarvo::bench

@@ -771,25 +771,15 @@ void speed_table(ocl::Runtime& rt, const std::string& scene, const sim::Options&
 // OpenCV's ECC (homography, 3 levels, bench_ecc.h) on `pairs` pairs (k, k+1) spread over the
 // frames, undistorted with cv::remap first (not timed): the median time per pair.
 double ecc_median_ms(const sim::Options& so, const std::vector<cv::Mat>& frames, int pairs) {
-  const int w = so.camera.width, h = so.camera.height;
-  const UndistortMap umap = compute_undistort_map(so.camera);
-  const cv::Mat map_x(h, w, CV_32F, const_cast<float*>(umap.map_x.data()));
-  const cv::Mat map_y(h, w, CV_32F, const_cast<float*>(umap.map_y.data()));
-  const cv::Mat mask = cv::Mat(h, w, CV_8U, const_cast<uint8_t*>(umap.valid.data())) * 255;
-  auto undistort = [&](const cv::Mat& g) {
-    cv::Mat f, u;
-    g.convertTo(f, CV_32F);
-    cv::remap(f, u, map_x, map_y, cv::INTER_LINEAR, cv::BORDER_CONSTANT, 0);
-    return u;
-  };
+  const bench::EccFrames ecc_frames(so.camera);
   std::vector<double> ms;
   const size_t n = frames.size();
   for (int i = 0; i < pairs; ++i) {
     const size_t k = 1 + static_cast<size_t>(i) * (n - 3) / static_cast<size_t>(std::max(1, pairs - 1));
-    const cv::Mat a = undistort(frames[k]), b = undistort(frames[k + 1]);
+    const cv::Mat a = ecc_frames.undistort(frames[k]), b = ecc_frames.undistort(frames[k + 1]);
     cv::Mat H;
     const double t0 = bench::now_ms();
-    bench::ecc_pair(a, b, mask, 3, &H);
+    bench::ecc_pair(a, b, ecc_frames.mask, 3, &H);
     ms.push_back(bench::now_ms() - t0);
   }
   return median(ms);
