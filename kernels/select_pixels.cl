@@ -9,7 +9,9 @@
 // (src/track/README.md, "Full resolution from subsampled pixels").
 //
 // Output: a grid of ceil(w / B) x ceil(h / B) float4, entry (bx, by) = (I, dI/du, dI/dv, code)
-// of the block's pixel, code = 1 + oy B + ox for the pixel (bx B + ox, by B + oy), or all zero
+// of the block's pixel, code = 1 + ox + 256 oy for the pixel (bx B + ox, by B + oy) (decoded with
+// a mask and a shift: an integer division per pixel costs the fused pass a scalar division per
+// lane on CPUs, whose vector units have none), or all zero
 // when that pixel is invalid or outside the level. This is the reference of warp_reduce.cl built
 // with SELECT = 1 and select_block = B. One work-item per block; global size (grid_w, grid_h) rounded up to the
 // work-group size. The plain C++ reference is select_pixels_reference() in
@@ -35,7 +37,7 @@ __kernel void select_pixels(__global const float4* level, const int width, const
   float4 out = (float4)(0.0f, 0.0f, 0.0f, 0.0f);
   if (x < width && y < height) {
     const float4 p = level[y * width + x];
-    if (p.w != 0.0f) out = (float4)(p.x, p.y, p.z, (float)(1 + off));
+    if (p.w != 0.0f) out = (float4)(p.x, p.y, p.z, (float)(1 + off % block + 256 * (off / block)));
   }
   grid[by * grid_w + bx] = out;
 }

@@ -34,7 +34,7 @@
 // With SELECT = 1 the reference is not a level but its subsampled pixels
 // (kernels/select_pixels.cl) and an argument select_block = B follows huber_k: a grid of
 // ref_w x ref_h entries, one per B x B block of the level, each (I_r, dI_r/du, dI_r/dv, code) of
-// the block's pixel, code = 1 + oy B + ox for the pixel (bx B + ox, by B + oy) of block (bx, by),
+// the block's pixel, code = 1 + ox + 256 oy for the pixel (bx B + ox, by B + oy) of block (bx, by),
 // 0 for none. Everything above then applies to that pixel; the work distribution, the partials
 // and the clusters are those of the grid. B is an argument, not a build option, so that one
 // program serves every block size.
@@ -286,8 +286,8 @@ WR_KERNEL {
     const int8 has = code > 0;
     const float8 mref = select((float8)(0.0f), (float8)(1.0f), has);
     const int8 off = select((int8)(0), code - 1, has);
-    const float8 fu = convert_float8(x * select_block + off % select_block);
-    const float8 fv = convert_float8(y * select_block + off / select_block);
+    const float8 fu = convert_float8(x * select_block + (off & 255));
+    const float8 fv = convert_float8(y * select_block + (off >> 8));
 #else
     const float8 mref = rC;
     const float8 fu = convert_float8(x);
@@ -383,8 +383,8 @@ WR_KERNEL {
     const int code = in_ref ? (int)refp[ri + 3] : 0;
     const float mref = code > 0 ? 1.0f : 0.0f;
     const int off = code > 0 ? code - 1 : 0;
-    const float fu = (float)(x * select_block + off % select_block);
-    const float fv = (float)(y * select_block + off / select_block);
+    const float fu = (float)(x * select_block + (off & 255));
+    const float fv = (float)(y * select_block + (off >> 8));
 #else
     const float mref = in_ref ? refp[ri + 3] : 0.0f;
     const float fu = (float)x;

@@ -67,7 +67,7 @@ std::vector<float> select_pixels_reference(const LevelView& level, int block) {
       g[0] = p[0];
       g[1] = p[1];
       g[2] = p[2];
-      g[3] = static_cast<float>(1 + off);
+      g[3] = static_cast<float>(1 + off % block + 256 * (off / block));  // select_pixels.cl's code
     }
   return grid;
 }

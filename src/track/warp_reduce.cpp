@@ -184,8 +184,8 @@ ReduceSums warp_reduce_reference(const LevelView& ref, const LevelView& live,
       int px = x, py = y;
       if (o.select_block > 0) {
         const int off = static_cast<int>(R[3]) - 1;
-        px = x * o.select_block + off % o.select_block;
-        py = y * o.select_block + off / o.select_block;
+        px = x * o.select_block + off % 256;
+        py = y * o.select_block + off / 256;
       }
       KernelSample sample;
       if (!kernel_sample(h, px, py, live, &sample)) continue;

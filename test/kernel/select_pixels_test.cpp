@@ -89,7 +89,7 @@ TEST_F(SelectPixels, TakesOnePixelPerBlockAtAnEvenlySpreadOffset) {
             EXPECT_EQ(e[3], 0.0f) << "block " << bx << "," << by;
             continue;
           }
-          EXPECT_EQ(e[3], static_cast<float>(1 + off));
+          EXPECT_EQ(e[3], static_cast<float>(1 + off % block + 256 * (off / block)));
           EXPECT_EQ(e[0], p[0]);
           EXPECT_EQ(e[1], p[1]);
           EXPECT_EQ(e[2], p[2]);
@@ -132,9 +132,9 @@ TEST_F(SelectPixels, FusedPassOverSelectedPixelsIsThePassOverThosePixels) {
       for (int bx = 0; bx < sel.grid_w; ++bx) {
         const float* e = &grid[4 * (static_cast<size_t>(by) * static_cast<size_t>(sel.grid_w) + static_cast<size_t>(bx))];
         if (e[3] == 0.0f) continue;
-        const int off = static_cast<int>(e[3]) - 1;
-        const size_t i = 4 * (static_cast<size_t>(by * block + off / block) * static_cast<size_t>(w) +
-                              static_cast<size_t>(bx * block + off % block));
+        const int code = static_cast<int>(e[3]) - 1;  // ox + 256 oy
+        const size_t i = 4 * (static_cast<size_t>(by * block + code / 256) * static_cast<size_t>(w) +
+                              static_cast<size_t>(bx * block + code % 256));
         std::copy(&ref[i], &ref[i] + 4, &masked[i]);
       }
     for (bool stats : {false, true}) {
