@@ -25,7 +25,10 @@ uint32_t select_offset(int bx, int by, int block) {
   h ^= h >> 15;
   h *= 0x2C1B3C6Du;
   h ^= h >> 12;
-  return h % static_cast<uint32_t>(block * block);
+  // select_pixels.cl: the low 16 bits scaled to the column, the high 16 to the row.
+  const uint32_t b = static_cast<uint32_t>(block);
+  const uint32_t ox = ((h & 0xFFFFu) * b) >> 16, oy = ((h >> 16) * b) >> 16;
+  return oy * b + ox;
 }
 
 void PixelSelector::run(const PyramidLevel& level, int level_index, int block, SelectedPixels* out) {

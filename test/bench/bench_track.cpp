@@ -2,7 +2,7 @@
 //   bench_track kernel   [width height]   the fused pass per work-group shape / pixels per
 //                                          work-item / lanes / fast math, median ms per pass
 //   bench_track kernel w h wx wy pix hist fast lanes [rounds]   one configuration
-//   bench_track speed [w h] [seconds] [rounds] [configs]   ms per frame through the camera-frame API
+//   bench_track speed [w h] [seconds] [rounds] [configs] [scenes]   ms per frame through the camera-frame API
 //                                          (median, mean, and the p99 and maximum over the median)
 //   bench_track accuracy [key=value...]     simulated sequences tracked against ground truth
 //       (seconds, w, h, seed, motion=mixed|straight|circle|spin, levels, finest, refine_kf, conv,
@@ -785,7 +785,8 @@ double ecc_median_ms(const sim::Options& so, const std::vector<cv::Mat>& frames,
   return median(ms);
 }
 
-int bench_speed(int width, int height, double seconds, int rounds, const std::string& only) {
+int bench_speed(int width, int height, double seconds, int rounds, const std::string& only,
+                const std::string& scene_names) {
   ocl::Runtime rt;
   std::printf("device: %s\n", rt.device_info().device_name.c_str());
   std::vector<SpeedConfig> configs = speed_configs();
@@ -811,6 +812,8 @@ int bench_speed(int width, int height, double seconds, int rounds, const std::st
   scenes[2].scene.speed = 3.0;
   std::vector<std::string> summary;
   for (size_t i = 0; i < scenes.size(); ++i) {
+    if (!scene_names.empty() && ("," + scene_names + ",").find(std::string(",") + scenes[i].name + ",") == std::string::npos)
+      continue;
     const sim::Options so = scenes[i].scene.options("asphalt_01.png", seconds, width, height, 1);
     const sim::Trajectory traj = sim::generate_trajectory(so);
     const std::vector<cv::Mat> frames = bench::render_sequence(rt, so, traj);
@@ -854,7 +857,7 @@ int main(int argc, char** argv) {
     // bench_track speed [w h] [seconds] [rounds]
     const int w = argc > 3 ? std::atoi(argv[2]) : 640, h = argc > 3 ? std::atoi(argv[3]) : 480;
     return bench_speed(w, h, argc > 4 ? std::atof(argv[4]) : 5.0, argc > 5 ? std::atoi(argv[5]) : 3,
-                       argc > 6 ? argv[6] : "");
+                       argc > 6 ? argv[6] : "", argc > 7 ? argv[7] : "");
   }
   if (mode == "accuracy") {
     // bench_track accuracy [key=value ...]: seconds=10 w=640 h=480 levels=4 finest=0
