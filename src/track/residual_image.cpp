@@ -7,6 +7,7 @@
 
 #include "core/error.h"
 #include "ocl/runtime.h"
+#include "track/texture_residual.h"
 #include "track/warp_model.h"
 
 namespace planarvo::track {
@@ -25,6 +26,7 @@ namespace {
 // binaries hold it: the tracker measures every frame's texture residual with it (the honest-status
 // check, texture_residual.h), and the calibration tracks its drives.
 const bool kDefaultVariantRegistered = [] {
+  ocl::Runtime::register_build_options("texture_residual", "", {ocl::kUseTrack, ocl::kUseCalibrate});
   ocl::Runtime::register_build_options(
       "warp_reduce", WarpReduce::build_options(kMotionParams, ResidualImager::kernel_options(WarpReduceOptions())),
       {ocl::kUseTrack, ocl::kUseCalibrate});
@@ -38,7 +40,8 @@ ResidualImager::ResidualImager(ocl::Runtime& runtime, const Eigen::Matrix3d& K, 
 
 ResidualImager::~ResidualImager() = default;
 
-void ResidualImager::compute(const AlignmentRecord& a, const Extrinsics& extrinsics, int level, ResidualImage* out) {
+WarpInputs ResidualImager::run_pass(const AlignmentRecord& a, const Extrinsics& extrinsics, int level,
+                                    ReduceSums* sums) {
   const int levels = std::min(a.reference.num_levels(), a.live.num_levels());
   if (level < 0 || level >= levels)
     throw_invalid_argument("residual image: level " + std::to_string(level) + " is not one of the pyramid's 0.." +
@@ -64,11 +67,48 @@ void ResidualImager::compute(const AlignmentRecord& a, const Extrinsics& extrins
 
   const size_t n = static_cast<size_t>(R.width) * static_cast<size_t>(R.height);
   if (n > debug_capacity_) {
-    debug_ = cl::Buffer(runtime_.context(), CL_MEM_WRITE_ONLY, n * 4 * sizeof(float));
+    debug_ = cl::Buffer(runtime_.context(), CL_MEM_READ_WRITE, n * 4 * sizeof(float));
     debug_capacity_ = n;
   }
+  pass_.run(R.data, R.width, R.height, L.data, L.width, L.height, in, sums, &debug_);
+  return in;
+}
+
+double ResidualImager::texture_residual(const AlignmentRecord& a, const Extrinsics& extrinsics, int level) {
   ReduceSums sums;
-  pass_.run(R.data, R.width, R.height, L.data, L.width, L.height, in, &sums, &debug_);
+  run_pass(a, extrinsics, level, &sums);
+  const PyramidLevel& R = a.reference.levels[static_cast<size_t>(level)];
+  constexpr size_t kWx = 16, kWy = 4;  // texture_residual.cl's TR_WG_X, TR_WG_Y
+  const size_t gx = (static_cast<size_t>(R.width) + kWx - 1) / kWx, gy = (static_cast<size_t>(R.height) + kWy - 1) / kWy;
+  const size_t floats = 3 * gx * gy;
+  if (floats > texture_capacity_) {
+    texture_partials_ = cl::Buffer(runtime_.context(), CL_MEM_WRITE_ONLY, floats * sizeof(float));
+    texture_capacity_ = floats;
+    host_texture_.resize(floats);
+  }
+  if (!texture_kernel_()) texture_kernel_ = cl::Kernel(runtime_.program("texture_residual", ""), "texture_residual");
+  texture_kernel_.setArg(0, debug_);
+  texture_kernel_.setArg(1, R.data);
+  texture_kernel_.setArg(2, R.width);
+  texture_kernel_.setArg(3, R.height);
+  texture_kernel_.setArg(4, texture_partials_);
+  cl::CommandQueue& q = runtime_.queue();
+  q.enqueueNDRangeKernel(texture_kernel_, cl::NullRange, cl::NDRange(gx * kWx, gy * kWy), cl::NDRange(kWx, kWy));
+  q.enqueueReadBuffer(texture_partials_, CL_TRUE, 0, floats * sizeof(float), host_texture_.data());
+  double sr = 0.0, si = 0.0, count = 0.0;
+  for (size_t g = 0; g < gx * gy; ++g) {
+    sr += static_cast<double>(host_texture_[3 * g]);
+    si += static_cast<double>(host_texture_[3 * g + 1]);
+    count += static_cast<double>(host_texture_[3 * g + 2]);
+  }
+  return texture_residual_ratio(sr, si, count);
+}
+
+void ResidualImager::compute(const AlignmentRecord& a, const Extrinsics& extrinsics, int level, ResidualImage* out) {
+  ReduceSums sums;
+  const WarpInputs in = run_pass(a, extrinsics, level, &sums);
+  const PyramidLevel& R = a.reference.levels[static_cast<size_t>(level)];
+  const size_t n = static_cast<size_t>(R.width) * static_cast<size_t>(R.height);
   host_debug_.resize(4 * n);
   host_ref_.resize(4 * n);
   cl::CommandQueue& q = runtime_.queue();

@@ -63,16 +63,26 @@ class ResidualImager {
   // The residual image of an alignment at `level`; InvalidArgument for a level either pyramid
   // lacks (or a live level below 2 x 2 pixels).
   void compute(const AlignmentRecord& alignment, const Extrinsics& extrinsics, int level, ResidualImage* out);
+  // texture_residual(image) of texture_residual.h for that residual image, reduced on the device
+  // (kernels/texture_residual.cl) instead of read back: the honest-status check of every frame.
+  double texture_residual(const AlignmentRecord& alignment, const Extrinsics& extrinsics, int level);
 
   static WarpReduceOptions kernel_options(const WarpReduceOptions& tracker_kernel);
 
  private:
   ocl::Runtime& runtime_;
   Eigen::Matrix3d K_;
+  // The DEBUG_OUTPUT pass into debug_ (checks the level); the warp's inputs.
+  WarpInputs run_pass(const AlignmentRecord& alignment, const Extrinsics& extrinsics, int level, ReduceSums* sums);
+
   WarpReduce pass_;
   cl::Buffer debug_;
   size_t debug_capacity_ = 0;  // pixels
   std::vector<float> host_debug_, host_ref_;
+  cl::Kernel texture_kernel_;  // texture_residual.cl, built on the first texture_residual()
+  cl::Buffer texture_partials_;
+  size_t texture_capacity_ = 0;  // floats
+  std::vector<float> host_texture_;
 };
 
 }  // namespace planarvo::track

@@ -43,8 +43,12 @@ double texture_residual(const ResidualImage& im) {
       ++n;
     }
   }
-  if (n < 16 || !(si > 0.0)) return std::numeric_limits<double>::quiet_NaN();
-  return sr / (std::sqrt(2.0) * si);
+  return texture_residual_ratio(sr, si, static_cast<double>(n));
+}
+
+double texture_residual_ratio(double sum_nr, double sum_ni, double count) {
+  if (count < 16 || !(sum_ni > 0.0)) return std::numeric_limits<double>::quiet_NaN();
+  return sum_nr / (std::sqrt(2.0) * sum_ni);
 }
 
 }  // namespace planarvo::track

@@ -161,7 +161,6 @@ struct Tracker::Impl {
   std::unique_ptr<TiltJacobian> tilt_jacobian;
   Eigen::Matrix<double, 3, 2> prev_tilt = Eigen::Matrix<double, 3, 2>::Zero();
   ResidualImage cached;
-  ResidualImage check_image;  // the honest-status check's (measure_texture_residual)
   Pyramid spare;
 
   Impl(ocl::Runtime& r, const CameraModel& c, const Extrinsics& e, const TrackerOptions& o)
@@ -289,8 +288,7 @@ struct Tracker::Impl {
     if (!std::isfinite(opt.max_texture_residual) || level >= live.num_levels() || level >= keyframe.num_levels())
       return std::numeric_limits<double>::quiet_NaN();
     if (!imager) imager = std::make_unique<ResidualImager>(rt, camera.K(), opt.kernel);
-    imager->compute(record(live, e), ext, level, &check_image);
-    return texture_residual(check_image);
+    return imager->texture_residual(record(live, e), ext, level);
   }
 
   // An alignment of `live` with the keyframe, as residual_image.h takes it.

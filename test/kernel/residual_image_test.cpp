@@ -18,6 +18,7 @@
 #include "core/extrinsics.h"
 #include "ocl/runtime.h"
 #include "sim/simulator.h"
+#include "track/texture_residual.h"
 #include "track/tracker.h"
 #include "unit/track_test_pyramid.h"
 
@@ -160,6 +161,13 @@ TEST_F(ResidualImageTest, KernelAgreesWithHostAndFindsThePastedBlob) {
     std::nth_element(clear_abs.begin(), clear_abs.begin() + clear_abs.size() / 2, clear_abs.end());
     EXPECT_LT(clear_abs[clear_abs.size() / 2], 2.0);
   }
+  // The honest-status check's measure, which the tracker reduces on the device
+  // (kernels/texture_residual.cl), against the host's texture_residual() of the same residual
+  // image read back: float sums per pixel against double.
+  const int tl = texture_residual_level(options_.camera.width, 4);
+  const double host_measure = texture_residual(tracker.residuals(tl));
+  ASSERT_TRUE(std::isfinite(host_measure));
+  EXPECT_NEAR(fr.texture_residual, host_measure, 1e-4 * host_measure);
 }
 
 TEST_F(ResidualImageTest, AskingLeavesTrackingUnchangedAndKeepsTheAlignedKeyframe) {
