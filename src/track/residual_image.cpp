@@ -36,7 +36,8 @@ const bool kDefaultVariantRegistered = [] {
 }  // namespace
 
 ResidualImager::ResidualImager(ocl::Runtime& runtime, const Eigen::Matrix3d& K, const WarpReduceOptions& kernel)
-    : runtime_(runtime), K_(K), pass_(runtime, kMotionParams, kernel_options(kernel)) {}
+    : runtime_(runtime), K_(K), pass_(runtime, kMotionParams, kernel_options(kernel)),
+      texture_kernel_(runtime.program("texture_residual", ""), "texture_residual") {}
 
 ResidualImager::~ResidualImager() = default;
 
@@ -86,7 +87,6 @@ double ResidualImager::texture_residual(const AlignmentRecord& a, const Extrinsi
     texture_capacity_ = floats;
     host_texture_.resize(floats);
   }
-  if (!texture_kernel_()) texture_kernel_ = cl::Kernel(runtime_.program("texture_residual", ""), "texture_residual");
   texture_kernel_.setArg(0, debug_);
   texture_kernel_.setArg(1, R.data);
   texture_kernel_.setArg(2, R.width);

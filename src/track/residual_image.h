@@ -79,7 +79,7 @@ class ResidualImager {
   cl::Buffer debug_;
   size_t debug_capacity_ = 0;  // pixels
   std::vector<float> host_debug_, host_ref_;
-  cl::Kernel texture_kernel_;  // texture_residual.cl, built on the first texture_residual()
+  cl::Kernel texture_kernel_;  // texture_residual.cl
   cl::Buffer texture_partials_;
   size_t texture_capacity_ = 0;  // floats
   std::vector<float> host_texture_;

@@ -169,6 +169,9 @@ struct Tracker::Impl {
         light_gate(camera.K(), camera.width, camera.height, e, o.learn_motion_px, o.max_texture_residual),
         plane(o.local_plane_prior_sigma), watch(watch_options(o, e)) {
     readout_twist = ReadoutTwist(camera.mean_row_time());
+    // The honest-status check runs on every aligned frame: its programs are built now, not at the
+    // first aligned frame (whose latency a cold kernel cache would otherwise carry).
+    if (std::isfinite(opt.max_texture_residual)) imager = std::make_unique<ResidualImager>(rt, camera.K(), opt.kernel);
     // The flat field is read now, so that a bad file fails at once rather than at the first frame.
     if (!opt.flat_field.empty() && opt.photometric.enabled) {
       const UndistortMap map = compute_undistort_map(camera);
