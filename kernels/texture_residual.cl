@@ -1,7 +1,7 @@
 // The honest-status check's sums (src/track/texture_residual.h): over the pixels of a residual
 // image whose 3 x 3 neighbourhood is valid (every Huber weight > 0), |N*r| and |N*I_r| with
 // Immerkaer's operator N = [1 -2 1; -2 4 -2; 1 -2 1], and their count, one row of three partial
-// sums per work-group (local-memory tree reduction; the host sums the rows in double). Plain C++
+// sums per work-group (local-memory tree reduction; the host sums the rows in 64-bit floating point). Plain C++
 // reference: texture_residual() in src/track/texture_residual.cpp, on the residual image read back.
 //
 //   debug    w x h float4 (r, weight, valid, rho): the DEBUG_OUTPUT pass of warp_reduce.cl

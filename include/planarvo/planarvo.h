@@ -363,11 +363,10 @@ typedef struct planarvo_tracker_options {
   double keyframe_overlap;    /* a new keyframe when the overlap falls below this; default 0.7 */
   int32_t estimate_brightness;/* non-zero: estimate gain and offset per frame; default 1 */
   /* The finest level on one pixel per B x B block (a jittered grid per keyframe), solved with the
-   * level above's estimate. finest_level -1: the coarsest level at least 320 px wide, then the
-   * level below it at B, 0 meaning 3, the first on one pixel per 2x2 block when the second is
-   * subsampled (640x480: level 1 at 1/4, then level 0 at 1/9; 320x240: level 0 on every pixel).
-   * Explicit finest_level: 0 is every pixel. 1: every pixel (and the level above it too); 2..8: B.
-   * Unread (so 0) for older struct_size. */
+   * level above's estimate. finest_level -1: the coarsest level at least 320 px wide (at 1/4 when
+   * the level below it is subsampled), then that level at B, 0 meaning 3 (640x480: level 1 at 1/4,
+   * level 0 at 1/9; 320x240: level 0 on every pixel). Explicit finest_level: 0 is every pixel. 1:
+   * every pixel, and the level above it too; 2..8: B. Unread (so 0) for older struct_size. */
   int32_t level0_subsample;
   /* A known flat field (NULL or "" = learn the light fixed to the camera from the frames, the
    * default): an image file of the camera's relative brightness per pixel of the distorted camera

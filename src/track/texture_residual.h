@@ -31,8 +31,8 @@ int texture_residual_level(int width, int levels);
 // The measure above; NaN when fewer than 16 pixels have a valid 3 x 3 neighbourhood or the images
 // have no texture at all.
 double texture_residual(const ResidualImage& image);
-// The measure from its sums: sum |N*r|, sum |N*I_r| and the count of pixels (NaN as above).
+// The measure from its sums: sum |N*r|, sum |N*I_r| and the count of pixels (NaN as above); the
+// device's reduction (ResidualImager::texture_residual, residual_image.h) ends with it.
 double texture_residual_ratio(double sum_nr, double sum_ni, double count);
-// On the device: ResidualImager::texture_residual (residual_image.h).
 
 }  // namespace planarvo::track

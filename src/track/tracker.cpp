@@ -290,8 +290,7 @@ struct Tracker::Impl {
     const int level = texture_residual_level(camera.width, opt.levels);
     if (!std::isfinite(opt.max_texture_residual) || level >= live.num_levels() || level >= keyframe.num_levels())
       return std::numeric_limits<double>::quiet_NaN();
-    if (!imager) imager = std::make_unique<ResidualImager>(rt, camera.K(), opt.kernel);
-    return imager->texture_residual(record(live, e), ext, level);
+    return imager->texture_residual(record(live, e), ext, level);  // made with the tracker
   }
 
   // An alignment of `live` with the keyframe, as residual_image.h takes it.
