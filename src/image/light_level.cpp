@@ -1,6 +1,10 @@
 #include "image/light_level.h"
 
-#include <opencv2/imgproc.hpp>
+#include <algorithm>
+#include <cstdint>
+#include <vector>
+
+#include <opencv2/core.hpp>
 
 #include "core/error.h"
 
@@ -14,82 +18,100 @@ void check(const cv::Mat& m, const cv::Mat& support, int r) {
   if (r < 1) throw_invalid_argument("light level: the box's half-width must be >= 1");
 }
 
-// local_plane_level's fit. The moments of the support are the same for every image fitted
-// (settled_light_level fits two), so they are made once.
-class LocalPlane {
- public:
-  LocalPlane(const cv::Mat& support, int r) : k_(2 * r + 1, 2 * r + 1), r_(r) {
-    const int w = support.cols, h = support.rows;
-    support.convertTo(v_, CV_64F);
-    cv::threshold(v_, v_, 0.5, 1.0, cv::THRESH_BINARY);
-    x_.create(h, w, CV_64FC1);
-    y_.create(h, w, CV_64FC1);
-    for (int y = 0; y < h; ++y) {
-      double* xr = x_.ptr<double>(y);
-      double* yr = y_.ptr<double>(y);
-      for (int x = 0; x < w; ++x) {
-        xr[x] = x;
-        yr[x] = y;
-      }
+// local_plane_level's fit, streamed row by row: the box sums (half-width r, clipped at the
+// image's border) are running sums, first along each row, then down the columns, where each row
+// is added when the box reaches it and subtracted when it leaves. Over a row the weight x is
+// the pixel's own and y the row's, so five row sums (support 1, x, x^2; level m, m x) give the
+// nine moments. Nothing of the image's size is held but the output (no large temporaries: at
+// 640x480 those were a third of the time, in page faults). The support's sums are integers,
+// exact in double.
+cv::Mat fit_local_plane(const cv::Mat& m, const cv::Mat& support, int r) {
+  const int w = m.cols, h = m.rows;
+  const size_t W = static_cast<size_t>(w);
+  enum { kV, kVx, kVxx, kM, kMx, kRowSums };
+  enum { kS0, kSx, kSxx, kSy, kSyy, kSxy, kT0, kTx, kTy, kColumnSums };
+  std::vector<double> rows(kRowSums * W), acc(kColumnSums * W, 0.0), vm(2 * W);
+  // The five row sums of image row y into `rows`.
+  auto row_sums = [&](int y) {
+    const uint8_t* s = support.ptr<uint8_t>(y);
+    const float* a = m.ptr<float>(y);
+    for (int x = 0; x < w; ++x) {
+      vm[static_cast<size_t>(x)] = s[x] ? 1.0 : 0.0;
+      vm[W + static_cast<size_t>(x)] = s[x] ? static_cast<double>(a[x]) : 0.0;
     }
-    const cv::Mat vx = v_.mul(x_), vy = v_.mul(y_);
-    s0_ = box(v_);
-    sx_ = box(vx);
-    sy_ = box(vy);
-    sxx_ = box(vx.mul(x_));
-    syy_ = box(vy.mul(y_));
-    sxy_ = box(vx.mul(y_));
-  }
-
-  // The fitted level at every pixel whose box holds a supported pixel; 0 elsewhere.
-  cv::Mat fit(const cv::Mat& m) const {
-    cv::Mat M;
-    m.convertTo(M, CV_64F);
-    M = M.mul(v_);
-    const cv::Mat t0 = box(M), tx = box(M.mul(x_)), ty = box(M.mul(y_));
-    const double full = r_ * (r_ + 1) / 3.0;  // the full box's variance along each axis
-    cv::Mat out(m.size(), CV_32FC1, cv::Scalar(0.0f));
-    for (int y = 0; y < m.rows; ++y) {
-      const double *n0 = s0_.ptr<double>(y), *nx = sx_.ptr<double>(y), *ny = sy_.ptr<double>(y),
-                   *nxx = sxx_.ptr<double>(y), *nyy = syy_.ptr<double>(y), *nxy = sxy_.ptr<double>(y),
-                   *m0 = t0.ptr<double>(y), *mx = tx.ptr<double>(y), *my = ty.ptr<double>(y);
-      float* o = out.ptr<float>(y);
-      for (int x = 0; x < m.cols; ++x) {
-        const double n = n0[x];
-        if (!(n > 0.5)) continue;
-        const double cx = nx[x] / n, cy = ny[x] / n;  // the support's centroid
-        const double cuu = nxx[x] / n - cx * cx, cvv = nyy[x] / n - cy * cy, cuv = nxy[x] / n - cx * cy;
-        const double mean = m0[x] / n;
-        const double du = mx[x] / n - mean * cx, dv = my[x] / n - mean * cy;
-        const double det = cuu * cvv - cuv * cuv;
-        double value = mean;
-        // A plane where the support spreads over at least a tenth of the box's extent each way.
-        if (det > 0.01 * full * full && cuu > 0.01 * full && cvv > 0.01 * full) {
-          const double gu = (cvv * du - cuv * dv) / det, gv = (cuu * dv - cuv * du) / det;
-          value = mean + gu * (x - cx) + gv * (y - cy);
-        }
-        o[x] = static_cast<float>(value);
-      }
+    double v = 0, vx = 0, vxx = 0, mm = 0, mx = 0;
+    auto step = [&](int x, double sign) {
+      const double fx = x, sv = sign * vm[static_cast<size_t>(x)], sm = sign * vm[W + static_cast<size_t>(x)];
+      v += sv;
+      vx += sv * fx;
+      vxx += sv * fx * fx;
+      mm += sm;
+      mx += sm * fx;
+    };
+    for (int x = 0; x < std::min(r, w); ++x) step(x, 1.0);
+    for (int x = 0; x < w; ++x) {
+      if (x + r < w) step(x + r, 1.0);
+      if (x - r - 1 >= 0) step(x - r - 1, -1.0);
+      const size_t i = static_cast<size_t>(x);
+      rows[kV * W + i] = v;
+      rows[kVx * W + i] = vx;
+      rows[kVxx * W + i] = vxx;
+      rows[kM * W + i] = mm;
+      rows[kMx * W + i] = mx;
     }
-    return out;
+  };
+  // Row y entering (sign 1) or leaving (-1) the column sums.
+  auto column_step = [&](int y, double sign) {
+    row_sums(y);
+    const double fy = y, fyy = fy * fy;
+    for (size_t i = 0; i < W; ++i) {
+      const double v = sign * rows[kV * W + i], vx = sign * rows[kVx * W + i], mm = sign * rows[kM * W + i];
+      acc[kS0 * W + i] += v;
+      acc[kSx * W + i] += vx;
+      acc[kSxx * W + i] += sign * rows[kVxx * W + i];
+      acc[kSy * W + i] += fy * v;
+      acc[kSyy * W + i] += fyy * v;
+      acc[kSxy * W + i] += fy * vx;
+      acc[kT0 * W + i] += mm;
+      acc[kTx * W + i] += sign * rows[kMx * W + i];
+      acc[kTy * W + i] += fy * mm;
+    }
+  };
+  const double full = r * (r + 1) / 3.0;  // the full box's variance along each axis
+  cv::Mat out(m.size(), CV_32FC1, cv::Scalar(0.0f));
+  for (int y = 0; y < std::min(r, h); ++y) column_step(y, 1.0);
+  for (int y = 0; y < h; ++y) {
+    if (y + r < h) column_step(y + r, 1.0);
+    if (y - r - 1 >= 0) column_step(y - r - 1, -1.0);
+    float* o = out.ptr<float>(y);
+    for (int x = 0; x < w; ++x) {
+      const size_t i = static_cast<size_t>(x);
+      const double n = acc[kS0 * W + i];
+      if (!(n > 0.5)) continue;
+      const double in = 1.0 / n;
+      const double cx = acc[kSx * W + i] * in, cy = acc[kSy * W + i] * in;  // the support's centroid
+      const double cuu = acc[kSxx * W + i] * in - cx * cx, cvv = acc[kSyy * W + i] * in - cy * cy,
+                   cuv = acc[kSxy * W + i] * in - cx * cy;
+      const double mean = acc[kT0 * W + i] * in;
+      const double du = acc[kTx * W + i] * in - mean * cx, dv = acc[kTy * W + i] * in - mean * cy;
+      const double det = cuu * cvv - cuv * cuv;
+      double value = mean;
+      // A plane where the support spreads over at least a tenth of the box's extent each way.
+      if (det > 0.01 * full * full && cuu > 0.01 * full && cvv > 0.01 * full) {
+        const double gu = (cvv * du - cuv * dv) / det, gv = (cuu * dv - cuv * du) / det;
+        value = mean + gu * (x - cx) + gv * (y - cy);
+      }
+      o[x] = static_cast<float>(value);
+    }
   }
-
- private:
-  cv::Mat box(const cv::Mat& a) const {
-    cv::Mat out;
-    cv::boxFilter(a, out, CV_64F, k_, cv::Point(-1, -1), false, cv::BORDER_CONSTANT);
-    return out;
-  }
-  cv::Size k_;
-  int r_;
-  cv::Mat v_, x_, y_, s0_, sx_, sy_, sxx_, syy_, sxy_;
-};
+  return out;
+}
 
 }  // namespace
 
 cv::Mat local_plane_level(const cv::Mat& m, const cv::Mat& support, int r) {
   check(m, support, r);
-  return LocalPlane(support, r).fit(m);
+  return fit_local_plane(m, support, r);
 }
 
 // The box (half-width r) blurs the level by r (r + 1) / 6 times its Laplacian: the simulator's
@@ -98,9 +120,8 @@ cv::Mat local_plane_level(const cv::Mat& m, const cv::Mat& support, int r) {
 // inside the image, the second-order one at its border.
 cv::Mat settled_light_level(const cv::Mat& mean, const cv::Mat& support, int r) {
   check(mean, support, r);
-  const LocalPlane plane(support, r);
-  const cv::Mat p = plane.fit(mean);
-  const cv::Mat pp = plane.fit(p);
+  const cv::Mat p = fit_local_plane(mean, support, r);
+  const cv::Mat pp = fit_local_plane(p, support, r);
   cv::Mat out = p.clone();
   for (int y = 0; y < mean.rows; ++y) {
     const float *a = p.ptr<float>(y), *b = pp.ptr<float>(y);

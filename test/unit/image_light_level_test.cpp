@@ -2,6 +2,7 @@
 // reproduced exactly at the image's border and beside holes, where a box's mean is off by the
 // slope times the valid pixels' offset; a quadratic is reproduced inside the image to the
 // fourth-order term, where a box's mean is off by its variance times the curvature.
+#include <algorithm>
 #include <cmath>
 
 #include <gtest/gtest.h>
@@ -80,6 +81,58 @@ TEST(LightLevel, ACurvedLevelIsSharpenedInside) {
   EXPECT_LT(worst(settled_light_level(truth, support, kR), truth, inside), 0.01 * box_error);
   // ... and at the border the plane's second-order term is left, less than the box's.
   EXPECT_LT(worst(settled_light_level(truth, support, kR), truth, support), box_error);
+}
+
+// The least-squares plane over each box, summed pixel by pixel in double (centred moments): the
+// reference for local_plane_level's running sums, on a level with no structure (every pixel
+// its own value), a support with holes and borders, and boxes wider than the image.
+cv::Mat brute_force_plane(const cv::Mat& m, const cv::Mat& support, int r) {
+  cv::Mat out(m.size(), CV_32FC1, cv::Scalar(0.0f));
+  const double full = r * (r + 1) / 3.0;
+  for (int y = 0; y < m.rows; ++y)
+    for (int x = 0; x < m.cols; ++x) {
+      double n = 0, sx = 0, sy = 0, sm = 0;
+      auto each = [&](auto f) {
+        for (int v = std::max(0, y - r); v <= std::min(m.rows - 1, y + r); ++v)
+          for (int u = std::max(0, x - r); u <= std::min(m.cols - 1, x + r); ++u)
+            if (support.at<uint8_t>(v, u)) f(u, v, static_cast<double>(m.at<float>(v, u)));
+      };
+      each([&](int u, int v, double a) {
+        n += 1;
+        sx += u;
+        sy += v;
+        sm += a;
+      });
+      if (n < 0.5) continue;
+      const double cx = sx / n, cy = sy / n, mean = sm / n;
+      double cuu = 0, cvv = 0, cuv = 0, du = 0, dv = 0;
+      each([&](int u, int v, double a) {
+        cuu += (u - cx) * (u - cx) / n;
+        cvv += (v - cy) * (v - cy) / n;
+        cuv += (u - cx) * (v - cy) / n;
+        du += (a - mean) * (u - cx) / n;
+        dv += (a - mean) * (v - cy) / n;
+      });
+      const double det = cuu * cvv - cuv * cuv;
+      double value = mean;
+      if (det > 0.01 * full * full && cuu > 0.01 * full && cvv > 0.01 * full)
+        value = mean + ((cvv * du - cuv * dv) * (x - cx) + (cuu * dv - cuv * du) * (y - cy)) / det;
+      out.at<float>(y, x) = static_cast<float>(value);
+    }
+  return out;
+}
+
+TEST(LightLevel, TheRunningSumsAreTheLeastSquaresPlaneOfEachBox) {
+  cv::RNG rng(5);
+  for (const int r : {1, 3, 8, 40}) {
+    cv::Mat m(37, 29, CV_32FC1);
+    rng.fill(m, cv::RNG::UNIFORM, 0.0, 255.0);
+    cv::Mat support(m.size(), CV_8UC1);
+    rng.fill(support, cv::RNG::UNIFORM, 0, 4);  // a quarter of the pixels left out
+    support(cv::Rect(0, 0, 29, 3)).setTo(0);  // no support along the top
+    const cv::Mat ref = brute_force_plane(m, support, r);
+    EXPECT_LT(cv::norm(local_plane_level(m, support, r), ref, cv::NORM_INF), 1e-3) << "r " << r;
+  }
 }
 
 TEST(LightLevel, BadInputIsRefused) {
