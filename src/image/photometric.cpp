@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <future>
+#include <initializer_list>
 #include <string>
 #include <vector>
 
@@ -27,10 +29,10 @@ constexpr int kOwnVarianceFrames = kPhotometricSettledFrames;
 // edge of the light.
 constexpr double kMaxRelativeSpread = 2.0;
 
-// The q-quantile (0..1) of m's values where mask is non-zero (0 when none).
+// The q-quantiles (0..1) of m's values where mask is non-zero (0 when none), in qs' order.
 // The maps it is used on are box-smoothed, so on large images every 4th row and column says the
 // same (a sixteenth of the work of a refit's sorting).
-double masked_quantile(const cv::Mat& m, const cv::Mat& mask, double q) {
+std::vector<double> masked_quantiles(const cv::Mat& m, const cv::Mat& mask, std::initializer_list<double> qs) {
   const int step = m.total() > 100000 ? 4 : 1;
   std::vector<float> v;
   v.reserve(m.total() / static_cast<size_t>(step * step) + 1);
@@ -40,19 +42,33 @@ double masked_quantile(const cv::Mat& m, const cv::Mat& mask, double q) {
     for (int c = 0; c < m.cols; c += step)
       if (k[c]) v.push_back(a[c]);
   }
-  if (v.empty()) return 0.0;
-  auto at = v.begin() + static_cast<std::ptrdiff_t>(q * static_cast<double>(v.size() - 1));
-  std::nth_element(v.begin(), at, v.end());
-  return *at;
+  std::vector<double> out;
+  for (const double q : qs) {
+    if (v.empty()) {
+      out.push_back(0.0);
+      continue;
+    }
+    auto at = v.begin() + static_cast<std::ptrdiff_t>(q * static_cast<double>(v.size() - 1));
+    std::nth_element(v.begin(), at, v.end());
+    out.push_back(*at);
+  }
+  return out;
+}
+
+// The count of valid pixels (valid01: 1 or 0) in each pixel's (2r + 1)^2 box (edges: the box
+// clipped): masked_box's denominator, the same for every image boxed with one radius.
+cv::Mat box_count(const cv::Mat& valid01, int r) {
+  cv::Mat den;
+  cv::boxFilter(valid01, den, CV_32F, cv::Size(2 * r + 1, 2 * r + 1), cv::Point(-1, -1), false, cv::BORDER_CONSTANT);
+  return den;
 }
 
 // The mean of m over the valid pixels in a (2r + 1)^2 box (edges: the box clipped), 0 where
-// the box holds none.
-cv::Mat masked_box(const cv::Mat& m, const cv::Mat& valid01, int r) {
-  cv::Mat num, den;
+// the box holds none. den: box_count(valid01, r).
+cv::Mat masked_box(const cv::Mat& m, const cv::Mat& valid01, const cv::Mat& den, int r) {
+  cv::Mat num;
   const cv::Size k(2 * r + 1, 2 * r + 1);
   cv::boxFilter(m.mul(valid01), num, CV_32F, k, cv::Point(-1, -1), false, cv::BORDER_CONSTANT);
-  cv::boxFilter(valid01, den, CV_32F, k, cv::Point(-1, -1), false, cv::BORDER_CONSTANT);
   cv::Mat out(m.size(), CV_32FC1);
   for (int y = 0; y < m.rows; ++y) {
     const float* n = num.ptr<float>(y);
@@ -99,21 +115,25 @@ PhotometricFit fit_photometric(const cv::Mat& mean, const cv::Mat& square, const
   // used for the gain: on a tilted camera it changes over the image with the ground's scale in
   // it, which no correction should undo.)
   const int radius = o.radius > 0 ? o.radius : std::max(1, (mean.cols + 20) / 40);
-  const cv::Mat m = masked_box(mean, valid01, radius);
+  const cv::Mat den = box_count(valid01, radius);
+  const cv::Mat m = masked_box(mean, valid01, den, radius);
   // The floor's contrast as the pixel sees it: the spread of the values over the box and the
-  // frames together (the texture within the box varies from the first frame on).
-  const cv::Mat own_var = cv::max(square - mean.mul(mean), 0.0f);
-  const cv::Mat q = masked_box(square, valid01, radius);
-  cv::Mat sd;
-  cv::sqrt(cv::max(q - m.mul(m), 0.0f), sd);
-  cv::Mat rel(mean.size(), CV_32FC1, cv::Scalar(0.0f));
-  for (int y = 0; y < mean.rows; ++y)
-    for (int x = 0; x < mean.cols; ++x) {
-      const float mm = m.at<float>(y, x);
-      rel.at<float>(y, x) = mm > 0 ? sd.at<float>(y, x) / mm : 0.0f;
-    }
-  const double mean_ref = masked_quantile(m, valid, 0.5);
-  const double rel_ref = masked_quantile(rel, valid, 0.5);
+  // frames together (the texture within the box varies from the first frame on), relative to
+  // the level.
+  const cv::Mat q = masked_box(square, valid01, den, radius);
+  cv::Mat rel(mean.size(), CV_32FC1);
+  for (int y = 0; y < mean.rows; ++y) {
+    const float *mm = m.ptr<float>(y), *qq = q.ptr<float>(y);
+    float* rr = rel.ptr<float>(y);
+    for (int x = 0; x < mean.cols; ++x) rr[x] = mm[x] > 0 ? std::sqrt(std::max(qq[x] - mm[x] * mm[x], 0.0f)) / mm[x] : 0.0f;
+  }
+  const std::vector<double> m_quantiles = masked_quantiles(m, valid, {0.5, 0.1, 0.9});
+  const double mean_ref = m_quantiles[0];
+  const double rel_ref = masked_quantiles(rel, valid, {0.5})[0];
+  // The pixel's own spread over the frames (once they are enough to say, and for the settled level).
+  const bool settled = frames >= kPhotometricSettledFrames;
+  cv::Mat own_var;
+  if (settled || frames >= kOwnVarianceFrames) own_var = cv::max(square - mean.mul(mean), 0.0f);
   PhotometricFit f;
   f.frames = frames;
   f.mean_ref = mean_ref;
@@ -124,7 +144,7 @@ PhotometricFit fit_photometric(const cv::Mat& mean, const cv::Mat& square, const
   // smoothed over 5 x 5 pixels, so that it marks regions, not single noisy pixels.
   const bool own = frames >= kOwnVarianceFrames;
   cv::Mat own_sd;
-  if (own) cv::sqrt(masked_box(own_var, valid01, 2), own_sd);
+  if (own) cv::sqrt(masked_box(own_var, valid01, box_count(valid01, 2), 2), own_sd);
   // No value (each test on smoothed statistics, so that it marks regions: the pyramid leaves
   // out every coarse pixel that has one fine pixel without a value, so scattered holes would
   // empty the coarse levels):
@@ -169,8 +189,7 @@ PhotometricFit fit_photometric(const cv::Mat& mean, const cv::Mat& square, const
   // 10 frames, 0.032 at 29) and leaves up to 3 % of the pixels without a value (anti_skid_tiles
   // at 10-15 frames): the spread allowed grows as sqrt(40 / frames), and the pixels without a
   // value do not count. A lamp's falloff or a shadow spreads it by 0.3-0.7.
-  const double m_spread = masked_quantile(m, valid, 0.9) - masked_quantile(m, valid, 0.1);
-  const bool settled = frames >= kPhotometricSettledFrames;
+  const double m_spread = m_quantiles[2] - m_quantiles[1];
   const double allowed = o.uniform_spread * (settled ? 1.0 : std::sqrt(40.0 / std::max(frames, 1)));
   f.uniform = m_spread < allowed * mean_ref && (!settled || f.unusable < 0.005);
   if (f.uniform && !needed) {
@@ -431,6 +450,18 @@ struct PhotometricModel::Impl {
   bool has_known = false;
   int frames = 0, frames_at_fit = 0;
   long revision = 0;
+  // A refit in the background (start_refit): the statistics' copy it reads and its result.
+  std::future<PhotometricFit> pending;
+
+  // Waits for a refit in the background and forgets it, its error too: what it would have fitted
+  // is no longer wanted.
+  void drop_pending() {
+    if (!pending.valid()) return;
+    try {
+      pending.get();
+    } catch (...) {  // NOLINT(bugprone-empty-catch): the dropped refit's error is not the caller's
+    }
+  }
 
   Impl(ocl::Runtime& r, const cv::Mat& v, const PhotometricOptions& o)
       : rt(r), options(o), valid(v.clone()), width(v.cols), height(v.rows) {}
@@ -463,7 +494,9 @@ PhotometricModel::PhotometricModel(ocl::Runtime& runtime, const cv::Mat& valid,
   reset();
 }
 
-PhotometricModel::~PhotometricModel() = default;
+PhotometricModel::~PhotometricModel() {
+  if (impl_) impl_->drop_pending();
+}
 
 const PhotometricOptions& PhotometricModel::options() const { return impl_->options; }
 const cl::Buffer& PhotometricModel::model() const { return impl_->model; }
@@ -490,17 +523,53 @@ bool PhotometricModel::refit_due(bool needed) const {
 
 void PhotometricModel::refit(bool needed) {
   Impl& m = *impl_;
+  m.drop_pending();
+  start_refit(needed);
+  take_refit();
+}
+
+void PhotometricModel::start_refit(bool needed) {
+  Impl& m = *impl_;
+  if (m.pending.valid()) return;
   cv::Mat mean(m.height, m.width, CV_32FC1), square(m.height, m.width, CV_32FC1);
   const size_t bytes = m.plane() * sizeof(float);
+  cl::Event read;
   try {
-    m.rt.queue().enqueueReadBuffer(m.stats, CL_TRUE, 0, bytes, mean.ptr<float>());
-    m.rt.queue().enqueueReadBuffer(m.stats, CL_TRUE, bytes, bytes, square.ptr<float>());
-    m.upload(fit_photometric(mean, square, m.valid, m.frames, m.options, needed));
+    m.rt.queue().enqueueReadBuffer(m.stats, CL_FALSE, 0, bytes, mean.ptr<float>());
+    m.rt.queue().enqueueReadBuffer(m.stats, CL_FALSE, bytes, bytes, square.ptr<float>(), nullptr, &read);
+    m.rt.queue().flush();  // the worker waits for the read; it must reach the device
   } catch (const cl::Error& e) {
     throw Error(ErrorCode::OpenCL, std::string("photometric model: refit failed: ") + e.what() +
                                        " " + ocl::error_name(e.err()));
   }
+  // The worker holds its own copies (cv::Mat shares, the options and counts are copied): the
+  // model may be moved on, reset or destroyed before it ends (the destructor and reset wait).
+  m.pending = std::async(std::launch::async, [read, mean, square, valid = m.valid, frames = m.frames,
+                                             options = m.options, needed]() mutable {
+    try {
+      read.wait();  // in-order queue: both reads are done
+    } catch (const cl::Error& e) {
+      throw Error(ErrorCode::OpenCL, std::string("photometric model: reading the statistics failed: ") +
+                                         e.what() + " " + ocl::error_name(e.err()));
+    }
+    return fit_photometric(mean, square, valid, frames, options, needed);
+  });
   m.frames_at_fit = m.frames;
+}
+
+bool PhotometricModel::refit_pending() const { return impl_->pending.valid(); }
+
+bool PhotometricModel::take_refit() {
+  Impl& m = *impl_;
+  if (!m.pending.valid()) return false;
+  PhotometricFit fit = m.pending.get();  // rethrows the worker's error; pending is then empty
+  try {
+    m.upload(fit);
+  } catch (const cl::Error& e) {
+    throw Error(ErrorCode::OpenCL, std::string("photometric model: uploading a refit failed: ") + e.what() +
+                                       " " + ocl::error_name(e.err()));
+  }
+  return true;
 }
 
 void PhotometricModel::set(const PhotometricFit& fit) {
@@ -516,6 +585,7 @@ void PhotometricModel::set(const PhotometricFit& fit) {
 
 void PhotometricModel::reset() {
   Impl& m = *impl_;
+  m.drop_pending();
   m.frames = m.frames_at_fit = 0;
   try {
     // A write, not clEnqueueFillBuffer: OpenCL 1.1 devices have none.

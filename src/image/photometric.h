@@ -171,8 +171,20 @@ class PhotometricModel {
   // least 4) since the last fit; or, when the model is `needed` (the caller sees the light hold
   // its alignments), at least min_frames frames and one more since the last fit.
   bool refit_due(bool needed = false) const;
-  // Reads the statistics back (blocking), fits (fit_photometric) and uploads the model.
+  // Reads the statistics back (blocking), fits (fit_photometric) and uploads the model. A refit
+  // started in the background is dropped first.
   void refit(bool needed = false);
+  // A refit off the caller's thread: the statistics as learnt so far are read back (enqueued on
+  // the queue now, so later learning does not enter them) and fitted on a worker thread, while
+  // the caller goes on with its frames; the model in use does not change until take_refit(). A
+  // refit started counts as the last fit for refit_due(). Does nothing while one is pending.
+  void start_refit(bool needed = false);
+  // A refit started and not yet taken.
+  bool refit_pending() const;
+  // Waits for the started refit (rethrowing its error) and uploads its model. False (nothing
+  // changed) when none was pending. The caller decides when, by its own frame count, so that
+  // tracking is the same however fast the worker thread was.
+  bool take_refit();
   // Uses a known model (and stops learning); its size must be the image's.
   void set(const PhotometricFit& fit);
   // The model in use.
@@ -180,7 +192,8 @@ class PhotometricModel {
   // Counts the models put in use (each refit, set and reset): what was made from fit() is stale
   // when it changed.
   long revision() const;
-  // Forgets the statistics; back to the identity (or the known model given with set()).
+  // Forgets the statistics (and a pending refit); back to the identity (or the known model given
+  // with set()).
   void reset();
 
  private:
