@@ -14,6 +14,7 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "image/photometric.h"
 #include "image/pipeline.h"
 #include "image/rolling_shutter.h"
 #include "ocl/runtime.h"
@@ -109,6 +110,44 @@ void rolling_shutter_rows(ocl::Runtime& rt, const ImagePipelineOptions& opt, int
 
 }  // namespace
 
+// The photometric model's fit on the host (fit_photometric, what a refit runs beside the
+// tracking): statistics of a lamp's falloff over a texture, young (before the statistics
+// settle) and settled, with and without the light.
+static void photometric_fit(int frames) {
+  std::printf("\nphotometric fit on the host (fit_photometric), median ms\n%-9s %8s %8s %8s %8s\n", "size",
+              "young", "settled", "young,even", "settled,even");
+  const int sizes[][2] = {{640, 480}, {320, 240}};
+  for (const auto& s : sizes) {
+    const int w = s[0], h = s[1];
+    cv::Mat texture(h, w, CV_32FC1), lamp(h, w, CV_32FC1);
+    cv::randu(texture, 40.0, 200.0);
+    cv::GaussianBlur(texture, texture, cv::Size(0, 0), 2.0);
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x) {
+        const double r2 = (std::pow(x - 0.5 * w, 2) + std::pow(y - 0.5 * h, 2)) / (0.25 * w * w);
+        lamp.at<float>(y, x) = static_cast<float>(1.0 / (1.0 + r2));
+      }
+    const cv::Mat valid(h, w, CV_8UC1, cv::Scalar(255));
+    double t[4];
+    for (int c = 0; c < 4; ++c) {
+      const cv::Mat mean = c < 2 ? cv::Mat(texture.mul(lamp)) : texture;
+      const cv::Mat square = mean.mul(mean) + 25.0f;
+      const int n = c % 2 ? 2 * kPhotometricSettledFrames : kPhotometricFirstFitFrames;
+      std::vector<double> ms;
+      for (int k = 0; k < std::max(5, frames / 20); ++k) {
+        const double t0 = now_ms();
+        const PhotometricFit f = fit_photometric(mean, square, valid, n, PhotometricOptions());
+        ms.push_back(now_ms() - t0);
+        if (f.scale.empty()) std::abort();
+      }
+      t[c] = median(ms);
+    }
+    char size[32];
+    std::snprintf(size, sizeof size, "%dx%d", w, h);
+    std::printf("%-9s %8.2f %8.2f %8.2f %8.2f\n", size, t[0], t[1], t[2], t[3]);
+  }
+}
+
 int main(int argc, char** argv) {
   int frames = 200;
   ImagePipelineOptions opt;
@@ -177,5 +216,6 @@ int main(int argc, char** argv) {
               "of their per-frame sums;\npipeline: median of process() + finish() with no stage "
               "boundaries; C++ ref: pipeline_reference, single-threaded.\n");
   rolling_shutter_rows(rt, opt, frames);
+  photometric_fit(frames);
   return 0;
 }

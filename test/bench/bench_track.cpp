@@ -2,8 +2,10 @@
 //   bench_track kernel   [width height]   the fused pass per work-group shape / pixels per
 //                                          work-item / lanes / fast math, median ms per pass
 //   bench_track kernel w h wx wy pix hist fast lanes [rounds]   one configuration
-//   bench_track speed [w h] [seconds] [rounds] [configs] [scenes]   ms per frame through the camera-frame API
-//                                          (median, mean, and the p99 and maximum over the median)
+//   bench_track speed [w h] [seconds] [rounds] [configs] [scenes] [paced]   ms per frame through the
+//                                          camera-frame API (median, mean, and the p99 and maximum over
+//                                          the median); paced=1 hands each frame at its time (the
+//                                          camera's 30 fps) instead of as soon as the last returned
 //   bench_track accuracy [key=value...]     simulated sequences tracked against ground truth
 //       (seconds, w, h, seed, motion=mixed|straight|circle|spin, levels, finest, refine_kf, conv,
 //        huber, overlap, maxit=l0,l1,.., textures=a.png,b.png or textures=all,
@@ -30,6 +32,7 @@
 #include <cstdlib>
 #include <memory>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include <sys/resource.h>
@@ -700,7 +703,7 @@ struct SpeedStats {
 void speed_table(ocl::Runtime& rt, const std::string& scene, const sim::Options& so, const sim::Trajectory& traj,
                  const std::vector<cv::Mat>& global_frames, const sim::Options* rolling,
                  const std::vector<cv::Mat>* rolling_frames, const std::vector<SpeedConfig>& configs, int rounds,
-                 std::vector<SpeedStats>* out) {
+                 bool paced, std::vector<SpeedStats>* out) {
   std::vector<SpeedStats>& stats = *out;
   stats.assign(configs.size(), SpeedStats());
   for (int round = 0; round < rounds; ++round)
@@ -708,7 +711,11 @@ void speed_table(ocl::Runtime& rt, const std::string& scene, const sim::Options&
       if (configs[c].shutter && !rolling_frames) continue;
       const std::vector<cv::Mat>& frames = configs[c].shutter ? *rolling_frames : global_frames;
       track::Tracker tracker(rt, configs[c].shutter == 1 ? rolling->camera : so.camera, so.extrinsics, configs[c].opt);
+      const auto start = std::chrono::steady_clock::now();
       for (size_t k = 0; k < frames.size(); ++k) {
+        if (paced)  // the frame handed at its time, as a camera would
+          std::this_thread::sleep_until(start + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                                                    std::chrono::duration<double>(traj.t[k] - traj.t[0])));
         const double c0 = cpu_ms();
         const track::FrameResult r = tracker.track(frames[k].data, frames[k].cols, frames[k].rows, frames[k].step, traj.t[k]);
         if (k == 0) continue;  // the first frame builds the pipeline
@@ -735,8 +742,9 @@ void speed_table(ocl::Runtime& rt, const std::string& scene, const sim::Options&
       }
     }
   std::printf("\nscene %s: %dx%d, %zu frames x %d rounds, camera-frame API (upload, undistortion, pyramid, "
-              "tracking); rms_mm: per-frame translation error against the truth\n",
-              scene.c_str(), so.camera.width, so.camera.height, global_frames.size(), rounds);
+              "tracking)%s; rms_mm: per-frame translation error against the truth\n",
+              scene.c_str(), so.camera.width, so.camera.height, global_frames.size(), rounds,
+              paced ? ", frames handed at the camera's rate" : ", frames handed back to back");
   std::printf("%-28s %9s %9s %9s %9s %9s %8s %7s %7s %7s %8s %5s\n", "configuration", "med_frame", "mean_frame",
               "med_pipe", "med_track", "cpu/frame", "passes", "fps", "p99/md", "max/md", "rms_mm", "lost");
   for (size_t c = 0; c < configs.size(); ++c) {
@@ -786,7 +794,7 @@ double ecc_median_ms(const sim::Options& so, const std::vector<cv::Mat>& frames,
 }
 
 int bench_speed(int width, int height, double seconds, int rounds, const std::string& only,
-                const std::string& scene_names) {
+                const std::string& scene_names, bool paced) {
   ocl::Runtime rt;
   std::printf("device: %s\n", rt.device_info().device_name.c_str());
   const std::vector<SpeedConfig> all = speed_configs();
@@ -823,9 +831,9 @@ int bench_speed(int width, int height, double seconds, int rounds, const std::st
       sim::Options rolling = so;
       rolling.readout_time = rolling.camera.rolling_shutter_readout = 0.025;
       const std::vector<cv::Mat> rolling_frames = bench::render_sequence(rt, rolling, traj);
-      speed_table(rt, scenes[i].name, so, traj, frames, &rolling, &rolling_frames, run, rounds, &stats);
+      speed_table(rt, scenes[i].name, so, traj, frames, &rolling, &rolling_frames, run, rounds, paced, &stats);
     } else {
-      speed_table(rt, scenes[i].name, so, traj, frames, nullptr, nullptr, run, rounds, &stats);
+      speed_table(rt, scenes[i].name, so, traj, frames, nullptr, nullptr, run, rounds, paced, &stats);
     }
     const double ecc = ecc_median_ms(so, frames, 20);
     const double def = tail(stats[0].frame).median;
@@ -854,10 +862,10 @@ int main(int argc, char** argv) {
     return bench_kernel(w, h, only, argc > 10 ? std::atoi(argv[10]) : 6);
   }
   if (mode == "speed") {
-    // bench_track speed [w h] [seconds] [rounds]
+    // bench_track speed [w h] [seconds] [rounds] [configs] [scenes] [paced]
     const int w = argc > 3 ? std::atoi(argv[2]) : 640, h = argc > 3 ? std::atoi(argv[3]) : 480;
     return bench_speed(w, h, argc > 4 ? std::atof(argv[4]) : 5.0, argc > 5 ? std::atoi(argv[5]) : 3,
-                       argc > 6 ? argv[6] : "", argc > 7 ? argv[7] : "");
+                       argc > 6 ? argv[6] : "", argc > 7 ? argv[7] : "", argc > 8 && std::atoi(argv[8]) != 0);
   }
   if (mode == "accuracy") {
     // bench_track accuracy [key=value ...]: seconds=10 w=640 h=480 levels=4 finest=0
@@ -990,7 +998,7 @@ int main(int argc, char** argv) {
       }
     return bench_nees(tex, configs, sizes, finests, seconds, seed, noise, topt);
   }
-  std::fprintf(stderr, "usage: bench_track kernel [w h [wx wy pix hist fast [rounds]]] | speed [w h [seconds [rounds]]]"
+  std::fprintf(stderr, "usage: bench_track kernel [w h [wx wy pix hist fast [rounds]]] | speed [w h [seconds [rounds [configs [scenes [paced]]]]]]"
                        " | accuracy [key=value...] | nees [key=value...]\n");
   return 2;
 }
