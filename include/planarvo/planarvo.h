@@ -833,7 +833,9 @@ typedef struct planarvo_camera_calibration_result {
   planarvo_calibration_result graph;        /* stage 3 (x, y, scale = height, yaw) */
   int32_t frames, frames_ok, frames_degraded, frames_lost, samples;
   double tracking_median_ms; /* engine time per frame in stage 2 */
-  /* Wall seconds: image decoding (data sets), roll and pitch, tracking, graph, all. */
+  /* Wall seconds: waiting for images (data sets: each is decoded while the one before is
+   * processed, so this is the decoding the processing did not hide), roll and pitch, tracking,
+   * graph, all. */
   double seconds_decode, seconds_roll_pitch, seconds_tracking, seconds_graph, seconds_total;
   /* The rolling shutter's readout time, seconds: what roll and pitch and the tracking used
    * (readout), and its estimate from the drive with its standard deviation when one was made

@@ -103,7 +103,7 @@ struct PipelineReport {
     double median_ms = 0.0;   // per frame
   } tracking;
   struct Timings {            // wall seconds per stage
-    double decode = 0.0;      // reading and decoding images (calibrate_dataset)
+    double decode = 0.0;      // waiting for images (calibrate_dataset; io::Dataset reads ahead)
     double roll_pitch = 0.0;  // stage 1: its tracker and the joint alignment
     double readout = 0.0;     // the readout time's estimate
     double tracking = 0.0;    // stage 2

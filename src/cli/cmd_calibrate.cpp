@@ -117,7 +117,7 @@ int cmd_calibrate_dataset(const Args& args, const planarvo_calibration_options& 
   else if (r.readout_evaluations > 0 || r.readout_reason[0] != 0)
     std::printf("rolling shutter: the readout time could not be estimated (%s); %.2f ms used\n", r.readout_reason,
                 r.readout * 1e3);
-  std::printf("time: %.2f s in all (%.2f s reading images)\n", r.seconds_total, r.seconds_decode);
+  std::printf("time: %.2f s in all (%.2f s waiting for images)\n", r.seconds_total, r.seconds_decode);
   if (st == PLANARVO_OK || r.status == PLANARVO_CALIBRATION_UNOBSERVABLE) print_result(r);
   if (st == PLANARVO_ERROR_FAILED) {
     std::fprintf(stderr, "planarvo calibrate: %s\n", r.reason);

@@ -90,7 +90,9 @@ class Dataset {
   // Images that are not 8-bit (16-bit PNG or TIFF, float) are rejected with Error(InvalidInput),
   // as are missing or undecodable files and frames of the wrong size. Decoding is not cached
   // for image files; for a video, the last few decoded frames are (see dataset.cpp on the cost
-  // of reading a video out of order). Not safe to call from two threads at once.
+  // of reading a video out of order). Image files are read ahead: while frames are asked for in
+  // order, the next one is decoded on a worker thread (its error, if any, thrown when it is asked
+  // for). Not safe to call from two threads at once.
   cv::Mat frame(int64_t i);
 
   // Odometry (odometry.txt) and ground truth (groundtruth.txt) interpolated to frame i's time;

@@ -99,6 +99,37 @@ TEST(IoDataset, OpensImagesAndReadsFrames) {
   EXPECT_EQ(moved.frame_count(), 4);
 }
 
+// Image files are read ahead while frames are asked for in order: the frames are the files'
+// whatever the order of the calls (in order, repeated, backwards, skipping), and an undecodable
+// file's error comes when its frame is asked for, not when the one before it is.
+TEST(IoDataset, ReadingAheadGivesTheFramesInAnyOrder) {
+  ScratchDir dir;
+  make_dataset(dir.path());
+  Dataset ds(dir.path().string());
+  for (const int64_t i : {0, 1, 2, 3, 3, 2, 0, 1, 3, 0, 2}) {
+    const cv::Mat f = ds.frame(i);
+    ASSERT_EQ(f.size(), cv::Size(kW, kH));
+    EXPECT_EQ(cv::norm(f, noise_image(static_cast<int>(i)), cv::NORM_INF), 0.0) << i;
+  }
+  write_text(dir / image_name(2), "this is not a PNG file");
+  Dataset bad(dir.path().string());
+  EXPECT_NO_THROW(bad.frame(0));
+  EXPECT_NO_THROW(bad.frame(1));  // frame 2's decoding fails beside it
+  expect_invalid_input([&] { bad.frame(2); }, (dir / image_name(2)).string());
+  EXPECT_EQ(cv::norm(bad.frame(3), noise_image(3), cv::NORM_INF), 0.0);
+  // Dropped unasked: a data set destroyed with frame 2's failing read-ahead pending, and one
+  // that asks for another frame instead.
+  {
+    Dataset dropped(dir.path().string());
+    EXPECT_NO_THROW(dropped.frame(0));
+    EXPECT_NO_THROW(dropped.frame(1));
+  }
+  Dataset skipped(dir.path().string());
+  EXPECT_NO_THROW(skipped.frame(0));
+  EXPECT_NO_THROW(skipped.frame(1));
+  EXPECT_EQ(cv::norm(skipped.frame(3), noise_image(3), cv::NORM_INF), 0.0);
+}
+
 // Encoded images cut short (what a CompressedImage or an image file holds when its bytes stop
 // early): JPEG and PNG as OpenCV writes them, whole and cut at several places.
 TEST(IoImageBytes, CutJpegAndPngAreFoundWholeOnesPass) {
