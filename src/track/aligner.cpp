@@ -50,12 +50,16 @@ const bool kDefaultVariantsRegistered = [] {
           "warp_reduce", WarpReduce::build_options(nparam, kernel_options(AlignerOptions(), stats)), uses);
   }
   // The tracker's pass over a subsampled level (planarvo_tracker_options.level0_subsample; one
-  // program for every block size).
+  // program for every block size): the calibration's tracking stage runs it too (level 1 at 1/4
+  // and level 0 at 1/9 are the tracker's defaults).
   for (int nparam : {kMotionParams, kMotionParams + kAttitudeParams})
     for (bool stats : {false, true}) {
       WarpReduceOptions k = kernel_options(AlignerOptions(), stats);
       k.select_block = 2;
-      ocl::Runtime::register_build_options("warp_reduce", WarpReduce::build_options(nparam, k), {ocl::kUseTrack});
+      ocl::Runtime::register_build_options("warp_reduce", WarpReduce::build_options(nparam, k),
+                                           nparam == kMotionParams
+                                               ? std::vector<std::string>{ocl::kUseTrack, ocl::kUseCalibrate}
+                                               : std::vector<std::string>{ocl::kUseTrack});
     }
   return true;
 }();

@@ -7,10 +7,10 @@ namespace planarvo::track {
 
 namespace {
 
-// The program has no build options; registered for export with the tracker's use (the
-// calibration's tracking stage does not subsample).
+// The program has no build options; registered for export with the tracker's uses (the
+// calibration's tracking stage subsamples too: the tracker's default levels).
 const bool kRegistered = [] {
-  ocl::Runtime::register_build_options("select_pixels", "", {ocl::kUseTrack});
+  ocl::Runtime::register_build_options("select_pixels", "", {ocl::kUseTrack, ocl::kUseCalibrate});
   return true;
 }();
 

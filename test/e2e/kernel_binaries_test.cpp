@@ -299,6 +299,18 @@ TEST_F(KernelBinaries, ExportForTrackIsASubsetThatSufficesForTrack) {
   EXPECT_NE(r.output.find("--for calibrate`"), std::string::npos) << r.output;
 }
 
+// What `--for calibrate` exports is all that calibrate runs (its tracking stage subsamples
+// levels 0 and 1 as the tracker does by default: those passes were once exported for track only).
+TEST_F(KernelBinaries, ExportForCalibrateSufficesForCalibrate) {
+  const std::string dir = path("calibrate-kernels");
+  auto r = run_cli("kernels --export " + dir + " --for calibrate " + compiled());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const std::string out = path("calib-for-calibrate.yaml");
+  r = run_cli(calibrate_args(out) + from_binaries(dir), empty_pocl_cache("for-calibrate"));
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_TRUE(fs::exists(out));
+}
+
 // --for names commands; commands that run no kernels, unknown names, and an export that would
 // load binaries instead of building them are usage errors, caught before any device work.
 TEST(KernelExport, UsageErrorsExitWith2) {
