@@ -22,13 +22,6 @@ LiveCalibration::LiveCalibration(planarvo_context* context, const planarvo_camer
   planarvo_camera_calibration_options_init(&o);
   o.method = PLANARVO_CALIBRATE_ODOMETRY;
   o.height = params.calibration_height;
-  // As `planarvo calibrate`: the camera's motions are far more precise than wheel odometry, so
-  // the odometry's noise model is fitted to the drive's residuals.
-  planarvo_calibration_options graph;
-  planarvo_calibration_options_init(&graph);
-  graph.method = PLANARVO_CALIBRATE_ODOMETRY;
-  graph.estimate_odometry_noise = 1;
-  o.graph = &graph;
   o.tracker = &params.tracker;
   if (planarvo_camera_calibrator_create(context, &camera, &o, &calibrator_) != PLANARVO_OK)
     throw std::runtime_error(std::string("planarvo_camera_calibrator_create: ") + planarvo_last_error());

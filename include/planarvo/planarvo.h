@@ -697,11 +697,14 @@ typedef struct planarvo_calibration_options {
    * (no linear motion) when the odometry's forward speed is below this, else its sign. m/s,
    * default 1e-3; >= 0. */
   double still_speed;
-  /* Odometry method, pairs without an odometry covariance: non-zero fits the odometry's noise model
-   * to the calibration's own residuals (per component along travel, sideways and in heading: a
-   * constant, a part per metre and a part per radian) and solves again, so the covariance reflects
-   * the odometry's actual noise. Default 0 here; planarvo_calibrate_dataset uses 1 when its graph
-   * options are NULL. */
+  /* Odometry method, pairs without an odometry covariance: 1 fits the odometry's noise model to the
+   * calibration's own residuals (per component along travel, sideways and in heading: a constant, a
+   * part per metre and a part per radian) and solves again, so the covariance reflects the
+   * odometry's actual noise; 0 keeps the odometry_sigma_* model. Default -1: the workflow's own
+   * choice, 1 where the camera's motions are tracked from frames (planarvo_calibrate_dataset, the
+   * camera calibrator: the camera's motions are far more precise than wheel odometry, so the
+   * residuals measure the odometry) and 0 for motion pairs given (planarvo_calibrate: a sensor of
+   * unknown precision). Any other negative value is -1, any positive 1. */
   int32_t estimate_odometry_noise;
 } planarvo_calibration_options;
 

@@ -35,7 +35,9 @@ class RobustLoss(enum.IntEnum):
 @dataclass
 class CalibrationOptions:
     """planarvo_calibration_options (the graph calibration); None keeps the library's default.
-    initial: (x, y, scale, yaw) to start from instead of the built-in initialisation."""
+    initial: (x, y, scale, yaw) to start from instead of the built-in initialisation.
+    estimate_odometry_noise: None lets the workflow choose (fitted when the camera's motions are
+    tracked from frames, as calibrate_dataset does; kept as odometry_sigma_* for motion pairs)."""
     method: Optional[CalibrationMethod] = None
     fix_scale: Optional[bool] = None
     fixed_scale: Optional[float] = None

@@ -131,7 +131,9 @@ planarvo::calib::PipelineOptions pipeline_options_from_c(const planarvo_camera_c
           "planarvo_camera_calibration_options: roll and pitch not estimated needs has_initial");
   planarvo::calib::PipelineOptions po;
   planarvo_calibration_options graph_read;
-  if (o.graph) po.graph = planarvo::capi::calibration_options_from_c(o.graph, &graph_read);
+  if (o.graph)
+    po.graph = planarvo::capi::calibration_options_from_c(
+        o.graph, &graph_read, planarvo::calib::PipelineOptions::default_graph_options().estimate_odometry_noise);
   po.graph.method = o.method == PLANARVO_CALIBRATE_ODOMETRY ? planarvo::graph::CalibrationMethod::Odometry
                                                             : planarvo::graph::CalibrationMethod::Nonholonomic;
   po.graph.fix_scale = o.height > 0;

@@ -157,7 +157,8 @@ planarvo::graph::MotionSample read_pair(const planarvo_motion_pair* pairs, size_
 namespace planarvo::capi {
 
 planarvo::graph::CalibrationOptions calibration_options_from_c(const planarvo_calibration_options* options,
-                                                               planarvo_calibration_options* read) {
+                                                               planarvo_calibration_options* read,
+                                                               bool estimate_odometry_noise) {
   planarvo_calibration_options& o = *read;
   planarvo_calibration_options_init(&o);
   if (options) {
@@ -192,7 +193,7 @@ planarvo::graph::CalibrationOptions calibration_options_from_c(const planarvo_ca
   co.loss_scale = o.loss_scale;
   co.gate_sigma = o.gate_sigma;
   co.still_speed = o.still_speed;
-  co.estimate_odometry_noise = o.estimate_odometry_noise != 0;
+  co.estimate_odometry_noise = o.estimate_odometry_noise < 0 ? estimate_odometry_noise : o.estimate_odometry_noise > 0;
   return co;
 }
 
@@ -360,7 +361,7 @@ PLANARVO_API void planarvo_calibration_options_init(planarvo_calibration_options
   o->loss_scale = d.loss_scale;
   o->gate_sigma = d.gate_sigma;
   o->still_speed = d.still_speed;
-  o->estimate_odometry_noise = d.estimate_odometry_noise ? 1 : 0;
+  o->estimate_odometry_noise = -1;  // the workflow's choice (calibration_options_from_c)
 }
 
 PLANARVO_API planarvo_status planarvo_calibrate(const planarvo_motion_pair* pairs, size_t count,
@@ -373,7 +374,7 @@ PLANARVO_API planarvo_status planarvo_calibrate(const planarvo_motion_pair* pair
     planarvo::capi::require_struct_size(result->struct_size, kCalibrationResultEnd, "planarvo_calibration_result");
     require(count > 0 && pairs != nullptr, "planarvo_calibrate: no motion pairs");
     planarvo_calibration_options o;
-    const planarvo::graph::CalibrationOptions co = planarvo::capi::calibration_options_from_c(options, &o);
+    const planarvo::graph::CalibrationOptions co = planarvo::capi::calibration_options_from_c(options, &o, false);
     const size_t stride = motion_pair_stride(pairs);
     std::vector<planarvo::graph::MotionSample> samples;
     samples.reserve(count);

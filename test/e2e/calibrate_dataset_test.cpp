@@ -258,9 +258,17 @@ TEST(CalibrateDataset, StagesAndStreamThroughTheCApiEqualThePipeline) {
   info.struct_size = sizeof info;
   ASSERT_EQ(planarvo_dataset_info_get(ds, &info), PLANARVO_OK);
 
-  // The stream: the same frames, odometry and labels, one at a time.
+  // The stream: the same frames, odometry and labels, one at a time. Its graph options are an
+  // initialised struct where the whole run had none: the defaults are the init function's, so
+  // the odometry's noise is fitted as it is without them (issue 26: a struct passed once lost it).
+  planarvo_calibration_options stream_graph;
+  planarvo_calibration_options_init(&stream_graph);
+  planarvo_camera_calibration_options stream_options;
+  planarvo_camera_calibration_options_init(&stream_options);
+  stream_options.graph = &stream_graph;
   planarvo_camera_calibrator* cal = nullptr;
-  ASSERT_EQ(planarvo_camera_calibrator_create(ctx, &info.camera, nullptr, &cal), PLANARVO_OK) << planarvo_last_error();
+  ASSERT_EQ(planarvo_camera_calibrator_create(ctx, &info.camera, &stream_options, &cal), PLANARVO_OK)
+      << planarvo_last_error();
   for (int64_t i = 0; i < info.frame_count; ++i) {
     planarvo_frame_data fd{};
     ASSERT_EQ(planarvo_dataset_frame_data(ds, i, &fd), PLANARVO_OK);
@@ -292,10 +300,19 @@ TEST(CalibrateDataset, StagesAndStreamThroughTheCApiEqualThePipeline) {
   EXPECT_EQ(static_cast<int>(n), whole.samples);
   planarvo_calibration_options go;
   planarvo_calibration_options_init(&go);
+  EXPECT_EQ(go.estimate_odometry_noise, -1);  // the workflow's choice
+  // Motion pairs given: by default the odometry_sigma_* model is kept, as with 0.
+  planarvo_calibration_result kept{}, zero{};
+  kept.struct_size = zero.struct_size = sizeof kept;
+  ASSERT_EQ(planarvo_calibrate(pairs.data(), n, &go, &kept), PLANARVO_OK) << planarvo_last_error();
+  go.estimate_odometry_noise = 0;
+  ASSERT_EQ(planarvo_calibrate(pairs.data(), n, &go, &zero), PLANARVO_OK) << planarvo_last_error();
+  for (int i = 0; i < 16; ++i) EXPECT_EQ(kept.covariance[i], zero.covariance[i]) << i;
   go.estimate_odometry_noise = 1;
   planarvo_calibration_result g{};
   g.struct_size = sizeof g;
   ASSERT_EQ(planarvo_calibrate(pairs.data(), n, &go, &g), PLANARVO_OK) << planarvo_last_error();
+  EXPECT_NE(g.covariance[0], kept.covariance[0]);  // the fit changes the covariance
   planarvo_extrinsics e{};
   double cov[36];
   int32_t estimated[6];
