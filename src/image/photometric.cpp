@@ -41,12 +41,9 @@ std::vector<double> masked_quantiles(const cv::Mat& m, const cv::Mat& mask, std:
     for (int c = 0; c < m.cols; c += step)
       if (k[c]) v.push_back(a[c]);
   }
+  if (v.empty()) return std::vector<double>(qs.size(), 0.0);
   std::vector<double> out;
   for (const double q : qs) {
-    if (v.empty()) {
-      out.push_back(0.0);
-      continue;
-    }
     auto at = v.begin() + static_cast<std::ptrdiff_t>(q * static_cast<double>(v.size() - 1));
     std::nth_element(v.begin(), at, v.end());
     out.push_back(*at);

@@ -117,7 +117,7 @@ void PhotometricModel::start_refit(bool needed) {
   // The worker holds its own copies (cv::Mat shares, the options and counts are copied): the
   // model may be moved on, reset or destroyed before it ends (the destructor and reset wait).
   m.pending = std::async(std::launch::async, [read, mean, square, valid = m.valid, frames = m.frames,
-                                             options = m.options, needed]() mutable {
+                                             options = m.options, needed] {
     try {
       read.wait();  // in-order queue: both reads are done
     } catch (const cl::Error& e) {

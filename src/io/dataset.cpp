@@ -435,7 +435,7 @@ Dataset::Dataset(const std::string& directory, DatasetOptions options) : impl_(s
     for (int64_t i = 0; i < n; ++i) {
       progress.report(kTextShare + (1.0 - kTextShare) * static_cast<double>(i) / static_cast<double>(n),
                       "verifying images");
-      read_image(d.dir / d.frames[static_cast<size_t>(i)].path, d.camera, d.context(i));
+      d.read(i);
     }
   }
   progress.report(1.0, "done");

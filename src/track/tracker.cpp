@@ -121,12 +121,12 @@ struct Tracker::Impl {
   bool light_holds = false;  // this frame was misaligned (held by the light fixed to the camera?)
   bool keyframe_kept = false;  // the keyframe's camera frame is kept in the pipeline
   bool learnt_this_frame = false;
-  // Camera frames handed to the tracker, and the one at which the refit in the background
-  // (PhotometricModel::start_refit) began: it is taken into use refit_lag frames later
-  // (kYoungRefitLagFrames: at that frame; kSettledRefitLagFrames: at the next keyframe), by the
-  // frame count, not by when the worker thread ends, so that tracking is the same however busy
-  // the machine is.
-  long camera_frames = 0, refit_started = 0, refit_lag = 0;
+  // Camera frames handed to the tracker, and the first at which the refit in the background
+  // (PhotometricModel::start_refit) may be taken into use (a young model's at that frame, a
+  // settled one's at the next keyframe): by the frame count, not by when the worker thread ends,
+  // so that tracking is the same however busy the machine is.
+  long camera_frames = 0, refit_take_at = 0;
+  bool refit_young = false;  // the pending refit is a young model's (kYoungRefitLagFrames)
   // The rolling shutter: the twist the live frame in the pipeline was undistorted with, and
   // whether the keyframe's was measured (not predicted).
   Eigen::Vector3d live_twist = Eigen::Vector3d::Zero();
@@ -638,7 +638,7 @@ struct Tracker::Impl {
   void take_young_refit() {
     PhotometricModel* photometric = pipeline ? pipeline->photometric() : nullptr;
     // A settled model's refit is taken at a keyframe (make_keyframe).
-    if (!photometric || !photometric->refit_pending() || refit_lag != kYoungRefitLagFrames) return;
+    if (!photometric || !photometric->refit_pending() || !refit_young) return;
     const bool was_identity = photometric->fit().identity;
     if (refit_taken() && !(was_identity && photometric->fit().identity) && has_keyframe && keyframe_kept)
       correct_with_new_model();
@@ -648,15 +648,14 @@ struct Tracker::Impl {
     PhotometricModel* photometric = pipeline->photometric();
     if (photometric->refit_pending()) return;
     photometric->start_refit(needed);
-    refit_started = camera_frames;
-    refit_lag = photometric->frames() < kPhotometricSettledFrames ? kYoungRefitLagFrames : kSettledRefitLagFrames;
+    refit_young = photometric->frames() < kPhotometricSettledFrames;
+    refit_take_at = camera_frames + (refit_young ? kYoungRefitLagFrames : kSettledRefitLagFrames);
   }
 
   // The refit in the background taken into use when its lag is over: true when the model changed.
   bool refit_taken() {
     PhotometricModel* photometric = pipeline->photometric();
-    return photometric->refit_pending() && camera_frames - refit_started >= refit_lag &&
-           photometric->take_refit();
+    return photometric->refit_pending() && camera_frames >= refit_take_at && photometric->take_refit();
   }
 
   // The kept keyframe and the live frame corrected again with the model just fitted, so that
