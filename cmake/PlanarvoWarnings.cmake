@@ -28,7 +28,7 @@ if(PLANARVO_SANITIZE)
   add_compile_options(-fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined)
   if(CMAKE_CXX_COMPILER_ID STREQUAL "Clang")
     # UBSan's object-size check kept clang from inlining Eigen's small fixed-size matrices (100
-    # out-of-line Eigen functions in image/camera.cpp, 39 without it; the suite ran 1.5 times
+    # out-of-line Eigen functions in core/camera.cpp, 39 without it; the suite ran 1.5 times
     # slower); AddressSanitizer checks every access against its object's bounds anyway.
     add_compile_options(-fno-sanitize=object-size)
   endif()

@@ -21,7 +21,7 @@
 #include "calib/tilt_propagation.h"
 #include "core/se2.h"
 #include "graph/calibration.h"
-#include "image/camera.h"
+#include "core/camera.h"
 #include "track/roll_pitch.h"
 #include "track/tracker.h"
 

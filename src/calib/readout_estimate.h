@@ -29,7 +29,7 @@
 #include <opencv2/core.hpp>
 
 #include "core/extrinsics.h"
-#include "image/camera.h"
+#include "core/camera.h"
 #include "track/tracker.h"
 
 namespace planarvo::ocl {

@@ -11,7 +11,7 @@
 #include "core/extrinsics.h"
 #include "core/motion.h"
 #include "core/se2.h"
-#include "image/camera.h"
+#include "core/camera.h"
 #include "planarvo/planarvo.h"
 
 namespace planarvo::capi {

@@ -19,7 +19,7 @@
 #include <CL/opencl.hpp>
 #include <opencv2/core.hpp>
 
-#include "image/camera.h"
+#include "core/camera.h"
 #include "image/rolling_shutter.h"
 #include "image/undistort.h"
 

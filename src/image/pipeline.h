@@ -12,7 +12,7 @@
 #include <CL/opencl.hpp>
 #include <opencv2/core.hpp>
 
-#include "image/camera.h"
+#include "core/camera.h"
 #include "image/photometric.h"
 #include "image/pyramid.h"
 #include "image/rolling_shutter.h"

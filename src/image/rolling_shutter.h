@@ -35,7 +35,7 @@
 #include <opencv2/core.hpp>
 
 #include "core/extrinsics.h"
-#include "image/camera.h"
+#include "core/camera.h"
 #include "image/undistort.h"
 
 namespace planarvo {

@@ -13,7 +13,7 @@
 #include <opencv2/core.hpp>
 
 #include "core/se2.h"
-#include "image/camera.h"
+#include "core/camera.h"
 #include "io/dataset_bag.h"
 #include "io/formats.h"
 

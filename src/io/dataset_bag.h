@@ -17,7 +17,7 @@
 
 #include <opencv2/core.hpp>
 
-#include "image/camera.h"
+#include "core/camera.h"
 #include "io/formats.h"
 
 namespace planarvo::io {

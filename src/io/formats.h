@@ -15,7 +15,7 @@
 
 #include "core/extrinsics.h"
 #include "core/se2.h"
-#include "image/camera.h"
+#include "core/camera.h"
 
 namespace planarvo::io {
 

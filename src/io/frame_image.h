@@ -5,7 +5,7 @@
 
 #include <opencv2/core.hpp>
 
-#include "image/camera.h"
+#include "core/camera.h"
 
 namespace planarvo::io::detail {
 

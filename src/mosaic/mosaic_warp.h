@@ -12,7 +12,7 @@
 
 #include "core/extrinsics.h"
 #include "core/se2.h"
-#include "image/camera.h"
+#include "core/camera.h"
 #include "ocl/runtime.h"
 
 namespace planarvo::mosaic {

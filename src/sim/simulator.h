@@ -22,7 +22,7 @@
 #include "core/body_attitude.h"
 #include "core/extrinsics.h"
 #include "core/se2.h"
-#include "image/camera.h"
+#include "core/camera.h"
 
 namespace planarvo::ocl {
 class Runtime;

@@ -30,7 +30,7 @@
 #include <Eigen/Core>
 
 #include "core/se2.h"
-#include "image/camera.h"
+#include "core/camera.h"
 #include "image/photometric.h"
 #include "track/aligner.h"
 

@@ -15,7 +15,7 @@
 #include "core/extrinsics.h"
 #include "core/motion.h"
 #include "core/se2.h"
-#include "image/camera.h"
+#include "core/camera.h"
 #include "image/photometric.h"
 #include "image/pyramid.h"
 #include "track/aligner.h"

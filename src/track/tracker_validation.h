@@ -4,7 +4,7 @@
 // pyramid's coarsest level). Kept apart from the tracking itself.
 #pragma once
 #include "core/extrinsics.h"
-#include "image/camera.h"
+#include "core/camera.h"
 #include "track/tracker.h"
 
 namespace planarvo::track {

@@ -8,7 +8,7 @@
 #include <opencv2/imgproc.hpp>
 #include <opencv2/video/tracking.hpp>
 
-#include "image/camera.h"
+#include "core/camera.h"
 #include "image/undistort.h"
 
 namespace planarvo::bench {

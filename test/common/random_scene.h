@@ -4,7 +4,7 @@
 #include <cmath>
 
 #include "core/extrinsics.h"
-#include "image/camera.h"
+#include "core/camera.h"
 #include "sim/simulator.h"
 
 namespace planarvo::test {

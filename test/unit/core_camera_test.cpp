@@ -10,7 +10,7 @@
 #include <opencv2/core.hpp>
 #include <gtest/gtest.h>
 
-#include "image/camera.h"
+#include "core/camera.h"
 
 namespace planarvo {
 namespace {

@@ -1,4 +1,4 @@
-#include "image/camera.h"
+#include "core/camera.h"
 
 #include <cmath>
 #include <cstdio>
