@@ -8,8 +8,6 @@
 namespace planarvo_node {
 namespace {
 
-const char* const kNames[6] = {"x", "y", "z", "roll", "pitch", "yaw"};
-
 double yaw_of(const geometry_msgs::Quaternion& q) {
   return std::atan2(2 * (q.w * q.z + q.x * q.y), 1 - 2 * (q.y * q.y + q.z * q.z));
 }
@@ -34,10 +32,8 @@ void LiveCalibration::add_odometry(const nav_msgs::Odometry& m) {
   const Pose p{static_cast<int64_t>(m.header.stamp.toNSec()),
                {m.pose.pose.position.x, m.pose.pose.position.y, yaw_of(m.pose.pose.orientation)}};
   std::lock_guard<std::mutex> lock(mutex_);
-  if (!odometry_.empty() && p.ns <= odometry_.back().ns) {
-    if (p.ns < odometry_.back().ns - 1000000000LL) odometry_.clear();  // time went back: a new run
-    else return;
-  }
+  if (p.ns <= newest_ns_) return;  // a repeat, or time went back (a new run: its frames are left out too)
+  newest_ns_ = p.ns;
   odometry_.push_back(p);
 }
 
@@ -46,6 +42,10 @@ void LiveCalibration::add_frame(const planarvo_image& image, int64_t stamp_ns, d
   if (t <= last_t_) {
     ROS_WARN_THROTTLE(5, "planarvo_node: calibration: a frame at t = %.6f s after one at %.6f s is left out", t, last_t_);
     return;
+  }
+  if (!has_origin_) {
+    origin_ns_ = stamp_ns - static_cast<int64_t>(std::llround(t * 1e9));
+    has_origin_ = true;
   }
   last_t_ = t;
   Frame f;
@@ -63,34 +63,31 @@ void LiveCalibration::add_frame(const planarvo_image& image, int64_t stamp_ns, d
   waiting_.push_back(std::move(f));
 }
 
-// The odometry pose at the frame's stamp, interpolated between the messages around it; none when
-// the frame lies outside them (final: the odometry will not grow any more).
+// Hands the odometry received so far to the calibrator, which interpolates the frame's pose from it
+// (none when the frame lies outside it; final: the odometry will not grow any more).
 void LiveCalibration::feed(Frame& f, bool final) {
-  planarvo_se2 pose{};
-  bool has = false;
+  std::deque<Pose> received;
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    while (odometry_.size() > 2 && odometry_[1].ns <= f.ns) odometry_.pop_front();
-    for (size_t i = 0; i + 1 < odometry_.size() && !has; ++i) {
-      const Pose &a = odometry_[i], &b = odometry_[i + 1];
-      if (a.ns <= f.ns && f.ns <= b.ns) {
-        const double u = b.ns == a.ns ? 0.0 : static_cast<double>(f.ns - a.ns) / static_cast<double>(b.ns - a.ns);
-        pose.x = a.pose.x + u * (b.pose.x - a.pose.x);
-        pose.y = a.pose.y + u * (b.pose.y - a.pose.y);
-        pose.theta = a.pose.theta + u * std::remainder(b.pose.theta - a.pose.theta, 2 * M_PI);
-        has = true;
-      }
-    }
-    if (!has && odometry_.size() == 1 && odometry_[0].ns == f.ns) pose = odometry_[0].pose, has = true;
+    received.swap(odometry_);
   }
+  for (const Pose& p : received) {
+    const double t = static_cast<double>(p.ns - origin_ns_) * 1e-9;
+    if (planarvo_camera_calibrator_add_odometry(calibrator_, t, &p.pose) != PLANARVO_OK) {
+      ROS_WARN_THROTTLE(5, "planarvo_node: calibration: odometry left out: %s", planarvo_last_error());
+      continue;
+    }
+    if (first_given_ns_ < 0) first_given_ns_ = p.ns;
+    last_given_ns_ = p.ns;
+  }
+  const bool has = first_given_ns_ >= 0 && first_given_ns_ <= f.ns && f.ns <= last_given_ns_;
   if (!has && !warned_no_odometry_) {
     ROS_WARN("planarvo_node: calibration: no odometry around the frame at t = %.3f s%s; frames without it give "
              "the calibration no interval",
              f.t, final ? " (shutdown)" : " within ~calibration_odom_wait");
     warned_no_odometry_ = true;
   }
-  const planarvo_status st = planarvo_camera_calibrator_add_frame(calibrator_, &f.image, f.t, has ? &pose : nullptr,
-                                                                  nullptr);
+  const planarvo_status st = planarvo_camera_calibrator_add_frame(calibrator_, &f.image, f.t, nullptr, nullptr);
   if (st != PLANARVO_OK)
     ROS_ERROR_THROTTLE(5, "planarvo_node: calibration: frame at t = %.3f s: %s", f.t, planarvo_last_error());
   ++fed_;
@@ -103,7 +100,7 @@ bool LiveCalibration::poll() {
     int64_t newest = 0;
     {
       std::lock_guard<std::mutex> lock(mutex_);
-      newest = odometry_.empty() ? 0 : odometry_.back().ns;
+      newest = newest_ns_;
     }
     const bool covered = newest >= f.ns;
     const bool waited_too_long =
@@ -136,13 +133,8 @@ void LiveCalibration::complete() {
               st == PLANARVO_ERROR_FAILED ? result_.reason : planarvo_last_error(), params_.calibration_output.c_str());
     return;
   }
-  std::string estimated;
-  for (int i = 0; i < 6; ++i)
-    if (result_.estimated[i]) estimated += std::string(estimated.empty() ? "" : ",") + kNames[i];
-  const std::string method = "roll and pitch from images (sec. 5.1); x, y, z, yaw against wheel odometry (5.2.1)";
   const std::string notes = "planarvo_node live calibration, " + std::to_string(fed_) + " frames";
-  if (planarvo_extrinsics_save(params_.calibration_output.c_str(), &result_.extrinsics, result_.covariance,
-                               estimated.c_str(), method.c_str(), notes.c_str()) != PLANARVO_OK) {
+  if (planarvo_camera_calibration_save(params_.calibration_output.c_str(), &result_, notes.c_str()) != PLANARVO_OK) {
     ROS_ERROR("planarvo_node: calibration: %s", planarvo_last_error());
     return;
   }

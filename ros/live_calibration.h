@@ -1,6 +1,6 @@
 // The live calibration (~calibrate): planarvo_camera_calibrator fed with the frames as they come
-// and the wheel odometry (nav_msgs/Odometry on `odom`) interpolated to each frame's stamp. A frame
-// waits until an odometry message at or after its stamp has arrived (at most
+// and the wheel odometry's samples (nav_msgs/Odometry on `odom`), which the calibrator interpolates
+// to each frame's stamp. A frame waits until an odometry message at or after its stamp has arrived (at most
 // ~calibration_odom_wait seconds of frames; then it goes in without odometry, with a warning). The
 // calibration finishes after ~calibration_frames frames, or on shutdown, and writes
 // ~calibration_output.
@@ -55,8 +55,12 @@ class LiveCalibration {
 
   const NodeParams& params_;
   planarvo_camera_calibrator* calibrator_ = nullptr;
-  std::mutex mutex_;         // guards odometry_
-  std::deque<Pose> odometry_;
+  std::mutex mutex_;         // guards odometry_ and newest_ns_
+  std::deque<Pose> odometry_;  // received, not yet handed to the calibrator
+  int64_t newest_ns_ = -1;     // the newest odometry stamp received
+  int64_t origin_ns_ = 0;      // the stamp of t = 0 (the first frame's)
+  bool has_origin_ = false;
+  int64_t first_given_ns_ = -1, last_given_ns_ = -1;  // the odometry handed to the calibrator
   std::deque<Frame> waiting_;
   int64_t fed_ = 0, with_odometry_ = 0;
   double last_t_ = -1;

@@ -168,6 +168,10 @@ PLANARVO_API planarvo_status planarvo_extrinsics_save(const char* path,
 /* T_robot_camera as a 4x4 row-major matrix. */
 PLANARVO_API planarvo_status planarvo_extrinsics_matrix(const planarvo_extrinsics* e,
                                                         double matrix[16]);
+/* The name of extrinsics parameter `index` in the order of every covariance and flag array
+ * (0 "x", 1 "y", 2 "z", 3 "roll", 4 "pitch", 5 "yaw"), as extrinsics.yaml writes it; NULL for
+ * another index. */
+PLANARVO_API const char* planarvo_extrinsics_name(int32_t index);
 
 /* ------------------------------------------------------------------------------------------ */
 /* OpenCL devices and the context                                                              */
@@ -731,6 +735,14 @@ PLANARVO_API void planarvo_calibration_options_init(planarvo_calibration_options
 PLANARVO_API planarvo_status planarvo_calibrate(const planarvo_motion_pair* pairs, size_t count,
                                                 const planarvo_calibration_options* options,
                                                 planarvo_calibration_result* result);
+/* Writes a motion-pair calibration as extrinsics.yaml (docs/formats.md): x, y, yaw and z = the
+ * scale (the camera height), with their covariance and which were estimated; with metric_sensor
+ * non-zero (the pairs' sensor measured metres, e.g. a laser scan matcher) z is 0, not estimated.
+ * Roll and pitch are 0, not estimated (they come from images). The method's sentence, and notes as
+ * given (NULL: none). PLANARVO_ERROR_IO when the file cannot be written. */
+PLANARVO_API planarvo_status planarvo_calibration_save(const char* path, const planarvo_calibration_result* result,
+                                                       planarvo_calibration_method method, int32_t metric_sensor,
+                                                       const char* notes);
 
 /* ------------------------------------------------------------------------------------------ */
 /* Camera calibration from images (the paper's sections 5.1 and 5.2)                           */
@@ -850,6 +862,7 @@ typedef struct planarvo_camera_calibration_result {
   int32_t readout_evaluations, readout_frames;
   char readout_reason[256];
   double seconds_readout;
+  char method[192];          /* how the extrinsics were found, one sentence (extrinsics.yaml's method) */
 } planarvo_camera_calibration_result;
 
 PLANARVO_API void planarvo_camera_calibration_options_init(planarvo_camera_calibration_options* options);
@@ -872,14 +885,30 @@ PLANARVO_API planarvo_status planarvo_camera_calibrator_create(planarvo_context*
                                                                const planarvo_camera_calibration_options* options,
                                                                planarvo_camera_calibrator** calibrator);
 PLANARVO_API void planarvo_camera_calibrator_destroy(planarvo_camera_calibrator* calibrator);
+/* odometry_pose NULL: the pose interpolated at the frame's time from the samples given by then
+ * with planarvo_camera_calibrator_add_odometry (none when they do not reach it). */
 PLANARVO_API planarvo_status planarvo_camera_calibrator_add_frame(planarvo_camera_calibrator* calibrator,
                                                                   const planarvo_image* image, double timestamp,
                                                                   const planarvo_se2* odometry_pose,
                                                                   const int32_t* direction);
+/* A wheel-odometry sample (the robot's pose at `timestamp`), in time order: the calibrator
+ * interpolates the frames' poses from them (linear in x, y and the angle the shorter way round), so
+ * a stream's odometry messages can be given as they come, before or after the frames they cover.
+ * PLANARVO_ERROR_INVALID_ARGUMENT for a sample not after the one before or not finite. */
+PLANARVO_API planarvo_status planarvo_camera_calibrator_add_odometry(planarvo_camera_calibrator* calibrator,
+                                                                     double timestamp, const planarvo_se2* pose);
 /* Runs what is left and fills result (once per calibrator); PLANARVO_ERROR_FAILED with the reason
  * when the status is not OK, the result filled in either case. */
 PLANARVO_API planarvo_status planarvo_camera_calibrator_finish(planarvo_camera_calibrator* calibrator,
                                                                planarvo_camera_calibration_result* result);
+
+/* Writes the calibration's extrinsics as extrinsics.yaml (docs/formats.md): the values, the 6x6
+ * covariance, the parameters it estimated, its method sentence, and notes: `notes` (where the
+ * data came from; NULL: none) and, when the rolling shutter's readout time was estimated, the
+ * estimate. PLANARVO_ERROR_IO when the file cannot be written. */
+PLANARVO_API planarvo_status planarvo_camera_calibration_save(const char* path,
+                                                              const planarvo_camera_calibration_result* result,
+                                                              const char* notes);
 
 /* The stages on their own. Motions from a data set: tracks every frame with the given extrinsics
  * (for the graph calibration of a camera: x = y = 0, z = 1, yaw = 0 and its roll and pitch) and

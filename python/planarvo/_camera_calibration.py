@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import ctypes
 import enum
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Optional, Tuple
 
 import numpy as np
@@ -20,7 +20,7 @@ from ._handle import _Handle
 from ._native import lib
 from ._se2 import SE2
 from ._tracking import TrackerOptions, _tracker_options
-from ._util import ProgressFn, _c_options, _Callback, _matrix
+from ._util import PathLike, ProgressFn, _c_options, _Callback, _matrix, _opt, _path
 
 
 class CalibrationStatus(enum.IntEnum):
@@ -147,6 +147,15 @@ class CameraCalibrationResult:
     readout_sigma: float = 0.0
     readout_evaluations: int = 0
     readout_reason: str = ""
+    method: str = ""  # how the extrinsics were found, one sentence (extrinsics.yaml's method)
+    _c: Optional[N.CameraCalibrationResult] = field(default=None, repr=False, compare=False)
+
+    def save(self, path: PathLike, notes: Optional[str] = None) -> None:
+        """Writes the extrinsics as extrinsics.yaml (the values, covariance, which were estimated,
+        the method; notes: where the data came from), as planarvo calibrate -o does."""
+        if self._c is None:
+            raise ValueError("save: this result was not made by the library")
+        _check(lib.planarvo_camera_calibration_save(_path(path), ctypes.byref(self._c), _opt(notes)))
 
     @property
     def sigmas(self) -> np.ndarray:
@@ -161,7 +170,8 @@ class CameraCalibrationResult:
                    CalibrationResult._from_c(r.graph), r.frames, r.frames_ok, r.frames_degraded, r.frames_lost,
                    r.samples, r.tracking_median_ms, r.seconds_decode, r.seconds_roll_pitch, r.seconds_tracking,
                    r.seconds_graph, r.seconds_total, r.readout, r.readout_estimate, r.readout_sigma,
-                   r.readout_evaluations, r.readout_reason.decode(errors="replace"))
+                   r.readout_evaluations, r.readout_reason.decode(errors="replace"),
+                   r.method.decode(errors="replace"), r)
 
 
 class _CameraCalibrationC:
@@ -224,6 +234,11 @@ class CameraCalibrator(_Handle):
         self._options.callback.reraise()
         _check(status)
         del keep
+
+    def add_odometry(self, timestamp: float, pose: SE2) -> None:
+        """A wheel-odometry sample, in time order: frames fed without odometry_pose take the pose
+        interpolated at their time from the samples given by then."""
+        _check(lib.planarvo_camera_calibrator_add_odometry(self._h(), float(timestamp), ctypes.byref(pose._to_c())))
 
     def finish(self) -> CameraCalibrationResult:
         """Runs what is left; raises Error (.result the CameraCalibrationResult) when it gives no answer."""

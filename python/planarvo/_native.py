@@ -196,7 +196,8 @@ class CameraCalibrationResult(ctypes.Structure):
                 ("seconds_decode", c_double), ("seconds_roll_pitch", c_double), ("seconds_tracking", c_double),
                 ("seconds_graph", c_double), ("seconds_total", c_double), ("readout", c_double),
                 ("readout_estimate", c_double), ("readout_sigma", c_double), ("readout_evaluations", c_int32),
-                ("readout_frames", c_int32), ("readout_reason", ctypes.c_char * 256), ("seconds_readout", c_double)]
+                ("readout_frames", c_int32), ("readout_reason", ctypes.c_char * 256), ("seconds_readout", c_double),
+                ("method", ctypes.c_char * 192)]
 
 
 class MosaicOptions(ctypes.Structure):
@@ -282,6 +283,7 @@ _SIGNATURES = {
     "planarvo_motion_pairs_load": (S, [c_char_p, P(MotionPair), c_size_t, P(c_size_t)]),
     "planarvo_calibration_options_init": (None, [P(CalibrationOptions)]),
     "planarvo_calibrate": (S, [P(MotionPair), c_size_t, P(CalibrationOptions), P(CalibrationResult)]),
+    "planarvo_calibration_save": (S, [c_char_p, P(CalibrationResult), c_enum, c_int32, c_char_p]),
     "planarvo_roll_pitch_options_init": (None, [P(RollPitchOptions)]),
     "planarvo_roll_pitch_create": (S, [c_void_p, P(Camera), P(RollPitchOptions), P(c_void_p)]),
     "planarvo_roll_pitch_destroy": (None, [c_void_p]),
@@ -293,6 +295,8 @@ _SIGNATURES = {
     "planarvo_camera_calibrator_create": (S, [c_void_p, P(Camera), P(CameraCalibrationOptions), P(c_void_p)]),
     "planarvo_camera_calibrator_destroy": (None, [c_void_p]),
     "planarvo_camera_calibrator_add_frame": (S, [c_void_p, P(Image), c_double, P(SE2), P(c_int32)]),
+    "planarvo_camera_calibrator_add_odometry": (S, [c_void_p, c_double, P(SE2)]),
+    "planarvo_camera_calibration_save": (S, [c_char_p, P(CameraCalibrationResult), c_char_p]),
     "planarvo_camera_calibrator_finish": (S, [c_void_p, P(CameraCalibrationResult)]),
     "planarvo_track_motions": (S, [c_void_p, c_void_p, P(Extrinsics), P(TrackerOptions), P(MotionPair), c_size_t,
                                    P(c_size_t)]),

@@ -1,25 +1,21 @@
 #include "calib/extrinsics_estimate.h"
 
+#include "graph/calibration_extrinsics.h"
+
 namespace planarvo::calib {
 
 ExtrinsicsEstimate compose_extrinsics(double roll, double pitch, const Eigen::Matrix2d& rp_cov, bool rp_estimated,
                                       const graph::CalibrationResult& g, const Eigen::Matrix<double, 4, 2>* J) {
-  ExtrinsicsEstimate out;
-  out.value = Extrinsics{g.value[0], g.value[1], g.value[2], roll, pitch, g.value[3]};
-  // The graph's parameters x, y, scale, yaw sit at x, y, z, yaw.
-  constexpr std::array<int, 4> at = {0, 1, 2, 5};
-  for (size_t i = 0; i < 4; ++i) {
-    out.estimated[static_cast<size_t>(at[i])] = g.estimated[i];
-    out.observable[static_cast<size_t>(at[i])] = g.observable[i];
-    for (size_t j = 0; j < 4; ++j)
-      if (g.estimated[i] && g.estimated[j])
-        out.covariance(at[i], at[j]) = g.covariance(static_cast<int>(i), static_cast<int>(j));
-  }
+  ExtrinsicsEstimate out = graph::as_extrinsics(g, false);
+  out.value.roll = roll;
+  out.value.pitch = pitch;
   if (rp_estimated) {
     out.covariance.block<2, 2>(3, 3) = rp_cov;
     out.estimated[3] = out.estimated[4] = true;
     out.observable[3] = out.observable[4] = true;
     if (J && J->allFinite()) {
+      // The graph's parameters x, y, scale, yaw sit at x, y, z, yaw.
+      constexpr std::array<int, 4> at = {0, 1, 2, 5};
       const Eigen::Matrix4d added = *J * rp_cov * J->transpose();
       const Eigen::Matrix<double, 4, 2> cross = *J * rp_cov;
       for (size_t i = 0; i < 4; ++i) {
@@ -34,6 +30,12 @@ ExtrinsicsEstimate compose_extrinsics(double roll, double pitch, const Eigen::Ma
     }
   }
   return out;
+}
+
+std::string describe_camera_calibration(graph::CalibrationMethod method) {
+  return method == graph::CalibrationMethod::Odometry
+             ? "roll and pitch from images (sec. 5.1); x, y, z, yaw against wheel odometry (5.2.1)"
+             : "roll and pitch from images (sec. 5.1); x, yaw nonholonomic, y from direction labels (5.2.2), z given";
 }
 
 }  // namespace planarvo::calib

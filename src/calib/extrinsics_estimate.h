@@ -13,35 +13,29 @@
 // J C_rp J^T more and the cross-covariance with roll and pitch is J C_rp; without it the stages
 // are taken as independent.
 #pragma once
-#include <array>
+#include <string>
 
 #include <Eigen/Core>
 
 #include "core/extrinsics.h"
+#include "core/extrinsics_estimate.h"
 #include "graph/calibration.h"
 #include "track/roll_pitch.h"
 
 namespace planarvo::calib {
 
-inline constexpr std::array<const char*, 6> kExtrinsicsNames = {"x", "y", "z", "roll", "pitch", "yaw"};
-
-struct ExtrinsicsEstimate {
-  Extrinsics value;
-  // Order x, y, z, roll, pitch, yaw (metres, radians); rows and columns of parameters that were
-  // not estimated are zero.
-  Eigen::Matrix<double, 6, 6> covariance = Eigen::Matrix<double, 6, 6>::Zero();
-  std::array<bool, 6> estimated{};   // this run estimated it (else it was given or held)
-  std::array<bool, 6> observable{};  // estimated and determined by the data
-};
-
 // The tracker's extrinsics in stage 2 (eq. 14): the camera's tilt, at the robot's origin, one
 // unit above the ground, no yaw; its motions are the camera's ground frame's in units of height.
 inline Extrinsics stage2_extrinsics(double roll, double pitch) { return Extrinsics{0.0, 0.0, 1.0, roll, pitch, 0.0}; }
 
-// The graph's (x, y, scale, yaw) as x, y, z, yaw; its fixed scale (a height given by hand) as z,
+// The graph's (x, y, scale, yaw) as x, y, z, yaw (graph::as_extrinsics); its fixed scale (a height given by hand) as z,
 // not estimated. Roll and pitch as given, estimated when `roll_pitch_estimated`.
 ExtrinsicsEstimate compose_extrinsics(double roll, double pitch, const Eigen::Matrix2d& roll_pitch_covariance,
                                       bool roll_pitch_estimated, const graph::CalibrationResult& graph,
                                       const Eigen::Matrix<double, 4, 2>* tilt_jacobian = nullptr);
+
+// How the whole calibration (calib/pipeline.h) finds the extrinsics with the graph's method, one
+// sentence (extrinsics.yaml's method).
+std::string describe_camera_calibration(graph::CalibrationMethod method);
 
 }  // namespace planarvo::calib

@@ -60,6 +60,7 @@ struct CameraCalibrator::Impl {
   std::unique_ptr<track::Tracker> tracker;
   MotionSampler sampler;
   std::vector<double> frame_ms;
+  std::vector<io::StampedPose> odometry_samples;  // add_odometry's samples from the last one at or before a frame
   PipelineReport report;
   Clock::time_point start = Clock::now();
 
@@ -67,7 +68,7 @@ struct CameraCalibrator::Impl {
     if (!o.estimate_roll_pitch && !o.initial)
       throw_invalid_argument("calibration: roll and pitch are not estimated, so initial extrinsics must give them");
     if (o.graph.method == graph::CalibrationMethod::Nonholonomic && !o.graph.fix_scale)
-      throw_invalid_argument("calibration: the nonholonomic method needs the camera height (fix_scale, fixed_scale)");
+      throw_invalid_argument("calibration: the nonholonomic method cannot estimate the camera height: give the height");
     if (o.max_buffered_frames < 2) throw_invalid_argument("calibration: max_buffered_frames must be at least 2");
     return o;
   }
@@ -254,6 +255,7 @@ struct CameraCalibrator::Impl {
     report.tilt_jacobian = J;
     report.extrinsics =
         compose_extrinsics(rp.roll, rp.pitch, rp.covariance, opt.estimate_roll_pitch, report.graph, J ? &*J : nullptr);
+    report.extrinsics.method = describe_camera_calibration(go.method);
     if (report.graph.ok()) {
       report.status = PipelineReport::Status::Ok;
       report.reason.clear();
@@ -284,9 +286,28 @@ struct CameraCalibrator::Impl {
 CameraCalibrator::CameraCalibrator(ocl::Runtime& runtime, const CameraModel& camera, const PipelineOptions& options)
     : impl_(std::make_unique<Impl>(runtime, camera, options)) {}
 CameraCalibrator::~CameraCalibrator() = default;
+void CameraCalibrator::add_odometry(double timestamp, const SE2& pose) {
+  std::vector<io::StampedPose>& s = impl_->odometry_samples;
+  if (!std::isfinite(timestamp) || !std::isfinite(pose.x + pose.y + pose.theta))
+    throw_invalid_argument("calibration: an odometry sample is not finite");
+  if (!s.empty() && timestamp <= s.back().t)
+    throw_invalid_argument("calibration: odometry at t = " + std::to_string(timestamp) +
+                           " s is not after the sample before it (t = " + std::to_string(s.back().t) + " s)");
+  s.push_back({timestamp, pose});
+}
+
 void CameraCalibrator::add_frame(const uint8_t* gray, int width, int height, size_t stride, double timestamp,
                                  const std::optional<SE2>& odometry_pose, const std::optional<int>& direction) {
-  impl_->add_frame(gray, width, height, stride, timestamp, odometry_pose, direction);
+  std::optional<SE2> pose = odometry_pose;
+  std::vector<io::StampedPose>& s = impl_->odometry_samples;
+  if (!pose && !s.empty()) {
+    pose = io::interpolate_pose(s, timestamp);
+    // Frames come in time order: the samples before the last one at or before this frame are done.
+    const auto after = std::upper_bound(s.begin(), s.end(), timestamp,
+                                        [](double t, const io::StampedPose& p) { return t < p.t; });
+    if (after - s.begin() > 1) s.erase(s.begin(), after - 1);
+  }
+  impl_->add_frame(gray, width, height, stride, timestamp, pose, direction);
 }
 PipelineReport CameraCalibrator::finish() { return impl_->finish(); }
 const char* CameraCalibrator::stage() const {
@@ -299,33 +320,66 @@ const char* CameraCalibrator::stage() const {
   return "?";
 }
 
-PipelineReport calibrate_dataset(ocl::Runtime& runtime, io::Dataset& ds, const PipelineOptions& options) {
-  const auto t0 = Clock::now();
-  if (options.graph.method == graph::CalibrationMethod::Odometry && !ds.has_odometry())
-    throw_invalid_input(ds.directory() + ": the odometry method needs wheel odometry (odometry.txt)");
-  if (options.graph.method == graph::CalibrationMethod::Nonholonomic && !ds.has_direction())
-    throw_invalid_input(ds.directory() +
-                        ": the nonholonomic method needs direction labels (direction.txt) for y and the branch");
-  PipelineOptions o = options;
-  if (o.readout == PipelineOptions::Readout::IfUnknown)
-    o.readout = ds.readout_given() ? PipelineOptions::Readout::Off : PipelineOptions::Readout::On;
-  CameraCalibrator calibrator(runtime, ds.camera(), o);
+namespace {
+
+// The loop calibrate_dataset and track_motions share: every frame of the data set in order, with
+// the robot's odometry pose at its time and the direction label of the interval ending at it, to
+// `add`; progress after each frame (the stage from `stage`), Cancelled when it says so. Returns
+// the seconds spent waiting for images (io::Dataset decodes the next one while this one is used).
+template <class Stage, class Add>
+double drive(io::Dataset& ds, const std::function<bool(double, const char*)>& progress, Stage&& stage, Add&& add) {
   const int64_t n = ds.frame_count();
   double decode = 0.0;
   for (int64_t i = 0; i < n; ++i) {
     const auto d0 = Clock::now();
     const cv::Mat f = ds.frame(i);
     decode += seconds_since(d0);
-    calibrator.add_frame(f.data, f.cols, f.rows, f.step, ds.timestamp(i), ds.odometry_at(i),
-                         ds.direction_for_interval(i));
-    if (options.progress && !options.progress(static_cast<double>(i + 1) / static_cast<double>(n), calibrator.stage()))
+    add(f, ds.timestamp(i), ds.odometry_at(i), ds.direction_for_interval(i));
+    if (progress && !progress(static_cast<double>(i + 1) / static_cast<double>(n), stage()))
       throw Error(ErrorCode::Cancelled, "calibration cancelled");
   }
+  return decode;
+}
+
+}  // namespace
+
+PipelineReport calibrate_dataset(ocl::Runtime& runtime, io::Dataset& ds, const PipelineOptions& options) {
+  const auto t0 = Clock::now();
+  // The methods' inputs, checked here once for every caller (the C API, the command line).
+  if (options.graph.method == graph::CalibrationMethod::Odometry && !ds.has_odometry())
+    throw_invalid_input(ds.directory() + (ds.is_bag() ? ": no odometry topic given (--odom-topic, odometry_topic)" : " has no odometry.txt") +
+                        ": the odometry method needs wheel odometry (or use the nonholonomic method with direction "
+                        "labels and the camera height)");
+  if (options.graph.method == graph::CalibrationMethod::Nonholonomic && !ds.has_direction())
+    throw_invalid_input(ds.directory() + (ds.is_bag() ? ": a bag has no direction labels" : " has no direction.txt") +
+                        ": the nonholonomic method needs direction labels for y and the branch");
+  PipelineOptions o = options;
+  if (o.readout == PipelineOptions::Readout::IfUnknown)
+    o.readout = ds.readout_given() ? PipelineOptions::Readout::Off : PipelineOptions::Readout::On;
+  CameraCalibrator calibrator(runtime, ds.camera(), o);
+  const double decode = drive(
+      ds, options.progress, [&] { return calibrator.stage(); },
+      [&](const cv::Mat& f, double t, const std::optional<SE2>& odometry, const std::optional<int>& direction) {
+        calibrator.add_frame(f.data, f.cols, f.rows, f.step, t, odometry, direction);
+      });
   if (options.progress && !options.progress(1.0, "graph calibration")) throw Error(ErrorCode::Cancelled, "calibration cancelled");
   PipelineReport report = calibrator.finish();
   report.time.decode = decode;
   report.time.total = seconds_since(t0);
   return report;
+}
+
+std::vector<graph::MotionSample> track_motions(ocl::Runtime& runtime, io::Dataset& ds, const Extrinsics& extrinsics,
+                                               const track::TrackerOptions& options,
+                                               const std::function<bool(double, const char*)>& progress) {
+  track::Tracker tracker(runtime, ds.camera(), extrinsics, options);
+  MotionSampler sampler;
+  drive(
+      ds, progress, [] { return "tracking"; },
+      [&](const cv::Mat& f, double t, const std::optional<SE2>& odometry, const std::optional<int>& direction) {
+        sampler.add(tracker.track(f.data, f.cols, f.rows, f.step, t), t, odometry, direction);
+      });
+  return sampler.samples();
 }
 
 }  // namespace planarvo::calib

@@ -126,9 +126,14 @@ class CameraCalibrator {
   CameraCalibrator(const CameraCalibrator&) = delete;
   CameraCalibrator& operator=(const CameraCalibrator&) = delete;
 
+  // A wheel-odometry sample, in time order (InvalidArgument when not after the one before or not
+  // finite): frames given no pose of their own take the pose interpolated at their time
+  // (io::interpolate_pose) from the samples given by then, none when those do not reach it.
+  void add_odometry(double timestamp, const SE2& pose);
+
   // Frame k: 8-bit grey of the camera's size (rows stride bytes apart), its time, the robot's
-  // wheel-odometry pose at that time (none: the odometry does not cover it) and the direction
-  // label of the interval from the previous frame to this one.
+  // wheel-odometry pose at that time (none: the odometry does not cover it, or add_odometry's
+  // samples give it) and the direction label of the interval from the previous frame to this one.
   void add_frame(const uint8_t* gray, int width, int height, size_t stride, double timestamp,
                  const std::optional<SE2>& odometry_pose = std::nullopt,
                  const std::optional<int>& direction = std::nullopt);
@@ -149,5 +154,13 @@ class CameraCalibrator {
 // label (direction.txt). Throws InvalidInput when the method's inputs are missing (odometry for
 // the odometry method; direction labels for the nonholonomic one) or a frame cannot be read.
 PipelineReport calibrate_dataset(ocl::Runtime& runtime, io::Dataset& dataset, const PipelineOptions& options);
+
+// Stage 2 on its own: every frame of the data set tracked with the given extrinsics (for the graph
+// calibration of a camera, stage2_extrinsics), one sample per tracked interval with the data set's
+// odometry and direction labels, through calibrate_dataset's loop. Progress as calibrate_dataset's
+// (stage "tracking").
+std::vector<graph::MotionSample> track_motions(ocl::Runtime& runtime, io::Dataset& dataset, const Extrinsics& extrinsics,
+                                               const track::TrackerOptions& options,
+                                               const std::function<bool(double, const char*)>& progress = {});
 
 }  // namespace planarvo::calib

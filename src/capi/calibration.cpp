@@ -124,11 +124,7 @@ planarvo::calib::PipelineOptions pipeline_options_from_c(const planarvo_camera_c
   require(method == PLANARVO_CALIBRATE_ODOMETRY || method == PLANARVO_CALIBRATE_NONHOLONOMIC,
           "planarvo_camera_calibration_options.method is not a planarvo_calibration_method");
   require(std::isfinite(o.height) && o.height >= 0, "planarvo_camera_calibration_options.height must be >= 0");
-  require(o.method == PLANARVO_CALIBRATE_ODOMETRY || o.height > 0,
-          "planarvo_camera_calibration_options.height: the nonholonomic method needs the camera height");
   require(o.roll_pitch_frames >= 0, "planarvo_camera_calibration_options.roll_pitch_frames must be >= 0");
-  require(o.estimate_roll_pitch || o.has_initial,
-          "planarvo_camera_calibration_options: roll and pitch not estimated needs has_initial");
   planarvo::calib::PipelineOptions po;
   planarvo_calibration_options graph_read;
   if (o.graph)
@@ -193,6 +189,7 @@ planarvo_camera_calibration_result report_to_c(const planarvo::calib::PipelineRe
   out.readout_frames = r.readout.frames;
   planarvo::capi::copy_string(out.readout_reason, sizeof out.readout_reason, r.readout.reason);
   out.seconds_readout = r.time.readout;
+  planarvo::capi::copy_string(out.method, sizeof out.method, r.extrinsics.method);
   return out;
 }
 
@@ -339,6 +336,15 @@ PLANARVO_API planarvo_status planarvo_camera_calibrator_add_frame(planarvo_camer
   });
 }
 
+PLANARVO_API planarvo_status planarvo_camera_calibrator_add_odometry(planarvo_camera_calibrator* calibrator,
+                                                                     double timestamp, const planarvo_se2* pose) {
+  return guard([&] {
+    require(calibrator != nullptr && pose != nullptr, "planarvo_camera_calibrator_add_odometry: NULL argument");
+    require(!calibrator->finished, "planarvo_camera_calibrator_add_odometry: the calibrator has finished");
+    calibrator->calibrator->add_odometry(timestamp, planarvo::capi::to_cpp(*pose));
+  });
+}
+
 PLANARVO_API planarvo_status planarvo_camera_calibrator_finish(planarvo_camera_calibrator* calibrator,
                                                                planarvo_camera_calibration_result* result) {
   std::string reason;
@@ -369,17 +375,9 @@ PLANARVO_API planarvo_status planarvo_track_motions(planarvo_context* context, p
     if (capacity + 1 < n)
       throw planarvo::capi::BufferTooSmall("planarvo_track_motions: " + std::to_string(n) + " frames need capacity " +
                                            std::to_string(n - 1) + ", not " + std::to_string(capacity));
-    require(extrinsics->z > 0, "planarvo_track_motions: extrinsics.z (the camera height) must be positive");
-    planarvo::track::Tracker tracker(*context->runtime, ds.camera(), planarvo::capi::to_cpp(*extrinsics),
-                                     planarvo::capi::tracker_options_from_c(options));
-    planarvo::calib::MotionSampler sampler;
-    for (size_t i = 0; i < n; ++i) {
-      const auto k = static_cast<int64_t>(i);
-      const cv::Mat f = ds.frame(k);
-      const planarvo::track::FrameResult r = tracker.track(f.data, f.cols, f.rows, f.step, ds.timestamp(k));
-      sampler.add(r, ds.timestamp(k), ds.odometry_at(k), ds.direction_for_interval(k));
-    }
-    for (const planarvo::graph::MotionSample& s : sampler.samples()) {
+    const std::vector<planarvo::graph::MotionSample> samples = planarvo::calib::track_motions(
+        *context->runtime, ds, planarvo::capi::to_cpp(*extrinsics), planarvo::capi::tracker_options_from_c(options));
+    for (const planarvo::graph::MotionSample& s : samples) {
       planarvo_motion_pair p;
       planarvo_motion_pair_init(&p);
       p.interval = s.interval;
@@ -410,7 +408,7 @@ PLANARVO_API planarvo_status planarvo_compose_extrinsics(double roll, double pit
     g.covariance = planarvo::capi::matrix_from_c<4>(graph->covariance);
     const Eigen::Matrix2d rp = roll_pitch_covariance ? Eigen::Matrix2d(planarvo::capi::matrix_from_c<2>(roll_pitch_covariance))
                                                      : Eigen::Matrix2d(Eigen::Matrix2d::Zero());
-    const planarvo::calib::ExtrinsicsEstimate e =
+    const planarvo::ExtrinsicsEstimate e =
         planarvo::calib::compose_extrinsics(roll, pitch, rp, roll_pitch_covariance != nullptr, g);
     if (extrinsics) *extrinsics = planarvo::capi::to_c(e.value);
     if (covariance) planarvo::capi::matrix_to_c<6>(e.covariance, covariance);

@@ -1,5 +1,8 @@
 // C API: camera and extrinsics YAML, TUM trajectories.
 #include <cmath>
+#include <cstddef>
+#include <cstdio>
+#include <cstring>
 #include <memory>
 #include <sstream>
 #include <string>
@@ -7,6 +10,8 @@
 #include "capi/convert.h"
 #include "capi/status.h"
 #include "core/error.h"
+#include "core/extrinsics_estimate.h"
+#include "graph/calibration_extrinsics.h"
 #include "io/formats.h"
 #include "io/stats.h"
 
@@ -57,7 +62,7 @@ PLANARVO_API planarvo_status planarvo_extrinsics_save(const char* path, const pl
   return guard([&] {
     require_path(path, "planarvo_extrinsics_save");
     require(e != nullptr, "planarvo_extrinsics_save: extrinsics is NULL");
-    planarvo::io::ExtrinsicsFile f;
+    planarvo::ExtrinsicsEstimate f;
     f.value = planarvo::capi::to_cpp(*e);
     for (double v : {e->x, e->y, e->z, e->roll, e->pitch, e->yaw})
       require(std::isfinite(v), "planarvo_extrinsics_save: a value is NaN or inf");
@@ -65,12 +70,70 @@ PLANARVO_API planarvo_status planarvo_extrinsics_save(const char* path, const pl
     if (estimated) {
       std::stringstream ss(estimated);
       std::string name;
-      while (std::getline(ss, name, ','))
-        if (!name.empty()) f.estimated.push_back(name);
+      while (std::getline(ss, name, ',')) {
+        if (name.empty()) continue;
+        const int k = planarvo::extrinsics_index(name);
+        require(k >= 0, ("planarvo_extrinsics_save: estimated names '" + name + "', not one of x y z roll pitch yaw").c_str());
+        f.estimated[static_cast<size_t>(k)] = true;
+      }
     }
     if (method) f.method = method;
     if (notes) f.notes = notes;
     planarvo::io::write_extrinsics_yaml(path, f);
+  });
+}
+
+PLANARVO_API planarvo_status planarvo_camera_calibration_save(const char* path,
+                                                              const planarvo_camera_calibration_result* result,
+                                                              const char* notes) {
+  return guard([&] {
+    require_path(path, "planarvo_camera_calibration_save");
+    require(result != nullptr, "planarvo_camera_calibration_save: result is NULL");
+    planarvo::capi::require_struct_size(result->struct_size, sizeof *result, "planarvo_camera_calibration_result");
+    planarvo::ExtrinsicsEstimate e;
+    e.value = planarvo::capi::to_cpp(result->extrinsics);
+    e.covariance = planarvo::capi::matrix_from_c<6>(result->covariance);
+    for (size_t i = 0; i < 6; ++i) {
+      e.estimated[i] = result->estimated[i] != 0;
+      e.observable[i] = result->observable[i] != 0;
+    }
+    e.method.assign(result->method, strnlen(result->method, sizeof result->method));
+    e.notes = notes ? notes : "";
+    if (result->readout_evaluations > 0 && result->readout_reason[0] == 0) {
+      char line[160];
+      std::snprintf(line, sizeof line, "rolling_shutter_readout estimated %.6f s +- %.6f (%s)", result->readout_estimate,
+                    result->readout_sigma, result->readout > 0 ? "used" : "taken as 0, a global shutter");
+      e.notes += (e.notes.empty() ? "" : "; ") + std::string(line);
+    }
+    planarvo::io::write_extrinsics_yaml(path, e);
+  });
+}
+
+PLANARVO_API planarvo_status planarvo_calibration_save(const char* path, const planarvo_calibration_result* result,
+                                                       planarvo_calibration_method method, int32_t metric_sensor,
+                                                       const char* notes) {
+  return guard([&] {
+    require_path(path, "planarvo_calibration_save");
+    require(result != nullptr, "planarvo_calibration_save: result is NULL");
+    const int m = planarvo::capi::enum_value(method);
+    require(m == PLANARVO_CALIBRATE_ODOMETRY || m == PLANARVO_CALIBRATE_NONHOLONOMIC,
+            "planarvo_calibration_save: method is not a planarvo_calibration_method");
+    planarvo::capi::require_struct_size(result->struct_size, offsetof(planarvo_calibration_result, observable) +
+                                                                 sizeof result->observable,
+                                        "planarvo_calibration_result");
+    planarvo::graph::CalibrationResult g;
+    for (size_t i = 0; i < 4; ++i) {
+      g.value[i] = result->value[i];
+      g.estimated[i] = result->estimated[i] != 0;
+      g.observable[i] = result->observable[i] != 0;
+    }
+    g.covariance = planarvo::capi::matrix_from_c<4>(result->covariance);
+    const auto graph_method = m == PLANARVO_CALIBRATE_ODOMETRY ? planarvo::graph::CalibrationMethod::Odometry
+                                                               : planarvo::graph::CalibrationMethod::Nonholonomic;
+    planarvo::ExtrinsicsEstimate e = planarvo::graph::as_extrinsics(g, metric_sensor != 0);
+    e.method = planarvo::graph::describe_method(graph_method);
+    e.notes = notes ? notes : "";
+    planarvo::io::write_extrinsics_yaml(path, e);
   });
 }
 

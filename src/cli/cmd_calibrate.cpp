@@ -12,8 +12,6 @@ namespace {
 
 constexpr double kDeg = M_PI / 180.0;
 
-const char* const kNames[6] = {"x", "y", "z", "roll", "pitch", "yaw"};
-
 void print_result(const planarvo_camera_calibration_result& r) {
   std::printf("camera extrinsics (T_robot_camera; metres and radians in the file):\n");
   const double v[6] = {r.extrinsics.x, r.extrinsics.y, r.extrinsics.z, r.extrinsics.roll, r.extrinsics.pitch,
@@ -24,10 +22,10 @@ void print_result(const planarvo_camera_calibration_result& r) {
     const char* unit = angle ? "deg" : "mm";
     const double sd = std::sqrt(std::max(0.0, r.covariance[i * 7]));
     if (!r.estimated[i]) {
-      std::printf("  %-5s %10.3f %-3s  (given, not estimated)\n", kNames[i], v[i] * k, unit);
+      std::printf("  %-5s %10.3f %-3s  (given, not estimated)\n", planarvo_extrinsics_name(i), v[i] * k, unit);
       continue;
     }
-    std::printf("  %-5s %10.3f %-3s  +- %.3f%s\n", kNames[i], v[i] * k, unit, sd * k,
+    std::printf("  %-5s %10.3f %-3s  +- %.3f%s\n", planarvo_extrinsics_name(i), v[i] * k, unit, sd * k,
                 r.observable[i] ? "" : "  NOT DETERMINED");
   }
 }
@@ -50,7 +48,7 @@ int cmd_calibrate_dataset(const Args& args, const planarvo_calibration_options& 
   const std::string dir = args.positionals()[0];
   planarvo_camera_calibration_options o;
   planarvo_camera_calibration_options_init(&o);
-  const std::string method = args.get("method", "odometry");
+  const std::string method = args.get("method", "odometry");  // as the user wrote it, for the output
   o.method = graph.method;
   // The camera's motions are far more precise than wheel odometry, so the odometry's noise model
   // is fitted to the drive's residuals unless the user gave one (--odometry-sigma).
@@ -62,8 +60,6 @@ int cmd_calibrate_dataset(const Args& args, const planarvo_calibration_options& 
   if (args.has("height")) {
     o.height = args.get_double("height", 0);
     if (!(o.height > 0)) throw UsageError("--height must be a positive number of metres");
-  } else if (o.method == PLANARVO_CALIBRATE_NONHOLONOMIC) {
-    throw UsageError("--method nonholonomic cannot estimate the camera height: give --height METRES");
   }
   if (args.has("frames")) {
     const long long n = args.get_int("frames", 0);
@@ -85,16 +81,6 @@ int cmd_calibrate_dataset(const Args& args, const planarvo_calibration_options& 
   DatasetPtr ds = open_dataset(dir, args, false, &progress);
   apply_roi(roi, ds.get());
   apply_readout(readout, ds.get());
-  planarvo_dataset_info info{};
-  info.struct_size = sizeof info;
-  check(planarvo_dataset_info_get(ds.get(), &info));
-  if (o.method == PLANARVO_CALIBRATE_ODOMETRY && !info.has_odometry)
-    throw UsageError(dir + (info.is_bag ? ": no --odom-topic given" : " has no odometry.txt") +
-                     ": the odometry method needs wheel odometry (or use --method nonholonomic with direction labels "
-                     "and --height)");
-  if (o.method == PLANARVO_CALIBRATE_NONHOLONOMIC && !info.has_direction)
-    throw UsageError(dir + (info.is_bag ? ": a bag has no direction labels" : " has no direction.txt") +
-                     ": the nonholonomic method needs them");
   planarvo_camera_calibration_result r{};
   const planarvo_status st = calibrate_dataset(ctx.get(), ds.get(), &o, &progress, &r);
 
@@ -125,22 +111,7 @@ int cmd_calibrate_dataset(const Args& args, const planarvo_calibration_options& 
     return kExitFailed;
   }
   if (!out.empty()) {
-    std::string estimated;
-    for (int i = 0; i < 6; ++i)
-      if (r.estimated[i]) estimated += std::string(estimated.empty() ? "" : ",") + kNames[i];
-    const std::string m = method == "odometry"
-                              ? "roll and pitch from images (sec. 5.1); x, y, z, yaw against wheel odometry (5.2.1)"
-                              : "roll and pitch from images (sec. 5.1); x, yaw nonholonomic, y from direction labels "
-                                "(5.2.2), z given";
-    std::string notes = "planarvo calibrate " + dir;
-    if (r.readout_evaluations > 0 && r.readout_reason[0] == 0) {
-      char line[160];
-      std::snprintf(line, sizeof line, "; rolling_shutter_readout estimated %.6f s +- %.6f (%s)", r.readout_estimate,
-                    r.readout_sigma, r.readout > 0 ? "used" : "taken as 0, a global shutter");
-      notes += line;
-    }
-    check(planarvo_extrinsics_save(out.c_str(), &r.extrinsics, r.covariance, estimated.c_str(), m.c_str(),
-                                   notes.c_str()));
+    check(planarvo_camera_calibration_save(out.c_str(), &r, ("planarvo calibrate " + dir).c_str()));
     std::printf("wrote %s\n", out.c_str());
   }
   return kExitOk;

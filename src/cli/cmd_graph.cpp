@@ -210,22 +210,8 @@ int cmd_calibrate(int argc, char** argv) {
   const std::string out = args.get("output");
   if (!out.empty() && !r.ok) std::printf("%s not written: the calibration is not determined\n", out.c_str());
   if (!out.empty() && r.ok) {
-    // Extrinsics YAML: z is the camera height (0 for a metric sensor); roll and pitch are not
-    // estimated from motions (they come from images).
-    const planarvo_extrinsics e{r.value[0], r.value[1], metric ? 0.0 : r.value[2], 0, 0, r.value[3]};
-    double cov[36] = {};
-    const int map[4] = {0, 1, 2, 5};  // x y scale yaw -> x y z roll pitch yaw
-    for (int i = 0; i < 4; ++i)
-      for (int j = 0; j < 4; ++j)
-        if (!(metric && (i == 2 || j == 2))) cov[map[i] * 6 + map[j]] = r.covariance[i * 4 + j];
-    std::string estimated;
-    for (int i = 0; i < 4; ++i)
-      if (r.estimated[i] && !(i == 2 && metric)) estimated += std::string(estimated.empty() ? "" : ",") + (i == 2 ? "z" : names[i]);
     const std::string notes = std::to_string(n) + " motion pairs from " + path;
-    check(planarvo_extrinsics_save(out.c_str(), &e, cov, estimated.c_str(),
-                                   method == "odometry" ? "graph calibration against wheel odometry"
-                                                        : "nonholonomic graph calibration",
-                                   notes.c_str()));
+    check(planarvo_calibration_save(out.c_str(), &r, o.method, metric ? 1 : 0, notes.c_str()));
     std::printf("wrote %s\n", out.c_str());
   }
   if (st == PLANARVO_ERROR_FAILED) {

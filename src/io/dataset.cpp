@@ -299,7 +299,7 @@ struct Dataset::Impl {
   bool readout_given = false;  // the camera file or set_rolling_shutter_readout gave it
   std::vector<StampedPose> odometry, groundtruth;
   std::vector<DirectionLabel> direction;
-  std::optional<ExtrinsicsFile> extrinsics, extrinsics_gt;
+  std::optional<ExtrinsicsEstimate> extrinsics, extrinsics_gt;
   std::unique_ptr<VideoSource> video;
   std::unique_ptr<BagSource> bag;
 
@@ -553,7 +553,7 @@ std::optional<int> Dataset::direction_for_interval(int64_t i) const {
   return direction_at(impl_->direction, 0.5 * (f[static_cast<size_t>(i) - 1].t + f[static_cast<size_t>(i)].t));
 }
 
-const std::optional<ExtrinsicsFile>& Dataset::extrinsics() const { return impl_->extrinsics; }
-const std::optional<ExtrinsicsFile>& Dataset::extrinsics_gt() const { return impl_->extrinsics_gt; }
+const std::optional<ExtrinsicsEstimate>& Dataset::extrinsics() const { return impl_->extrinsics; }
+const std::optional<ExtrinsicsEstimate>& Dataset::extrinsics_gt() const { return impl_->extrinsics_gt; }
 
 }  // namespace planarvo::io

@@ -112,8 +112,8 @@ class Dataset {
   std::optional<int> direction_for_interval(int64_t i) const;
 
   // extrinsics.yaml and extrinsics_gt.yaml, when present.
-  const std::optional<ExtrinsicsFile>& extrinsics() const;
-  const std::optional<ExtrinsicsFile>& extrinsics_gt() const;
+  const std::optional<ExtrinsicsEstimate>& extrinsics() const;
+  const std::optional<ExtrinsicsEstimate>& extrinsics_gt() const;
 
  private:
   struct Impl;

@@ -14,6 +14,7 @@
 #include <Eigen/Core>
 
 #include "core/extrinsics.h"
+#include "core/extrinsics_estimate.h"
 #include "core/se2.h"
 #include "core/camera.h"
 
@@ -29,18 +30,13 @@ namespace planarvo::io {
 CameraModel read_camera_yaml(const std::string& path, bool* readout_given = nullptr);
 void write_camera_yaml(const std::string& path, const CameraModel& camera);
 
-struct ExtrinsicsFile {
-  Extrinsics value;
-  Eigen::Matrix<double, 6, 6> covariance = Eigen::Matrix<double, 6, 6>::Zero();  // x y z r p y
-  std::vector<std::string> estimated;  // names of estimated parameters, e.g. {"x", "yaw"}
-  std::string method;
-  std::string notes;
-};
-// x y z roll pitch yaw are required; T_robot_camera (checked against them to 1e-6 per entry),
-// covariance (6x6), estimated (a sequence of those six names, no repeats), method and notes
-// (strings) are optional. The writer writes every key.
-ExtrinsicsFile read_extrinsics_yaml(const std::string& path);
-void write_extrinsics_yaml(const std::string& path, const ExtrinsicsFile& e);
+// extrinsics.yaml (core/extrinsics_estimate.h): x y z roll pitch yaw are required;
+// T_robot_camera (checked against them to 1e-6 per entry), covariance (6x6), estimated (a
+// sequence of those six names, no repeats), method and notes (strings) are optional; observable
+// is not in the file (read as false). The writer writes every key, `estimated` in the names'
+// order.
+ExtrinsicsEstimate read_extrinsics_yaml(const std::string& path);
+void write_extrinsics_yaml(const std::string& path, const ExtrinsicsEstimate& e);
 
 struct StampedPose {
   double t;

@@ -22,7 +22,6 @@ namespace planarvo::io {
 
 namespace {
 
-const std::array<const char*, 6> kExtrinsicNames = {"x", "y", "z", "roll", "pitch", "yaw"};
 
 // A T_robot_camera that differs from the matrix of the six values by more than this (in any
 // entry: metres, or rotation-matrix units ~ radians) is an error: well above the ~1e-16 rounding
@@ -487,15 +486,15 @@ void write_camera_yaml(const std::string& path, const CameraModel& camera) {
   write_storage_text(path, fs);
 }
 
-ExtrinsicsFile read_extrinsics_yaml(const std::string& path) {
+ExtrinsicsEstimate read_extrinsics_yaml(const std::string& path) {
   return with_parse_errors(path, [&] {
     cv::FileStorage fs;
     open_for_reading(fs, path);
-    ExtrinsicsFile out;
+    ExtrinsicsEstimate out;
     double* values[6] = {&out.value.x,    &out.value.y,     &out.value.z,
                          &out.value.roll, &out.value.pitch, &out.value.yaw};
     for (size_t i = 0; i < 6; ++i)
-      *values[i] = read_real(required(fs, path, kExtrinsicNames[i]), path, kExtrinsicNames[i]);
+      *values[i] = read_real(required(fs, path, kExtrinsicsNames[i]), path, kExtrinsicsNames[i]);
 
     const cv::FileNode tn = fs["T_robot_camera"];
     if (!tn.empty() && !tn.isNone()) {
@@ -527,12 +526,10 @@ ExtrinsicsFile read_extrinsics_yaml(const std::string& path) {
       for (const cv::FileNode& item : en) {
         if (!item.isString()) fail(path, "'estimated' holds something that is not a name");
         const std::string name = item.string();
-        if (std::find_if(kExtrinsicNames.begin(), kExtrinsicNames.end(),
-                         [&](const char* k) { return name == k; }) == kExtrinsicNames.end())
-          fail(path, "'estimated' names '" + name + "', not one of x y z roll pitch yaw");
-        if (std::find(out.estimated.begin(), out.estimated.end(), name) != out.estimated.end())
-          fail(path, "'estimated' names '" + name + "' twice");
-        out.estimated.push_back(name);
+        const int k = extrinsics_index(name);
+        if (k < 0) fail(path, "'estimated' names '" + name + "', not one of x y z roll pitch yaw");
+        if (out.estimated[static_cast<size_t>(k)]) fail(path, "'estimated' names '" + name + "' twice");
+        out.estimated[static_cast<size_t>(k)] = true;
       }
     }
 
@@ -544,19 +541,14 @@ ExtrinsicsFile read_extrinsics_yaml(const std::string& path) {
   });
 }
 
-void write_extrinsics_yaml(const std::string& path, const ExtrinsicsFile& e) {
-  const double values[6] = {e.value.x, e.value.y, e.value.z, e.value.roll, e.value.pitch, e.value.yaw};
+void write_extrinsics_yaml(const std::string& path, const ExtrinsicsEstimate& e) {
+  const std::array<double, 6> values = extrinsics_values(e.value);
   for (double v : values)
     if (!std::isfinite(v)) throw_invalid_argument(path + ": extrinsics are not finite");
   if (!e.covariance.allFinite()) throw_invalid_argument(path + ": covariance is not finite");
-  for (const std::string& name : e.estimated)
-    if (std::find_if(kExtrinsicNames.begin(), kExtrinsicNames.end(),
-                     [&](const char* k) { return name == k; }) == kExtrinsicNames.end())
-      throw_invalid_argument(path + ": estimated names '" + name +
-                             "', not one of x y z roll pitch yaw");
 
   cv::FileStorage fs = memory_writer();
-  for (size_t i = 0; i < 6; ++i) fs << kExtrinsicNames[i] << values[i];
+  for (size_t i = 0; i < 6; ++i) fs << kExtrinsicsNames[i] << values[i];
   const Eigen::Matrix4d T = e.value.T_vc();
   cv::Mat Tm(4, 4, CV_64F), Cm(6, 6, CV_64F);
   for (int r = 0; r < 4; ++r)
@@ -566,7 +558,8 @@ void write_extrinsics_yaml(const std::string& path, const ExtrinsicsFile& e) {
   fs << "T_robot_camera" << Tm;
   fs << "covariance" << Cm;
   fs << "estimated" << "[";
-  for (const std::string& name : e.estimated) fs << name;
+  for (size_t i = 0; i < 6; ++i)
+    if (e.estimated[i]) fs << kExtrinsicsNames[i];
   fs << "]";
   // cv::write, not <<: operator<< reads a leading '[' or '{' of a string as structure.
   cv::write(fs, "method", e.method);

@@ -97,7 +97,7 @@ void simulate(ocl::Runtime& runtime, const Options& options, const std::string& 
   camera.rolling_shutter_readout = options.readout_time;
   camera.exposure_time = options.exposure_time;
   io::write_camera_yaml((dir / "camera.yaml").string(), camera);
-  io::ExtrinsicsFile gt;
+  ExtrinsicsEstimate gt;
   gt.value = options.extrinsics;
   gt.method = "simulator";
   gt.notes = "ground truth of a simulated data set (seed " + std::to_string(options.seed) + ")";
@@ -122,7 +122,7 @@ void simulate(ocl::Runtime& runtime, const Options& options, const std::string& 
     io::write_plane((dir / "plane.txt").string(), plane);
   }
   if (std::isfinite(options.knock_time)) {
-    io::ExtrinsicsFile knocked = gt;
+    ExtrinsicsEstimate knocked = gt;
     knocked.value = knocked_extrinsics(options);
     knocked.notes = "ground truth after the knock at t = " + std::to_string(options.knock_time) + " s (seed " +
                     std::to_string(options.seed) + ")";

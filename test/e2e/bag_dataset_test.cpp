@@ -70,7 +70,7 @@ class BagDataset : public ::testing::Test {
     const auto r = run_cli("simulate --quiet --out " + dataset_dir().string() +
                            " --seconds 2 --width 320 --height 240 --seed 3");
     ASSERT_EQ(r.exit_code, 0) << r.output;
-    io::ExtrinsicsFile e = io::read_extrinsics_yaml((dataset_dir() / "extrinsics_gt.yaml").string());
+    ExtrinsicsEstimate e = io::read_extrinsics_yaml((dataset_dir() / "extrinsics_gt.yaml").string());
     extrinsics_ = {e.value.x, e.value.y, e.value.z, e.value.roll, e.value.pitch, e.value.yaw};
     folder_ = track(dataset_dir().string(), nullptr);
   }
@@ -380,7 +380,7 @@ TEST_F(BagDataset, CalibrateReadsTheOdometryTopic) {
   const auto tool = run_cli("calibrate --quiet " + bag.string() + " --odom-topic /odom -o " + out.string());
   if (from_folder.status == PLANARVO_CALIBRATION_OK) {
     ASSERT_EQ(tool.exit_code, 0) << tool.output;
-    const io::ExtrinsicsFile e = io::read_extrinsics_yaml(out.string());
+    const ExtrinsicsEstimate e = io::read_extrinsics_yaml(out.string());
     const double v[6] = {e.value.x, e.value.y, e.value.z, e.value.roll, e.value.pitch, e.value.yaw};
     for (int k = 0; k < 6; ++k) EXPECT_NEAR(v[k], b[k], 1e-9) << k;
   } else {

@@ -137,7 +137,7 @@ TEST(CalibrateDataset, OdometryMethodThroughTheCApiAndTheTool) {
   const std::string out = (dir / "calibrated.yaml").string();
   const test::CommandResult c = test::run_cli("calibrate \"" + dir.path().string() + "\" --quiet -o \"" + out + "\"");
   ASSERT_EQ(c.exit_code, 0) << c.output;
-  const io::ExtrinsicsFile f = io::read_extrinsics_yaml(out);
+  const ExtrinsicsEstimate f = io::read_extrinsics_yaml(out);
   EXPECT_NEAR(f.value.x, e.x, 1e-12);
   EXPECT_NEAR(f.value.y, e.y, 1e-12);
   EXPECT_NEAR(f.value.z, e.z, 1e-12);
@@ -145,12 +145,12 @@ TEST(CalibrateDataset, OdometryMethodThroughTheCApiAndTheTool) {
   EXPECT_NEAR(f.value.pitch, e.pitch, 1e-12);
   EXPECT_NEAR(f.value.yaw, e.yaw, 1e-12);
   for (int i = 0; i < 36; ++i) EXPECT_NEAR(f.covariance(i / 6, i % 6), r.covariance[i], 1e-20) << i;
-  EXPECT_EQ(f.estimated.size(), 6u);
+  EXPECT_EQ(f.estimated, (std::array<bool, 6>{true, true, true, true, true, true}));
   expect_printed_report(c.output, r);
 
   // The other route: track at the camera's own frame (true tilt, x = y = 0, z = 1, yaw = 0), write
   // the motions with --motions-out, calibrate from the CSV: x, y, height and yaw again.
-  io::ExtrinsicsFile virtual_frame;
+  ExtrinsicsEstimate virtual_frame;
   virtual_frame.value = Extrinsics{0, 0, 1, t.roll, t.pitch, 0};
   io::write_extrinsics_yaml((dir / "virtual.yaml").string(), virtual_frame);
   const std::string pairs = (dir / "pairs.csv").string();
@@ -159,7 +159,7 @@ TEST(CalibrateDataset, OdometryMethodThroughTheCApiAndTheTool) {
   const std::string from_pairs = (dir / "from_pairs.yaml").string();
   const test::CommandResult cp = test::run_cli("calibrate --motions \"" + pairs + "\" -o \"" + from_pairs + "\"");
   ASSERT_EQ(cp.exit_code, 0) << cp.output;
-  const io::ExtrinsicsFile g = io::read_extrinsics_yaml(from_pairs);
+  const ExtrinsicsEstimate g = io::read_extrinsics_yaml(from_pairs);
   EXPECT_LT(std::abs(g.value.x - t.x), 3e-3);
   EXPECT_LT(std::abs(g.value.y - t.y), 3e-3);
   EXPECT_LT(std::abs(g.value.z - t.z), 2e-3);
@@ -287,6 +287,59 @@ TEST(CalibrateDataset, StagesAndStreamThroughTheCApiEqualThePipeline) {
   for (int i = 0; i < 36; ++i) EXPECT_EQ(streamed.covariance[i], whole.covariance[i]) << i;
   EXPECT_EQ(streamed.extrinsics.x, whole.extrinsics.x);
   EXPECT_EQ(streamed.extrinsics.yaw, whole.extrinsics.yaw);
+
+  // A stream whose odometry comes as samples of its own (a ROS topic): odometry.txt's samples,
+  // each given just before the first frame it reaches, and the frames without a pose. The
+  // calibrator interpolates them as the data set does, so the result is the same, bit for bit.
+  size_t n_odometry = 0;
+  const std::string odometry_path = (dir / "odometry.txt").string();
+  ASSERT_EQ(planarvo_read_tum(odometry_path.c_str(), nullptr, nullptr, 0, &n_odometry), PLANARVO_OK);
+  std::vector<double> odometry_t(n_odometry);
+  std::vector<planarvo_se2> odometry_pose(n_odometry);
+  ASSERT_EQ(planarvo_read_tum(odometry_path.c_str(), odometry_t.data(), odometry_pose.data(), n_odometry, &n_odometry),
+            PLANARVO_OK);
+  ASSERT_EQ(planarvo_camera_calibrator_create(ctx, &info.camera, &stream_options, &cal), PLANARVO_OK);
+  size_t given = 0;
+  for (int64_t i = 0; i < info.frame_count; ++i) {
+    planarvo_frame_data fd{};
+    ASSERT_EQ(planarvo_dataset_frame_data(ds, i, &fd), PLANARVO_OK);
+    while (given < n_odometry && (given == 0 || odometry_t[given - 1] < fd.timestamp)) {
+      ASSERT_EQ(planarvo_camera_calibrator_add_odometry(cal, odometry_t[given], &odometry_pose[given]), PLANARVO_OK);
+      ++given;
+    }
+    planarvo_image img{};
+    ASSERT_EQ(planarvo_dataset_frame(ds, i, &img), PLANARVO_OK);
+    ASSERT_EQ(planarvo_camera_calibrator_add_frame(cal, &img, fd.timestamp, nullptr,
+                                                   fd.has_direction ? &fd.direction : nullptr),
+              PLANARVO_OK);
+  }
+  // Samples out of order are refused.
+  EXPECT_EQ(planarvo_camera_calibrator_add_odometry(cal, odometry_t[0], &odometry_pose[0]),
+            PLANARVO_ERROR_INVALID_ARGUMENT);
+  planarvo_camera_calibration_result sampled{};
+  sampled.struct_size = sizeof sampled;
+  ASSERT_EQ(planarvo_camera_calibrator_finish(cal, &sampled), PLANARVO_OK) << planarvo_last_error();
+  planarvo_camera_calibrator_destroy(cal);
+  EXPECT_EQ(sampled.samples, whole.samples);
+  for (int i = 0; i < 36; ++i) EXPECT_EQ(sampled.covariance[i], whole.covariance[i]) << i;
+  EXPECT_EQ(sampled.extrinsics.x, whole.extrinsics.x);
+  EXPECT_EQ(sampled.extrinsics.z, whole.extrinsics.z);
+  EXPECT_EQ(sampled.extrinsics.yaw, whole.extrinsics.yaw);
+
+  // The library writes the result's extrinsics.yaml: what the result holds, the method of the
+  // pipeline, the notes given.
+  const std::string saved = (dir / "saved.yaml").string();
+  ASSERT_EQ(planarvo_camera_calibration_save(saved.c_str(), &sampled, "a stream"), PLANARVO_OK) << planarvo_last_error();
+  const ExtrinsicsEstimate read = io::read_extrinsics_yaml(saved);
+  EXPECT_EQ(read.value.x, sampled.extrinsics.x);
+  EXPECT_EQ(read.value.pitch, sampled.extrinsics.pitch);
+  for (int i = 0; i < 6; ++i) {
+    EXPECT_EQ(read.estimated[static_cast<size_t>(i)], sampled.estimated[i] != 0) << i;
+    for (int j = 0; j < 6; ++j) EXPECT_EQ(read.covariance(i, j), sampled.covariance[i * 6 + j]) << i << " " << j;
+  }
+  EXPECT_EQ(read.method, describe_camera_calibration(graph::CalibrationMethod::Odometry));
+  EXPECT_EQ(std::string(sampled.method), read.method);
+  EXPECT_EQ(read.notes, "a stream");
 
   // The stages by hand: motions tracked with the pipeline's roll and pitch, the graph calibration
   // with the odometry's noise estimated, the composition.

@@ -230,7 +230,7 @@ TEST(CliCalibrate, CensiLmovPrintsAndWritesWhatTheCApiComputes) {
   ASSERT_EQ(c.status, PLANARVO_OK) << planarvo_last_error();
   expect_printed_calibration(r.output, c);
 
-  const io::ExtrinsicsFile f = io::read_extrinsics_yaml(out);
+  const ExtrinsicsEstimate f = io::read_extrinsics_yaml(out);
   const double* v = c.result.value;
   EXPECT_NEAR(f.value.x, v[0], 1e-15);
   EXPECT_NEAR(f.value.y, v[1], 1e-15);
@@ -244,7 +244,7 @@ TEST(CliCalibrate, CensiLmovPrintsAndWritesWhatTheCApiComputes) {
       const double expected = map[i] < 0 || map[j] < 0 ? 0.0 : c.result.covariance[map[i] * 4 + map[j]];
       EXPECT_NEAR(f.covariance(i, j), expected, 1e-12 * std::abs(expected)) << i << "," << j;
     }
-  EXPECT_EQ(f.estimated, (std::vector<std::string>{"x", "y", "yaw"}));
+  EXPECT_EQ(f.estimated, (std::array<bool, 6>{true, true, false, false, false, true}));  // x, y, yaw
 
   // The archive (shared/data/real/censi2011): x -5.871 +- 1.261 mm, y -38.708 +- 0.673 mm,
   // yaw -106.585 +- 1.196 deg.

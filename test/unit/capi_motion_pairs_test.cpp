@@ -15,6 +15,9 @@
 #include <gtest/gtest.h>
 
 #include "common/test_util.h"
+#include "core/extrinsics_estimate.h"
+#include "graph/calibration_extrinsics.h"
+#include "io/formats.h"
 #include "planarvo/planarvo.h"
 #include "unit/graph_calibration_sim.h"
 
@@ -265,6 +268,49 @@ TEST(CApiCalibrateKnownAnswer, NoiseFreeMotionsGiveTheTruth) {
   }
   EXPECT_EQ(nonholonomic.estimated[2], 0);  // the scale was held
   EXPECT_EQ(nonholonomic.value[2], kTruth[2]);
+}
+
+// The library writes a motion-pair calibration's extrinsics.yaml: the graph's x, y, scale, yaw at
+// x, y, z, yaw with their covariance; a metric sensor's scale is not a height (z 0, not estimated);
+// roll and pitch 0, not estimated; the method's sentence; the notes given.
+TEST(CApiCalibrateKnownAnswer, SavedExtrinsicsAreTheGraphsFourParameters) {
+  CalibrationSim sim;
+  sim.seed = 5;
+  sim.sensor_sigma_t = 0.002 / kTruth[2];
+  const auto pairs = simulated_pairs(sim);
+  const planarvo_calibration_result r = calibrate(pairs, nullptr);
+  ASSERT_EQ(r.ok, 1);
+  test::ScratchDir dir;
+  for (int metric = 0; metric < 2; ++metric) {
+    const std::string path = (dir / ("e" + std::to_string(metric) + ".yaml")).string();
+    ASSERT_EQ(planarvo_calibration_save(path.c_str(), &r, PLANARVO_CALIBRATE_ODOMETRY, metric, "pairs"), PLANARVO_OK)
+        << planarvo_last_error();
+    const ExtrinsicsEstimate e = io::read_extrinsics_yaml(path);
+    const int at[4] = {0, 1, 2, 5};  // x y scale yaw in x y z roll pitch yaw
+    EXPECT_EQ(e.value.x, r.value[0]);
+    EXPECT_EQ(e.value.y, r.value[1]);
+    EXPECT_EQ(e.value.z, metric ? 0.0 : r.value[2]);
+    EXPECT_EQ(e.value.yaw, r.value[3]);
+    EXPECT_EQ(e.value.roll, 0.0);
+    EXPECT_EQ(e.value.pitch, 0.0);
+    for (int i = 0; i < 4; ++i) {
+      const bool kept = !(metric && i == 2);
+      EXPECT_EQ(e.estimated[static_cast<size_t>(at[i])], kept && r.estimated[i]) << i;
+      for (int j = 0; j < 4; ++j)
+        EXPECT_EQ(e.covariance(at[i], at[j]), kept && !(metric && j == 2) ? r.covariance[i * 4 + j] : 0.0) << i << j;
+    }
+    EXPECT_FALSE(e.estimated[3] || e.estimated[4]);
+    EXPECT_EQ(e.covariance.row(3).norm() + e.covariance.row(4).norm(), 0.0);
+    EXPECT_EQ(e.method, graph::describe_method(graph::CalibrationMethod::Odometry));
+    EXPECT_EQ(e.notes, "pairs");
+  }
+  EXPECT_EQ(planarvo_calibration_save((dir / "x.yaml").string().c_str(), &r,
+                                      static_cast<planarvo_calibration_method>(7), 0, nullptr),
+            PLANARVO_ERROR_INVALID_ARGUMENT);
+  // The parameters' names, in the order of every array.
+  for (int i = 0; i < 6; ++i) EXPECT_STREQ(planarvo_extrinsics_name(i), kExtrinsicsNames[static_cast<size_t>(i)]);
+  EXPECT_EQ(planarvo_extrinsics_name(-1), nullptr);
+  EXPECT_EQ(planarvo_extrinsics_name(6), nullptr);
 }
 
 // Noisy motions with gross errors: the truth within 4 reported standard deviations, the gross

@@ -260,9 +260,9 @@ TEST(IoDataset, DirectionForIntervalUsesTheMidpoint) {
 TEST(IoDataset, ReadsExtrinsicsFiles) {
   ScratchDir dir;
   make_dataset(dir.path());
-  io::ExtrinsicsFile e;
+  ExtrinsicsEstimate e;
   e.value = Extrinsics{0.2, -0.02, 0.18, 0.1, 0.2, -0.3};
-  e.estimated = {"yaw"};
+  e.estimated[5] = true;  // yaw
   io::write_extrinsics_yaml((dir / "extrinsics_gt.yaml").string(), e);
   write_text(dir / "extrinsics.yaml", "%YAML:1.0\n---\nx: 0.25\ny: 0\nz: 0.2\nroll: 0\npitch: 0\nyaw: 0\n");
   Dataset ds(dir.path().string());
@@ -270,7 +270,7 @@ TEST(IoDataset, ReadsExtrinsicsFiles) {
   ASSERT_TRUE(ds.extrinsics_gt());
   EXPECT_EQ(ds.extrinsics()->value.x, 0.25);
   EXPECT_EQ(ds.extrinsics_gt()->value.yaw, -0.3);
-  EXPECT_EQ(ds.extrinsics_gt()->estimated, std::vector<std::string>{"yaw"});
+  EXPECT_EQ(ds.extrinsics_gt()->estimated, (std::array<bool, 6>{false, false, false, false, false, true}));
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -264,16 +264,16 @@ TEST(IoCameraYaml, RollingShutterReadoutRoundTripsAndIsChecked) {
 
 TEST(IoExtrinsicsYaml, WriteThenReadKeepsEverything) {
   ScratchDir dir;
-  io::ExtrinsicsFile e;
+  ExtrinsicsEstimate e;
   e.value = Extrinsics{0.2441, -0.0185, 0.1787, 0.21642082, 0.30717795, -0.16057029};
   for (int r = 0; r < 6; ++r)
     for (int c = 0; c < 6; ++c) e.covariance(r, c) = (r == c ? 1e-4 : 1e-6) * (1 + r + 2 * c) / 7.0;
-  e.estimated = {"x", "y", "yaw"};
+  e.estimated = {true, true, false, false, false, true};  // x, y, yaw
   e.method = "odometry+nonholonomic";
   e.notes = "[3 runs] {tiles}: converged # after 12 iterations, \"quoted\"";
   const std::string path = (dir / "extrinsics.yaml").string();
   io::write_extrinsics_yaml(path, e);
-  const io::ExtrinsicsFile r = io::read_extrinsics_yaml(path);
+  const ExtrinsicsEstimate r = io::read_extrinsics_yaml(path);
   EXPECT_EQ(r.value.x, e.value.x);
   EXPECT_EQ(r.value.y, e.value.y);
   EXPECT_EQ(r.value.z, e.value.z);
@@ -299,12 +299,12 @@ TEST(IoExtrinsicsYaml, WriteThenReadKeepsEverything) {
 
 TEST(IoExtrinsicsYaml, EmptyEstimatedAndStringsRoundTrip) {
   ScratchDir dir;
-  io::ExtrinsicsFile e;
+  ExtrinsicsEstimate e;
   e.value = Extrinsics{0, 0, 1, 0, 0, 0};
   const std::string path = (dir / "e.yaml").string();
   io::write_extrinsics_yaml(path, e);
-  const io::ExtrinsicsFile r = io::read_extrinsics_yaml(path);
-  EXPECT_TRUE(r.estimated.empty());
+  const ExtrinsicsEstimate r = io::read_extrinsics_yaml(path);
+  EXPECT_EQ(r.estimated, (std::array<bool, 6>{}));
   EXPECT_EQ(r.method, "");
   EXPECT_EQ(r.notes, "");
   EXPECT_TRUE(r.covariance.isZero(0.0));
@@ -313,14 +313,14 @@ TEST(IoExtrinsicsYaml, EmptyEstimatedAndStringsRoundTrip) {
 TEST(IoExtrinsicsYaml, OnlyTheSixValuesAreRequired) {
   ScratchDir dir;
   write_text(dir / "e.yaml", "%YAML:1.0\n---\nx: 0.1\ny: -0.2\nz: 0.3\nroll: 0\npitch: 0.05\nyaw: -1\n");
-  const io::ExtrinsicsFile r = io::read_extrinsics_yaml((dir / "e.yaml").string());
+  const ExtrinsicsEstimate r = io::read_extrinsics_yaml((dir / "e.yaml").string());
   EXPECT_EQ(r.value.x, 0.1);
   EXPECT_EQ(r.value.y, -0.2);
   EXPECT_EQ(r.value.z, 0.3);
   EXPECT_EQ(r.value.roll, 0.0);
   EXPECT_EQ(r.value.pitch, 0.05);
   EXPECT_EQ(r.value.yaw, -1.0);
-  EXPECT_TRUE(r.estimated.empty());
+  EXPECT_EQ(r.estimated, (std::array<bool, 6>{}));
 }
 
 TEST(IoExtrinsicsYaml, BadFilesNameTheFile) {
@@ -611,7 +611,7 @@ TEST(IoWriters, FailedWritesAreIoErrorsNamingTheFile) {
   expect_error([&] { io::write_direction(p, {{0.0, 1}}); }, ErrorCode::Io, p);
   expect_error([&] { io::write_frames(p, {{0.0, "a.png"}}); }, ErrorCode::Io, p);
   expect_error([&] { io::write_camera_yaml(p, test_camera()); }, ErrorCode::Io, p);
-  expect_error([&] { io::write_extrinsics_yaml(p, io::ExtrinsicsFile{}); }, ErrorCode::Io, p);
+  expect_error([&] { io::write_extrinsics_yaml(p, ExtrinsicsEstimate{}); }, ErrorCode::Io, p);
   expect_error([&] { io::StatsWriter w(p); }, ErrorCode::Io, p);
 }
 

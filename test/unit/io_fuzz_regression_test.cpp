@@ -60,7 +60,7 @@ TEST(IoFuzzRegression, BracketsInQuotesAndCommentsAndShallowFilesStillRead) {
   const std::string brackets(300, '[');
   write_text(path, "%YAML:1.0\n---\nx: 0.1\ny: 0.0\nz: 0.2\nroll: 0\npitch: 0\nyaw: 0  # " + brackets +
                        "\nmethod: \"" + brackets + "\"\nnotes: '" + brackets + "'\n");
-  const io::ExtrinsicsFile e = io::read_extrinsics_yaml(path);
+  const ExtrinsicsEstimate e = io::read_extrinsics_yaml(path);
   EXPECT_EQ(e.value.z, 0.2);
   EXPECT_EQ(e.method, brackets);
   EXPECT_EQ(e.notes, brackets);

@@ -184,7 +184,7 @@ TEST(SimBody, ADataSetCarriesTheTruePlaneAndTheKnockedMount) {
     EXPECT_EQ(plane[k].pitch, a.pitch);
     EXPECT_EQ(plane[k].sigma_roll, 0.0);
   }
-  const io::ExtrinsicsFile knocked = io::read_extrinsics_yaml((dir.path() / "extrinsics_knocked.yaml").string());
+  const ExtrinsicsEstimate knocked = io::read_extrinsics_yaml((dir.path() / "extrinsics_knocked.yaml").string());
   EXPECT_NEAR(knocked.value.z, o.extrinsics.z - 0.02, 1e-12);
   EXPECT_NEAR(knocked.value.pitch, o.extrinsics.pitch + 2.0 * kDeg, 1e-12);
   EXPECT_NEAR(knocked.value.roll, o.extrinsics.roll, 1e-12);

@@ -39,6 +39,14 @@ PLANARVO_API planarvo_status planarvo_extrinsics_save(const char* path, const pl
   PLANARVO_FORWARD(planarvo_extrinsics_save);
   return fn ? fn(path, e, covariance, estimated, method, notes) : PLANARVO_ERROR_INTERNAL;
 }
+PLANARVO_API planarvo_status planarvo_camera_calibration_save(const char* path, const planarvo_camera_calibration_result* result, const char* notes) {
+  PLANARVO_FORWARD(planarvo_camera_calibration_save);
+  return fn ? fn(path, result, notes) : PLANARVO_ERROR_INTERNAL;
+}
+PLANARVO_API planarvo_status planarvo_calibration_save(const char* path, const planarvo_calibration_result* result, planarvo_calibration_method method, int32_t metric_sensor, const char* notes) {
+  PLANARVO_FORWARD(planarvo_calibration_save);
+  return fn ? fn(path, result, method, metric_sensor, notes) : PLANARVO_ERROR_INTERNAL;
+}
 
 PLANARVO_API planarvo_status planarvo_extrinsics_matrix(const planarvo_extrinsics* e, double matrix[16]) {
   PLANARVO_FORWARD(planarvo_extrinsics_matrix);
@@ -281,6 +289,10 @@ PLANARVO_API planarvo_status planarvo_camera_calibrator_add_frame(planarvo_camer
   return fn ? fn(calibrator, image, timestamp, odometry_pose, direction) : PLANARVO_ERROR_INTERNAL;
 }
 
+PLANARVO_API planarvo_status planarvo_camera_calibrator_add_odometry(planarvo_camera_calibrator* calibrator, double timestamp, const planarvo_se2* pose) {
+  PLANARVO_FORWARD(planarvo_camera_calibrator_add_odometry);
+  return fn ? fn(calibrator, timestamp, pose) : PLANARVO_ERROR_INTERNAL;
+}
 PLANARVO_API planarvo_status planarvo_camera_calibrator_finish(planarvo_camera_calibrator* calibrator, planarvo_camera_calibration_result* result) {
   PLANARVO_FORWARD(planarvo_camera_calibrator_finish);
   return fn ? fn(calibrator, result) : PLANARVO_ERROR_INTERNAL;
