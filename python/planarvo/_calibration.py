@@ -15,7 +15,7 @@ from ._errors import _check
 from ._motion_pairs import MotionPair, _pairs_array
 from ._native import lib
 from ._posegraph import SolverSummary
-from ._util import LogFn, _c_options, _Callback, _fill_matrix, _matrix
+from ._util import LogFn, PathLike, _c_options, _Callback, _fill_matrix, _matrix, _opt, _path
 
 
 class CalibrationMethod(enum.IntEnum):
@@ -85,6 +85,14 @@ class CalibrationResult:
     total_iterations: int
     total_seconds: float
     variance_factor: float
+
+    def save(self, path: PathLike, method: CalibrationMethod = CalibrationMethod.ODOMETRY,
+             metric_sensor: bool = False, notes: Optional[str] = None) -> None:
+        """Writes extrinsics.yaml as planarvo calibrate --motions -o does: x, y, yaw and z = the
+        scale (the camera height), or z 0 with metric_sensor (the pairs' sensor measured metres);
+        roll and pitch 0, not estimated; the method's sentence; notes as given."""
+        _check(lib.planarvo_calibration_save(_path(path), ctypes.byref(self._to_c()), int(method),
+                                             int(bool(metric_sensor)), _opt(notes)))
 
     def _to_c(self) -> N.CalibrationResult:
         r = N.sized(N.CalibrationResult)

@@ -40,7 +40,7 @@ def calibration_drive(context, tmp_path_factory):
     return simulate_drive(context, tmp_path_factory.mktemp("sim") / "calib", 8.0, seed=3, supersampling=1)
 
 
-def test_calibrate_dataset_finds_true_extrinsics(context, calibration_drive):
+def test_calibrate_dataset_finds_true_extrinsics(context, calibration_drive, tmp_path):
     stages = []
     with planarvo.Dataset(calibration_drive) as ds:
         truth = ds.info.extrinsics_gt
@@ -58,6 +58,11 @@ def test_calibrate_dataset_finds_true_extrinsics(context, calibration_drive):
     # Within 5 standard deviations, and close in absolute terms (2 cm, 1 degree).
     assert np.all(np.abs(err) < 5 * result.sigmas + 1e-4), (err, result.sigmas)
     assert np.all(np.abs(err[:3]) < 0.02) and np.all(np.abs(err[3:]) < math.radians(1.0)), err
+    # The library writes it as planarvo calibrate -o does; the values read back exactly.
+    assert result.method.startswith("roll and pitch from images")
+    result.save(tmp_path / "extrinsics.yaml", notes="test")
+    np.testing.assert_array_equal(planarvo.Extrinsics.load(tmp_path / "extrinsics.yaml").as_array(),
+                                  result.extrinsics.as_array())
 
 
 def test_calibrate_dataset_estimates_the_readout_when_asked(context, tmp_path):
@@ -78,7 +83,7 @@ def test_calibrate_dataset_estimates_the_readout_when_asked(context, tmp_path):
     assert np.all(np.abs(err[3:5]) < math.radians(0.3)), err
 
 
-def test_graph_calibration_from_motion_pairs(context, calibration_drive):
+def test_graph_calibration_from_motion_pairs(context, calibration_drive, tmp_path):
     """track_motions at height 1 with the true roll and pitch, then calibrate: x, y, the height as
     the scale, and yaw."""
     with planarvo.Dataset(calibration_drive) as ds:
@@ -96,6 +101,12 @@ def test_graph_calibration_from_motion_pairs(context, calibration_drive):
     assert (e.roll, e.pitch) == (truth.roll, truth.pitch) and all(estimated)
     np.testing.assert_allclose(cov[3:5, 3:5], rp_cov, rtol=1e-12)
     np.testing.assert_allclose(cov[np.ix_([0, 1, 2, 5], [0, 1, 2, 5])], result.covariance, rtol=1e-9, atol=1e-18)
+    # Saved as calibrate --motions -o writes it: z is the scale, or 0 for a metric sensor.
+    for metric in (False, True):
+        result.save(tmp_path / "e.yaml", metric_sensor=metric)
+        saved = planarvo.Extrinsics.load(tmp_path / "e.yaml").as_array()
+        np.testing.assert_array_equal(saved, [result.value[0], result.value[1], 0.0 if metric else result.value[2],
+                                              0.0, 0.0, result.value[3]])
 
 
 def test_progress_callback_cancels_and_reraises(context, tmp_path):
