@@ -50,10 +50,10 @@ int cmd_calibrate_dataset(const Args& args, const planarvo_calibration_options& 
   planarvo_camera_calibration_options_init(&o);
   const std::string method = args.get("method", "odometry");  // as the user wrote it, for the output
   o.method = graph.method;
-  // The camera's motions are far more precise than wheel odometry, so the odometry's noise model
-  // is fitted to the drive's residuals unless the user gave one (--odometry-sigma).
+  // The odometry's noise model is the workflow's default (fitted to the drive's residuals: the
+  // camera's motions are far more precise than wheel odometry) unless the user gave one.
   planarvo_calibration_options g = graph;
-  g.estimate_odometry_noise = args.has("odometry-sigma") ? 0 : 1;
+  if (args.has("odometry-sigma")) g.estimate_odometry_noise = 0;
   o.graph = &g;
   if (args.has("fix-scale")) throw UsageError("--fix-scale is for metric sensors' motion pairs; give --height METRES");
   if (args.has("initial")) throw UsageError("--initial is for motion pairs; give --initial-extrinsics FILE");
