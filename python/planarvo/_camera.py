@@ -64,7 +64,8 @@ class Camera:
                         self.p2, self.k3, N.Region(*self.roi), self.rolling_shutter_readout, self.exposure_time)
 
 
-EXTRINSICS_NAMES = ("x", "y", "z", "roll", "pitch", "yaw")
+# The six parameters' names in the order of every covariance and flag array: the library's table.
+EXTRINSICS_NAMES = tuple(lib.planarvo_extrinsics_name(i).decode() for i in range(6))
 
 
 @dataclass

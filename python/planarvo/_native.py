@@ -232,6 +232,7 @@ _SIGNATURES = {
     "planarvo_extrinsics_load": (S, [c_char_p, P(Extrinsics)]),
     "planarvo_extrinsics_save": (S, [c_char_p, P(Extrinsics), P(c_double), c_char_p, c_char_p, c_char_p]),
     "planarvo_extrinsics_matrix": (S, [P(Extrinsics), P(c_double)]),
+    "planarvo_extrinsics_name": (c_char_p, [c_int32]),
     "planarvo_list_devices": (S, [P(DeviceInfo), c_size_t, P(c_size_t)]),
     "planarvo_context_options_init": (None, [P(ContextOptions)]),
     "planarvo_context_create": (S, [P(ContextOptions), P(c_void_p)]),
