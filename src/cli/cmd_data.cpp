@@ -390,11 +390,10 @@ int cmd_demo(int argc, char** argv) {
     const planarvo_extrinsics& t = info.extrinsics_gt;
     const planarvo_extrinsics& e = cr.extrinsics;
     const double est[6] = {e.x, e.y, e.z, e.roll, e.pitch, e.yaw}, tru[6] = {t.x, t.y, t.z, t.roll, t.pitch, t.yaw};
-    const char* names[6] = {"x", "y", "z", "roll", "pitch", "yaw"};
     std::printf("   %-6s %12s %12s %10s %10s\n", "", "estimated", "true", "error", "sigma");
     for (int i = 0; i < 6; ++i) {
       const double k = i < 3 ? 1e3 : 1 / kDeg;
-      std::printf("   %-6s %8.3f %-3s %8.3f %-3s %10.3f %10.3f\n", names[i], est[i] * k, i < 3 ? "mm" : "deg",
+      std::printf("   %-6s %8.3f %-3s %8.3f %-3s %10.3f %10.3f\n", planarvo_extrinsics_name(i), est[i] * k, i < 3 ? "mm" : "deg",
                   tru[i] * k, i < 3 ? "mm" : "deg", std::remainder(est[i] - tru[i], 2 * M_PI) * k,
                   std::sqrt(std::max(0.0, cr.covariance[i * 7])) * k);
     }
