@@ -1,6 +1,6 @@
 #include "calib/extrinsics_estimate.h"
 
-#include "graph/calibration_extrinsics.h"
+#include "graph/calibration/calibration_extrinsics.h"
 
 namespace planarvo::calib {
 

@@ -19,7 +19,7 @@
 
 #include "core/extrinsics.h"
 #include "core/extrinsics_estimate.h"
-#include "graph/calibration.h"
+#include "graph/calibration/calibration.h"
 #include "track/roll_pitch.h"
 
 namespace planarvo::calib {

@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "core/se2.h"
-#include "graph/calibration.h"
+#include "graph/calibration/calibration.h"
 #include "track/tracker.h"
 
 namespace planarvo::calib {

@@ -20,7 +20,7 @@
 #include "calib/readout_estimate.h"
 #include "calib/tilt_propagation.h"
 #include "core/se2.h"
-#include "graph/calibration.h"
+#include "graph/calibration/calibration.h"
 #include "core/camera.h"
 #include "track/roll_pitch.h"
 #include "track/tracker.h"

@@ -23,7 +23,7 @@
 
 #include <Eigen/Core>
 
-#include "graph/calibration.h"
+#include "graph/calibration/calibration.h"
 
 namespace planarvo::calib {
 

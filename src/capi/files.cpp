@@ -11,7 +11,7 @@
 #include "capi/status.h"
 #include "core/error.h"
 #include "core/extrinsics_estimate.h"
-#include "graph/calibration_extrinsics.h"
+#include "graph/calibration/calibration_extrinsics.h"
 #include "io/formats.h"
 #include "io/stats.h"
 

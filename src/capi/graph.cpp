@@ -10,10 +10,9 @@
 #include "capi/graph_convert.h"
 #include "capi/status.h"
 #include "core/error.h"
-#include "graph/calibration.h"
-#include "graph/g2o.h"
-#include "graph/initialisation.h"
-#include "graph/solver.h"
+#include "graph/calibration/calibration.h"
+#include "graph/posegraph/optimize.h"
+#include "graph/solver/solver.h"
 #include "io/motions.h"
 
 using planarvo::capi::guard;
@@ -248,39 +247,17 @@ PLANARVO_API planarvo_status planarvo_posegraph_optimize(const char* in_path, co
                                           "planarvo_posegraph_options");
       o = planarvo::capi::read_versioned(*options, o);
     }
-    require(o.max_iterations > 0, "planarvo_posegraph_options.max_iterations must be positive");
     const int init = planarvo::capi::enum_value(o.init);
     require(init == PLANARVO_POSEGRAPH_INIT_NONE || init == PLANARVO_POSEGRAPH_INIT_ROTATION_FIRST,
             "planarvo_posegraph_options.init is not a planarvo_posegraph_init");
-    planarvo::graph::G2oFile file = planarvo::graph::read_g2o(in_path);
-    if (file.vertices.empty()) planarvo::throw_invalid_input(std::string(in_path) + ": no VERTEX_SE2 lines");
-    planarvo::graph::FactorGraph graph = planarvo::graph::make_pose_graph(file);
-    const double chi2_0 = graph.chi2();
-    // Every number in the file is finite (the reader checks), but an edge's error at the file's
-    // poses, or its information, can still be too large for double arithmetic: eᵀΩe overflows,
-    // and nothing measured from such a graph means anything. Bad input, naming the edge.
-    if (!std::isfinite(chi2_0)) {
-      const int k = graph.first_nonfinite_factor();
-      std::string where = "the sum of the edges' errors";
-      if (k >= 0) {
-        const planarvo::graph::G2oEdge& e = file.edges.at(static_cast<size_t>(k));
-        where = "the error of EDGE_SE2 " + std::to_string(e.from) + " " + std::to_string(e.to);
-      }
-      planarvo::throw_invalid_input(std::string(in_path) + ": " + where +
-                                    " at the file's poses overflows double arithmetic (eᵀΩe is not finite): a pose, "
-                                    "measurement or information value is far too large");
-    }
-    if (o.init == PLANARVO_POSEGRAPH_INIT_ROTATION_FIRST) planarvo::graph::initialise_rotation_first(graph);
-    planarvo::graph::SolverOptions so;
-    so.max_iterations = o.max_iterations;
-    planarvo::graph::Solver solver(so);
-    const planarvo::graph::SolverSummary s = solver.solve(graph);
-    send_lines(o.log, o.log_user_data, s.full_report());
-    fill_summary(s, chi2_0, graph.chi2(), summary);
-    if (out_path && *out_path) {
-      planarvo::graph::update_poses(file, graph);
-      planarvo::graph::write_g2o(out_path, file);
-    }
+    planarvo::graph::PosegraphOptions po;
+    po.max_iterations = o.max_iterations;
+    po.rotation_first = o.init == PLANARVO_POSEGRAPH_INIT_ROTATION_FIRST;
+    if (o.log) po.log = [&o](const std::string& report) { send_lines(o.log, o.log_user_data, report); };
+    const planarvo::graph::PosegraphResult r =
+        planarvo::graph::optimize_g2o(in_path, out_path ? out_path : "", po);
+    const planarvo::graph::SolverSummary& s = r.summary;
+    fill_summary(s, r.initial_chi2, r.final_chi2, summary);
     converged = s.converged();
     why = summary->termination;
   });

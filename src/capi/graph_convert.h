@@ -1,7 +1,7 @@
 // The graph calibration's options and result across the C API, shared by planarvo_calibrate and
 // the camera calibration (capi/calibration.cpp).
 #pragma once
-#include "graph/calibration.h"
+#include "graph/calibration/calibration.h"
 #include "planarvo/planarvo.h"
 
 namespace planarvo::capi {

@@ -17,7 +17,7 @@
 #include <string>
 #include <vector>
 
-#include "graph/calibration.h"
+#include "graph/calibration/calibration.h"
 #include "io/motions.h"
 #include "../unit/graph_calibration_sim.h"
 

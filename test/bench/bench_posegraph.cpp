@@ -20,9 +20,9 @@
 #include <vector>
 
 #include "bench_posegraph_synthetic.h"
-#include "graph/g2o.h"
-#include "graph/initialisation.h"
-#include "graph/solver.h"
+#include "graph/posegraph/g2o.h"
+#include "graph/posegraph/initialisation.h"
+#include "graph/solver/solver.h"
 
 using namespace planarvo;
 using namespace planarvo::graph;

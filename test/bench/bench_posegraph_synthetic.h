@@ -8,8 +8,9 @@
 
 #include <Eigen/Core>
 
-#include "graph/factor_graph.h"
-#include "graph/factors.h"
+#include "graph/solver/factor_graph.h"
+#include "graph/calibration/factors.h"
+#include "graph/posegraph/factors.h"
 
 namespace planarvo::bench {
 

@@ -13,7 +13,7 @@
 #include <gtest/gtest.h>
 
 #include "common/test_util.h"
-#include "graph/calibration.h"
+#include "graph/calibration/calibration.h"
 #include "planarvo/planarvo.h"
 #include "unit/graph_calibration_sim.h"
 

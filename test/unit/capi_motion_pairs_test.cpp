@@ -16,7 +16,7 @@
 
 #include "common/test_util.h"
 #include "core/extrinsics_estimate.h"
-#include "graph/calibration_extrinsics.h"
+#include "graph/calibration/calibration_extrinsics.h"
 #include "io/formats.h"
 #include "planarvo/planarvo.h"
 #include "unit/graph_calibration_sim.h"

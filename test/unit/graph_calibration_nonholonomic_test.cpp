@@ -10,10 +10,10 @@
 #include <Eigen/Dense>
 #include <gtest/gtest.h>
 
-#include "graph/calibration.h"
-#include "graph/calibration_init.h"
-#include "graph/factor_graph.h"
-#include "graph/factors.h"
+#include "graph/calibration/calibration.h"
+#include "graph/calibration/calibration_init.h"
+#include "graph/solver/factor_graph.h"
+#include "graph/calibration/factors.h"
 #include "unit/graph_calibration_sim.h"
 
 namespace planarvo::graph {

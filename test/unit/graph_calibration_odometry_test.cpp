@@ -10,8 +10,8 @@
 #include <gtest/gtest.h>
 
 #include "core/error.h"
-#include "graph/calibration.h"
-#include "graph/calibration_init.h"
+#include "graph/calibration/calibration.h"
+#include "graph/calibration/calibration_init.h"
 #include "unit/graph_calibration_sim.h"
 
 namespace planarvo::graph {

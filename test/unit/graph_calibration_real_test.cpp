@@ -10,7 +10,7 @@
 #include <gtest/gtest.h>
 
 #include "common/test_util.h"
-#include "graph/calibration.h"
+#include "graph/calibration/calibration.h"
 #include "io/motions.h"
 
 namespace planarvo::graph {

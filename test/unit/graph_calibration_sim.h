@@ -13,7 +13,7 @@
 #include <Eigen/Core>
 
 #include "core/se2.h"
-#include "graph/calibration.h"
+#include "graph/calibration/calibration.h"
 
 namespace planarvo::test {
 

@@ -9,9 +9,10 @@
 #include <Eigen/Dense>
 #include <gtest/gtest.h>
 
-#include "graph/covariance.h"
-#include "graph/factors.h"
-#include "graph/solver.h"
+#include "graph/solver/covariance.h"
+#include "graph/calibration/factors.h"
+#include "graph/posegraph/factors.h"
+#include "graph/solver/solver.h"
 
 namespace planarvo::graph {
 namespace {

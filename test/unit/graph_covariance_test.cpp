@@ -9,10 +9,10 @@
 #include <gtest/gtest.h>
 
 #include "core/error.h"
-#include "graph/covariance.h"
-#include "graph/factors.h"
-#include "graph/normal_equations.h"
-#include "graph/solver.h"
+#include "graph/solver/covariance.h"
+#include "graph/posegraph/factors.h"
+#include "graph/solver/normal_equations.h"
+#include "graph/solver/solver.h"
 
 namespace planarvo::graph {
 namespace {

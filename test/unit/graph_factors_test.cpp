@@ -11,8 +11,9 @@
 
 #include "core/error.h"
 #include "core/se2.h"
-#include "graph/factors.h"
-#include "graph/robust_kernel.h"
+#include "graph/posegraph/factors.h"
+#include "graph/calibration/factors.h"
+#include "graph/solver/robust_kernel.h"
 
 namespace planarvo::graph {
 namespace {

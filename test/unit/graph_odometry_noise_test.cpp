@@ -6,7 +6,7 @@
 
 #include <gtest/gtest.h>
 
-#include "graph/odometry_noise.h"
+#include "graph/calibration/odometry_noise.h"
 
 namespace planarvo::graph {
 namespace {

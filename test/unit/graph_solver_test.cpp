@@ -13,11 +13,11 @@
 #include "common/test_util.h"
 #include "core/error.h"
 #include "core/se2.h"
-#include "graph/factors.h"
-#include "graph/g2o.h"
-#include "graph/initialisation.h"
-#include "graph/normal_equations.h"
-#include "graph/solver.h"
+#include "graph/posegraph/factors.h"
+#include "graph/posegraph/g2o.h"
+#include "graph/posegraph/initialisation.h"
+#include "graph/solver/normal_equations.h"
+#include "graph/solver/solver.h"
 
 namespace planarvo::graph {
 namespace {

@@ -18,8 +18,8 @@
 
 #include "../bench_posegraph_synthetic.h"
 #include "core/error.h"
-#include "graph/g2o.h"
-#include "graph/solver.h"
+#include "graph/posegraph/g2o.h"
+#include "graph/solver/solver.h"
 
 using namespace planarvo;
 using namespace planarvo::graph;

@@ -1,4 +1,4 @@
-#include "graph/initialisation.h"
+#include "graph/posegraph/initialisation.h"
 
 #include <cmath>
 #include <deque>
@@ -8,7 +8,7 @@
 #include <Eigen/SparseCholesky>
 
 #include "core/error.h"
-#include "graph/factors.h"
+#include "graph/posegraph/factors.h"
 
 namespace planarvo::graph {
 namespace {

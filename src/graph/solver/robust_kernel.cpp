@@ -1,4 +1,4 @@
-#include "graph/robust_kernel.h"
+#include "graph/solver/robust_kernel.h"
 
 #include <cmath>
 #include <sstream>

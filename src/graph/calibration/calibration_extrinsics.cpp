@@ -1,4 +1,4 @@
-#include "graph/calibration_extrinsics.h"
+#include "graph/calibration/calibration_extrinsics.h"
 
 namespace planarvo::graph {
 

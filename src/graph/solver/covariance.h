@@ -8,8 +8,8 @@
 
 #include <Eigen/Core>
 
-#include "graph/factor_graph.h"
-#include "graph/normal_equations.h"
+#include "graph/solver/factor_graph.h"
+#include "graph/solver/normal_equations.h"
 
 namespace planarvo::graph {
 

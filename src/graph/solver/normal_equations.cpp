@@ -2,7 +2,7 @@
 // columns, H's CSC pattern with the factors' block offsets, and steps on the values (retract).
 // Filling H and g is in normal_equations_assembly.cpp; the ordering, the factorisation and the
 // solves in normal_equations_cholesky.cpp.
-#include "graph/normal_equations.h"
+#include "graph/solver/normal_equations.h"
 
 #include <algorithm>
 #include <cmath>
@@ -11,7 +11,7 @@
 #include <cholmod.h>
 
 #include "core/error.h"
-#include "graph/normal_equations_internal.h"
+#include "graph/solver/normal_equations_internal.h"
 
 namespace planarvo::graph {
 

@@ -1,4 +1,4 @@
-#include "graph/factor_graph.h"
+#include "graph/solver/factor_graph.h"
 
 #include <atomic>
 #include <cmath>

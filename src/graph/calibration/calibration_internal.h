@@ -10,10 +10,11 @@
 
 #include <Eigen/Core>
 
-#include "graph/calibration.h"
-#include "graph/factor_graph.h"
-#include "graph/factors.h"
-#include "graph/robust_kernel.h"
+#include "graph/calibration/calibration.h"
+#include "graph/solver/factor_graph.h"
+#include "graph/posegraph/factors.h"
+#include "graph/calibration/factors.h"
+#include "graph/solver/robust_kernel.h"
 
 namespace planarvo::graph::calibration_detail {
 

@@ -1,4 +1,4 @@
-#include "graph/solver.h"
+#include "graph/solver/solver.h"
 
 #include <algorithm>
 #include <chrono>

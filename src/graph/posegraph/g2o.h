@@ -8,7 +8,7 @@
 #include <Eigen/Core>
 
 #include "core/se2.h"
-#include "graph/factor_graph.h"
+#include "graph/solver/factor_graph.h"
 
 namespace planarvo::graph {
 

@@ -2,7 +2,7 @@
 // validation of its input, the context of a call (the motions' covariances, the inliers), the
 // robust pass's kernel and gating, and the covariance and observability judgement of z. The
 // methods' graphs are in calibration_odometry.cpp and calibration_nonholonomic.cpp.
-#include "graph/calibration.h"
+#include "graph/calibration/calibration.h"
 
 #include <algorithm>
 #include <chrono>
@@ -13,9 +13,9 @@
 #include <Eigen/Dense>
 
 #include "core/error.h"
-#include "graph/calibration_init.h"
-#include "graph/calibration_internal.h"
-#include "graph/covariance.h"
+#include "graph/calibration/calibration_init.h"
+#include "graph/calibration/calibration_internal.h"
+#include "graph/solver/covariance.h"
 
 namespace planarvo::graph {
 namespace calibration_detail {

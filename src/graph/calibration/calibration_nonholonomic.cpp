@@ -11,9 +11,9 @@
 
 #include <Eigen/Dense>
 
-#include "graph/calibration_init.h"
-#include "graph/calibration_internal.h"
-#include "graph/solver.h"
+#include "graph/calibration/calibration_init.h"
+#include "graph/calibration/calibration_internal.h"
+#include "graph/solver/solver.h"
 
 namespace planarvo::graph::calibration_detail {
 namespace {

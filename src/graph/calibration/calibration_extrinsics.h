@@ -4,7 +4,7 @@
 // (calib/extrinsics_estimate.h), and the one sentence that says how each method found them.
 #pragma once
 #include "core/extrinsics_estimate.h"
-#include "graph/calibration.h"
+#include "graph/calibration/calibration.h"
 
 namespace planarvo::graph {
 

@@ -10,10 +10,10 @@
 
 #include <Eigen/Dense>
 
-#include "graph/calibration_init.h"
-#include "graph/calibration_internal.h"
-#include "graph/odometry_noise.h"
-#include "graph/solver.h"
+#include "graph/calibration/calibration_init.h"
+#include "graph/calibration/calibration_internal.h"
+#include "graph/calibration/odometry_noise.h"
+#include "graph/solver/solver.h"
 
 namespace planarvo::graph::calibration_detail {
 namespace {

@@ -1,7 +1,7 @@
 // NormalEquations (normal_equations.h), the sparse Cholesky part on CHOLMOD: the fill-reducing
 // ordering (block AMD) and the symbolic analysis, once; damping, the numeric factorisation, the
 // triangular solves, products with H and the conjugate gradients on a reused factor.
-#include "graph/normal_equations.h"
+#include "graph/solver/normal_equations.h"
 
 #include <algorithm>
 #include <cmath>
@@ -11,7 +11,7 @@
 #include <cholmod.h>
 
 #include "core/error.h"
-#include "graph/normal_equations_internal.h"
+#include "graph/solver/normal_equations_internal.h"
 
 namespace planarvo::graph {
 

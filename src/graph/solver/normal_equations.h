@@ -18,7 +18,7 @@
 
 #include <Eigen/Core>
 
-#include "graph/factor_graph.h"
+#include "graph/solver/factor_graph.h"
 
 struct cholmod_common_struct;
 struct cholmod_sparse_struct;

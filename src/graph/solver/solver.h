@@ -25,8 +25,8 @@
 #include <string>
 #include <vector>
 
-#include "graph/factor_graph.h"
-#include "graph/normal_equations.h"
+#include "graph/solver/factor_graph.h"
+#include "graph/solver/normal_equations.h"
 
 namespace planarvo::graph {
 

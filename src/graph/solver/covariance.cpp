@@ -1,4 +1,4 @@
-#include "graph/covariance.h"
+#include "graph/solver/covariance.h"
 
 #include <algorithm>
 #include <cmath>

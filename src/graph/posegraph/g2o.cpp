@@ -1,4 +1,4 @@
-#include "graph/g2o.h"
+#include "graph/posegraph/g2o.h"
 
 #include <charconv>
 #include <cmath>
@@ -12,7 +12,7 @@
 
 #include "core/error.h"
 #include "core/output_file.h"
-#include "graph/factors.h"
+#include "graph/posegraph/factors.h"
 
 namespace planarvo::graph {
 namespace {

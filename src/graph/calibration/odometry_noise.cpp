@@ -1,4 +1,4 @@
-#include "graph/odometry_noise.h"
+#include "graph/calibration/odometry_noise.h"
 
 #include <algorithm>
 #include <array>

@@ -1,4 +1,4 @@
-#include "graph/factor.h"
+#include "graph/solver/factor.h"
 
 #include <cmath>
 #include <sstream>

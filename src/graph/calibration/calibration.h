@@ -20,8 +20,8 @@
 
 #include "core/motion.h"
 #include "core/se2.h"
-#include "graph/odometry_noise.h"
-#include "graph/solver.h"
+#include "graph/calibration/odometry_noise.h"
+#include "graph/solver/solver.h"
 
 namespace planarvo::graph {
 

@@ -3,7 +3,7 @@
 // anchors are the fixed poses (or, when no pose is fixed, the first pose of each connected
 // part). Poses not connected to an anchor keep their values.
 #pragma once
-#include "graph/factor_graph.h"
+#include "graph/solver/factor_graph.h"
 
 namespace planarvo::graph {
 

@@ -1,14 +1,14 @@
 // NormalEquations (normal_equations.h), assembly: each factor's whitened, robust-weighted error
 // and Jacobians (linearize_factor for one factor, linearize() for all), the cost at trial
 // points, and J̃ᵀJ̃ and J̃ᵀr̃ added block by block into H's fixed pattern and g.
-#include "graph/normal_equations.h"
+#include "graph/solver/normal_equations.h"
 
 #include <cmath>
 #include <cstring>
 
 #include <cholmod.h>
 
-#include "graph/normal_equations_internal.h"
+#include "graph/solver/normal_equations_internal.h"
 
 namespace planarvo::graph {
 

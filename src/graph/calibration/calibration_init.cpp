@@ -1,4 +1,4 @@
-#include "graph/calibration_init.h"
+#include "graph/calibration/calibration_init.h"
 
 #include <algorithm>
 #include <cmath>

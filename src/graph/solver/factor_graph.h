@@ -9,8 +9,8 @@
 #include <Eigen/Core>
 
 #include "core/se2.h"
-#include "graph/factor.h"
-#include "graph/robust_kernel.h"
+#include "graph/solver/factor.h"
+#include "graph/solver/robust_kernel.h"
 
 namespace planarvo::graph {
 
