@@ -111,12 +111,194 @@ Solver::~Solver() = default;
 Solver::Solver(Solver&&) noexcept = default;
 Solver& Solver::operator=(Solver&&) noexcept = default;
 
+namespace {
+
+// One run of Levenberg–Marquardt on prepared normal equations, its loop in named steps as Ceres'
+// TrustRegionMinimizer has them: linearise, solve the damped system, evaluate the step, update
+// the trust region (λ). The state is what the steps share.
+class LevenbergMarquardt {
+ public:
+  LevenbergMarquardt(NormalEquations& sys, const SolverOptions& o, FactorGraph& graph, SolverSummary& summary,
+                     Clock::time_point t_start)
+      : sys_(sys), o_(o), graph_(graph), summary_(summary), t_start_(t_start), x_(graph.values()), trial_(x_) {}
+
+  SolverSummary run() {
+    PhaseTimes& times = summary_.times;
+    if (sys_.num_columns() == 0) {
+      summary_.initial_cost = summary_.final_cost = sys_.evaluate_cost(x_.data(), &times);
+      IterationSummary it0;
+      it0.cost = summary_.initial_cost;
+      summary_.iterations.push_back(it0);
+      return finish(TerminationType::NothingToOptimize, "every variable is fixed");
+    }
+    linearise();
+    summary_.initial_cost = summary_.final_cost = cost_;
+    {
+      IterationSummary it0;
+      it0.cost = cost_;
+      it0.gradient_max_norm = gmax_;
+      it0.iteration_time_s = it0.cumulative_time_s = seconds_since(t_start_);
+      summary_.iterations.push_back(it0);
+    }
+    if (!std::isfinite(cost_) || !std::isfinite(gmax_))
+      return finish(TerminationType::NumericalFailure, "the cost or its gradient is not finite at the initial values");
+    start_trust_region();
+    for (int iter = 1;; ++iter) {
+      if (gmax_ <= o_.gradient_tolerance)
+        return finish(TerminationType::GradientTolerance,
+                      "gradient max-norm " + num(gmax_) + " <= " + num(o_.gradient_tolerance));
+      if (iter > o_.max_iterations)
+        return finish(TerminationType::MaxIterations, "reached " + std::to_string(o_.max_iterations) + " iterations");
+      if (seconds_since(t_start_) > o_.max_time_s)
+        return finish(TerminationType::MaxTime, "exceeded " + num(o_.max_time_s) + " s");
+
+      const auto t_iter = Clock::now();
+      IterationSummary it;
+      it.iteration = iter;
+      it.lambda = lambda_;
+      summary_.num_iterations = iter;
+      const bool ok = solve_damped_system(it);
+      std::string converged_message;  // set when the function tolerance is met
+      if (ok) {
+        double x_norm = 0.0;
+        if (!evaluate_step(it, &x_norm, &converged_message)) {
+          // A negligible step: converged at the current point, nothing to try or record.
+          summary_.num_iterations = iter - 1;
+          return finish(TerminationType::ParameterTolerance,
+                        "step " + num(it.step_norm) + " <= parameter_tolerance * (|x| + tol) with |x| = " + num(x_norm));
+        }
+      }
+      update_trust_region(it, ok);
+      it.cost = cost_;
+      it.gradient_max_norm = gmax_;
+      it.iteration_time_s = seconds_since(t_iter);
+      it.cumulative_time_s = seconds_since(t_start_);
+      summary_.iterations.push_back(it);
+      summary_.final_cost = cost_;
+
+      if (!converged_message.empty()) return finish(TerminationType::FunctionTolerance, converged_message);
+      if (lambda_ > o_.max_lambda)
+        return finish(TerminationType::DampingLimit,
+                      "lambda " + num(lambda_) + " > max_lambda " + num(o_.max_lambda) + ": no step lowers the cost");
+      if (o_.callback && !o_.callback(it)) return finish(TerminationType::UserStop, "the callback asked to stop");
+    }
+  }
+
+ private:
+  // H, g and the cost at x.
+  void linearise() {
+    cost_ = sys_.linearize(x_.data(), &summary_.times);
+    gmax_ = sys_.gradient().cwiseAbs().maxCoeff();
+  }
+
+  // The first λ, and the budget of factor reuse: CG iterations worth a fraction of a factorisation.
+  void start_trust_region() {
+    // λ in units of D: Levenberg's D = I needs the scale of H.
+    lambda_scale_ = o_.damping == Damping::Levenberg ? std::max(sys_.hessian_diagonal().maxCoeff(), 1e-300) : 1.0;
+    lambda_ = std::max(o_.initial_lambda * lambda_scale_, o_.min_lambda);
+    nu_ = 2.0;
+    cg_budget_ = o_.reuse_factorization
+                     ? static_cast<int>(std::min<double>(
+                           o_.reuse_max_cg_iterations,
+                           std::floor(o_.reuse_cg_budget * sys_.factor_cost() / std::max(sys_.cg_iteration_cost(), 1.0))))
+                     : 0;
+  }
+
+  // δ from (H + λD)δ = −g: by CG preconditioned with the last factor while that converges within
+  // the budget, else by a new factorisation. False when neither gives a step.
+  bool solve_damped_system(IterationSummary& it) {
+    PhaseTimes& times = summary_.times;
+    bool ok = false;
+    if (cg_budget_ >= 2 && sys_.has_factor() && reuse_skip_-- <= 0) {
+      it.cg_iterations =
+          sys_.solve_step_reusing_factor(lambda_, o_.damping, delta_, cg_budget_, o_.reuse_cg_tolerance, &times);
+      ok = it.cg_iterations > 0;
+      if (ok) {
+        reuse_backoff_ = 1;
+      } else {
+        // The factor no longer preconditions well: replace it now, and back off.
+        reuse_skip_ = reuse_backoff_;
+        reuse_backoff_ *= 2;
+      }
+    }
+    if (!ok) {
+      it.cg_iterations = 0;
+      it.refactorized = true;
+      ++summary_.num_factorizations;
+      ok = sys_.factorize(lambda_, o_.damping, &times) && sys_.solve_step(delta_, &times);
+      it.factorization_ok = ok;
+    }
+    return ok;
+  }
+
+  // The cost at x ⊞ δ against the decrease the model predicts (the gain ratio), and whether the
+  // function tolerance is met. False, with |x| in *x_norm, when δ is negligible (converged).
+  bool evaluate_step(IterationSummary& it, double* x_norm, std::string* converged_message) {
+    it.step_norm = delta_.norm();
+    *x_norm = sys_.free_values_norm(x_.data());
+    if (it.step_norm <= o_.parameter_tolerance * (*x_norm + o_.parameter_tolerance)) return false;
+    sys_.retract(x_.data(), delta_, trial_.data());
+    const double new_cost = sys_.evaluate_cost(trial_.data(), &summary_.times);
+    const double predicted =
+        it.refactorized ? sys_.predicted_decrease_of_solution(delta_) : sys_.predicted_decrease(delta_);
+    it.cost_change = cost_ - new_cost;
+    it.relative_decrease = predicted > 0.0 ? it.cost_change / predicted : -1.0;
+    it.step_accepted = std::isfinite(new_cost) && predicted > 0.0 && it.relative_decrease > o_.min_relative_decrease;
+    if (std::isfinite(new_cost) && std::abs(it.cost_change) <= o_.function_tolerance * cost_)
+      *converged_message = "relative cost change " + num(std::abs(it.cost_change) / std::max(cost_, 1e-300)) +
+                           " <= " + num(o_.function_tolerance);
+    return true;
+  }
+
+  // An accepted step moves x (linearised again there) and shrinks λ by the gain ratio (Nielsen's
+  // rule); a rejected or failed one grows λ, doubling the factor each time.
+  void update_trust_region(const IterationSummary& it, bool ok) {
+    if (it.step_accepted) {
+      ++summary_.num_accepted;
+      x_.swap(trial_);
+      linearise();
+      const double r = 2.0 * it.relative_decrease - 1.0;
+      lambda_ = std::max(lambda_ * std::max(1.0 / o_.lambda_max_decrease, 1.0 - r * r * r), o_.min_lambda);
+      nu_ = 2.0;
+    } else {
+      if (ok)
+        ++summary_.num_rejected;
+      else
+        ++summary_.num_failed_factorizations;
+      // From λ = 0 (pure Gauss–Newton allowed by the options) doubling stays at 0: restart from a
+      // small damping instead.
+      lambda_ = lambda_ > 0.0 ? lambda_ * nu_ : 1e-8 * lambda_scale_;
+      nu_ *= 2.0;
+    }
+  }
+
+  SolverSummary finish(TerminationType type, std::string message) {
+    summary_.termination = type;
+    summary_.message = std::move(message);
+    summary_.total_time_s = seconds_since(t_start_);
+    graph_.set_values(x_);
+    return summary_;
+  }
+
+  NormalEquations& sys_;
+  const SolverOptions& o_;
+  FactorGraph& graph_;
+  SolverSummary& summary_;
+  const Clock::time_point t_start_;
+  std::vector<double> x_, trial_;
+  double cost_ = 0.0, gmax_ = 0.0;
+  double lambda_ = 0.0, lambda_scale_ = 1.0, nu_ = 2.0;
+  int cg_budget_ = 0, reuse_skip_ = 0, reuse_backoff_ = 1;
+  Eigen::VectorXd delta_;
+};
+
+}  // namespace
+
 SolverSummary Solver::solve(FactorGraph& graph) {
   const auto t_start = Clock::now();
   const SolverOptions& o = options_;
   SolverSummary summary;
   summary.num_factors = graph.num_factors();
-
   if (!system_ || !system_->matches(graph) || !same_linear_options(system_->options(), o.linear)) {
     system_.reset();
     system_ = std::make_unique<NormalEquations>(graph, o.linear);
@@ -127,154 +309,8 @@ SolverSummary Solver::solve(FactorGraph& graph) {
   summary.factor_nonzeros = sys.factor_nonzeros();
   summary.factor_flops = sys.factor_flops();
   summary.linear_solver = sys.ordering_used();
-
   summary.iterations.reserve(static_cast<size_t>(std::max(o.max_iterations, 0)) + 1);
-  std::vector<double> x = graph.values();
-  std::vector<double> trial = x;
-  PhaseTimes& times = summary.times;
-
-  auto finish = [&](TerminationType type, std::string message) {
-    summary.termination = type;
-    summary.message = std::move(message);
-    summary.total_time_s = seconds_since(t_start);
-    graph.set_values(x);
-    return summary;
-  };
-
-  if (sys.num_columns() == 0) {
-    summary.initial_cost = summary.final_cost = sys.evaluate_cost(x.data(), &times);
-    IterationSummary it0;
-    it0.cost = summary.initial_cost;
-    summary.iterations.push_back(it0);
-    return finish(TerminationType::NothingToOptimize, "every variable is fixed");
-  }
-
-  double cost = sys.linearize(x.data(), &times);
-  summary.initial_cost = summary.final_cost = cost;
-  double gmax = sys.gradient().cwiseAbs().maxCoeff();
-  {
-    IterationSummary it0;
-    it0.cost = cost;
-    it0.gradient_max_norm = gmax;
-    it0.iteration_time_s = it0.cumulative_time_s = seconds_since(t_start);
-    summary.iterations.push_back(it0);
-  }
-  if (!std::isfinite(cost) || !std::isfinite(gmax))
-    return finish(TerminationType::NumericalFailure,
-                  "the cost or its gradient is not finite at the initial values");
-
-  // λ in units of D: Levenberg's D = I needs the scale of H.
-  const double lambda_scale =
-      o.damping == Damping::Levenberg ? std::max(sys.hessian_diagonal().maxCoeff(), 1e-300) : 1.0;
-  double lambda = std::max(o.initial_lambda * lambda_scale, o.min_lambda);
-  double nu = 2.0;
-  // Factor reuse: CG iterations worth a fraction of a factorisation, and the back-off.
-  const int cg_budget =
-      o.reuse_factorization
-          ? static_cast<int>(std::min<double>(
-                o.reuse_max_cg_iterations,
-                std::floor(o.reuse_cg_budget * sys.factor_cost() /
-                           std::max(sys.cg_iteration_cost(), 1.0))))
-          : 0;
-  int reuse_skip = 0, reuse_backoff = 1;
-  Eigen::VectorXd delta;
-
-  for (int iter = 1;; ++iter) {
-    if (gmax <= o.gradient_tolerance)
-      return finish(TerminationType::GradientTolerance,
-                    "gradient max-norm " + num(gmax) + " <= " + num(o.gradient_tolerance));
-    if (iter > o.max_iterations)
-      return finish(TerminationType::MaxIterations,
-                    "reached " + std::to_string(o.max_iterations) + " iterations");
-    if (seconds_since(t_start) > o.max_time_s)
-      return finish(TerminationType::MaxTime, "exceeded " + num(o.max_time_s) + " s");
-
-    const auto t_iter = Clock::now();
-    IterationSummary it;
-    it.iteration = iter;
-    it.lambda = lambda;
-    summary.num_iterations = iter;
-
-    bool ok = false;
-    if (cg_budget >= 2 && sys.has_factor() && reuse_skip-- <= 0) {
-      it.cg_iterations = sys.solve_step_reusing_factor(lambda, o.damping, delta, cg_budget,
-                                                       o.reuse_cg_tolerance, &times);
-      ok = it.cg_iterations > 0;
-      if (ok) {
-        reuse_backoff = 1;
-      } else {
-        // The factor no longer preconditions well: replace it now, and back off.
-        reuse_skip = reuse_backoff;
-        reuse_backoff *= 2;
-      }
-    }
-    if (!ok) {
-      it.cg_iterations = 0;
-      it.refactorized = true;
-      ++summary.num_factorizations;
-      ok = sys.factorize(lambda, o.damping, &times) && sys.solve_step(delta, &times);
-      it.factorization_ok = ok;
-    }
-    std::string converged_message;  // set when the function tolerance is met
-    if (ok) {
-      it.step_norm = delta.norm();
-      const double x_norm = sys.free_values_norm(x.data());
-      if (it.step_norm <= o.parameter_tolerance * (x_norm + o.parameter_tolerance)) {
-        // A negligible step: converged at the current point, nothing to try or record.
-        summary.num_iterations = iter - 1;
-        return finish(TerminationType::ParameterTolerance,
-                      "step " + num(it.step_norm) +
-                          " <= parameter_tolerance * (|x| + tol) with |x| = " + num(x_norm));
-      }
-      sys.retract(x.data(), delta, trial.data());
-      const double new_cost = sys.evaluate_cost(trial.data(), &times);
-      const double predicted = it.refactorized ? sys.predicted_decrease_of_solution(delta)
-                                               : sys.predicted_decrease(delta);
-      it.cost_change = cost - new_cost;
-      it.relative_decrease = predicted > 0.0 ? it.cost_change / predicted : -1.0;
-      it.step_accepted = std::isfinite(new_cost) && predicted > 0.0 &&
-                         it.relative_decrease > o.min_relative_decrease;
-      if (std::isfinite(new_cost) && std::abs(it.cost_change) <= o.function_tolerance * cost)
-        converged_message = "relative cost change " +
-                            num(std::abs(it.cost_change) / std::max(cost, 1e-300)) + " <= " +
-                            num(o.function_tolerance);
-    }
-
-    if (it.step_accepted) {
-      ++summary.num_accepted;
-      x.swap(trial);
-      cost = sys.linearize(x.data(), &times);
-      gmax = sys.gradient().cwiseAbs().maxCoeff();
-      const double r = 2.0 * it.relative_decrease - 1.0;
-      lambda = std::max(lambda * std::max(1.0 / o.lambda_max_decrease, 1.0 - r * r * r),
-                        o.min_lambda);
-      nu = 2.0;
-    } else {
-      if (ok)
-        ++summary.num_rejected;
-      else
-        ++summary.num_failed_factorizations;
-      // From λ = 0 (pure Gauss–Newton allowed by the options) doubling stays at 0: restart
-      // from a small damping instead.
-      lambda = lambda > 0.0 ? lambda * nu : 1e-8 * lambda_scale;
-      nu *= 2.0;
-    }
-    it.cost = cost;
-    it.gradient_max_norm = gmax;
-    it.iteration_time_s = seconds_since(t_iter);
-    it.cumulative_time_s = seconds_since(t_start);
-    summary.iterations.push_back(it);
-    summary.final_cost = cost;
-
-    if (!converged_message.empty())
-      return finish(TerminationType::FunctionTolerance, converged_message);
-    if (lambda > o.max_lambda)
-      return finish(TerminationType::DampingLimit,
-                    "lambda " + num(lambda) + " > max_lambda " + num(o.max_lambda) +
-                        ": no step lowers the cost");
-    if (o.callback && !o.callback(it))
-      return finish(TerminationType::UserStop, "the callback asked to stop");
-  }
+  return LevenbergMarquardt(sys, o, graph, summary, t_start).run();
 }
 
 SolverSummary solve(FactorGraph& graph, const SolverOptions& options) {
