@@ -98,88 +98,71 @@ void initialise_spanning_tree(FactorGraph& graph) {
   }
 }
 
-int initialise_rotation_first(FactorGraph& graph) {
-  const std::vector<Edge> edges = relative_pose_edges(graph);
-  const Tree t = spanning_tree(graph, edges);
-  const int n = graph.num_variables();
+namespace {
 
-  // Unknowns: reached, non-anchor poses.
-  std::vector<int> unknown(static_cast<size_t>(n), -1);
-  int m = 0;
-  std::vector<char> is_anchor(static_cast<size_t>(n), 0);
-  for (int a : t.anchors) is_anchor[static_cast<size_t>(a)] = 1;
-  for (int v : t.order)
-    if (!is_anchor[static_cast<size_t>(v)]) unknown[static_cast<size_t>(v)] = m++;
-  if (m == 0) return 0;
+// What the two linear least-squares problems of the rotation-first initialisation share: the
+// relative-pose edges, the spanning tree, the index of each unknown pose (reached, not an
+// anchor; -1 otherwise), and the edges' orientation weights.
+struct RotationFirst {
+  std::vector<Edge> edges;
+  Tree t;
+  std::vector<int> unknown;
+  int m = 0, n = 0;
+  std::vector<double> w_theta;
+};
 
-  // Spanning-tree orientations, not wrapped (the wraps k_ij are what they decide).
-  std::vector<double> theta(static_cast<size_t>(n), 0.0);
-  for (int v = 0; v < n; ++v)
-    if (graph.type(v).kind == VariableKind::Pose2) theta[static_cast<size_t>(v)] = graph.pose(v).theta;
-  for (int v : t.order) {
-    const int e = t.parent_edge[static_cast<size_t>(v)];
-    if (e < 0) continue;
-    const Edge& edge = edges[static_cast<size_t>(e)];
-    theta[static_cast<size_t>(v)] = edge.j == v ? theta[static_cast<size_t>(edge.i)] + edge.z.theta
-                                                : theta[static_cast<size_t>(edge.j)] - edge.z.theta;
-  }
-
-  // Orientation weights: the inverse marginal variance of the measured angle.
-  std::vector<double> w_theta(edges.size());
-  for (size_t e = 0; e < edges.size(); ++e)
-    w_theta[e] = 1.0 / edges[e].information.inverse()(2, 2);
-
-  auto solve_orientations = [&](const std::vector<double>& wraps_from) {
+// The orientations' least squares θ_j − θ_i = z + 2πk over the edges, the wraps k from the
+// angles `wraps_from` (known poses keep theirs).
+std::vector<double> solve_orientations(const RotationFirst& r, const std::vector<double>& wraps_from) {
+  const std::vector<Edge>& edges = r.edges;
+  const Tree& t = r.t;
+  const std::vector<int>& unknown = r.unknown;
+  const std::vector<double>& w_theta = r.w_theta;
+  const int m = r.m, n = r.n;
     // θ_j − θ_i = z + 2πk, with k from wraps_from.
-    std::vector<Eigen::Triplet<double>> trip;
-    Eigen::VectorXd rhs = Eigen::VectorXd::Zero(m);
-    for (size_t e = 0; e < edges.size(); ++e) {
-      const Edge& ed = edges[e];
-      const int ui = unknown[static_cast<size_t>(ed.i)], uj = unknown[static_cast<size_t>(ed.j)];
-      if (!t.reached[static_cast<size_t>(ed.i)] || !t.reached[static_cast<size_t>(ed.j)]) continue;
-      const double k = std::round((wraps_from[static_cast<size_t>(ed.j)] -
-                                   wraps_from[static_cast<size_t>(ed.i)] - ed.z.theta) /
-                                  (2.0 * M_PI));
-      const double d = ed.z.theta + 2.0 * M_PI * k;
-      const double w = w_theta[e];
-      // residual θ_j − θ_i − d
-      if (uj >= 0) {
-        trip.emplace_back(uj, uj, w);
-        rhs[uj] += w * (d + (ui < 0 ? wraps_from[static_cast<size_t>(ed.i)] : 0.0));
-      }
-      if (ui >= 0) {
-        trip.emplace_back(ui, ui, w);
-        rhs[ui] -= w * (d - (uj < 0 ? wraps_from[static_cast<size_t>(ed.j)] : 0.0));
-      }
-      if (ui >= 0 && uj >= 0) {
-        trip.emplace_back(ui, uj, -w);
-        trip.emplace_back(uj, ui, -w);
-      }
-    }
-    Eigen::SparseMatrix<double> A(m, m);
-    A.setFromTriplets(trip.begin(), trip.end());
-    Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt(A);
-    if (ldlt.info() != Eigen::Success)
-      throw Error(ErrorCode::Failed, "initialise_rotation_first: the orientation system is singular");
-    const Eigen::VectorXd x = ldlt.solve(rhs);
-    std::vector<double> out = wraps_from;
-    for (int v = 0; v < n; ++v)
-      if (unknown[static_cast<size_t>(v)] >= 0) out[static_cast<size_t>(v)] = x[unknown[static_cast<size_t>(v)]];
-    return out;
-  };
-
-  std::vector<double> solved = solve_orientations(theta);
-  // Re-estimate the wraps from the least-squares orientations (the tree's chained angles drift
-  // along long branches; the solution spreads loop errors) and solve again.
-  int changed = 0;
-  for (const Edge& ed : edges) {
+  std::vector<Eigen::Triplet<double>> trip;
+  Eigen::VectorXd rhs = Eigen::VectorXd::Zero(m);
+  for (size_t e = 0; e < edges.size(); ++e) {
+    const Edge& ed = edges[e];
+    const int ui = unknown[static_cast<size_t>(ed.i)], uj = unknown[static_cast<size_t>(ed.j)];
     if (!t.reached[static_cast<size_t>(ed.i)] || !t.reached[static_cast<size_t>(ed.j)]) continue;
-    const double k0 = std::round((theta[static_cast<size_t>(ed.j)] - theta[static_cast<size_t>(ed.i)] - ed.z.theta) / (2.0 * M_PI));
-    const double k1 = std::round((solved[static_cast<size_t>(ed.j)] - solved[static_cast<size_t>(ed.i)] - ed.z.theta) / (2.0 * M_PI));
-    changed += k0 != k1;
+    const double k = std::round((wraps_from[static_cast<size_t>(ed.j)] -
+                                 wraps_from[static_cast<size_t>(ed.i)] - ed.z.theta) /
+                                (2.0 * M_PI));
+    const double d = ed.z.theta + 2.0 * M_PI * k;
+    const double w = w_theta[e];
+    // residual θ_j − θ_i − d
+    if (uj >= 0) {
+      trip.emplace_back(uj, uj, w);
+      rhs[uj] += w * (d + (ui < 0 ? wraps_from[static_cast<size_t>(ed.i)] : 0.0));
+    }
+    if (ui >= 0) {
+      trip.emplace_back(ui, ui, w);
+      rhs[ui] -= w * (d - (uj < 0 ? wraps_from[static_cast<size_t>(ed.j)] : 0.0));
+    }
+    if (ui >= 0 && uj >= 0) {
+      trip.emplace_back(ui, uj, -w);
+      trip.emplace_back(uj, ui, -w);
+    }
   }
-  if (changed > 0) solved = solve_orientations(solved);
+  Eigen::SparseMatrix<double> A(m, m);
+  A.setFromTriplets(trip.begin(), trip.end());
+  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt(A);
+  if (ldlt.info() != Eigen::Success)
+    throw Error(ErrorCode::Failed, "initialise_rotation_first: the orientation system is singular");
+  const Eigen::VectorXd x = ldlt.solve(rhs);
+  std::vector<double> out = wraps_from;
+  for (int v = 0; v < n; ++v)
+    if (unknown[static_cast<size_t>(v)] >= 0) out[static_cast<size_t>(v)] = x[unknown[static_cast<size_t>(v)]];
+  return out;
+  }
 
+// The positions' least squares given the orientations `solved`: t_j − t_i = R(θ_i) z_t.
+void solve_positions(const RotationFirst& problem, const std::vector<double>& solved, FactorGraph& graph) {
+  const std::vector<Edge>& edges = problem.edges;
+  const Tree& t = problem.t;
+  const std::vector<int>& unknown = problem.unknown;
+  const int m = problem.m, n = problem.n;
   // Positions: t_j − t_i = R(θ_i) z_t, weight (R(θ_i + z_θ)) Ω_tt (…)ᵀ.
   std::vector<Eigen::Triplet<double>> trip;
   Eigen::VectorXd rhs = Eigen::VectorXd::Zero(2 * m);
@@ -217,6 +200,57 @@ int initialise_rotation_first(FactorGraph& graph) {
     const int u = unknown[static_cast<size_t>(v)];
     if (u >= 0) graph.set_pose(v, SE2(p[2 * u], p[2 * u + 1], solved[static_cast<size_t>(v)]));
   }
+}
+
+}  // namespace
+
+int initialise_rotation_first(FactorGraph& graph) {
+  RotationFirst r;
+  r.edges = relative_pose_edges(graph);
+  r.t = spanning_tree(graph, r.edges);
+  r.n = graph.num_variables();
+  const std::vector<Edge>& edges = r.edges;
+  const Tree& t = r.t;
+  const int n = r.n;
+
+  // Unknowns: reached, non-anchor poses.
+  r.unknown.assign(static_cast<size_t>(n), -1);
+  std::vector<char> is_anchor(static_cast<size_t>(n), 0);
+  for (int a : t.anchors) is_anchor[static_cast<size_t>(a)] = 1;
+  for (int v : t.order)
+    if (!is_anchor[static_cast<size_t>(v)]) r.unknown[static_cast<size_t>(v)] = r.m++;
+  if (r.m == 0) return 0;
+
+  // Spanning-tree orientations, not wrapped (the wraps k_ij are what they decide).
+  std::vector<double> theta(static_cast<size_t>(n), 0.0);
+  for (int v = 0; v < n; ++v)
+    if (graph.type(v).kind == VariableKind::Pose2) theta[static_cast<size_t>(v)] = graph.pose(v).theta;
+  for (int v : t.order) {
+    const int e = t.parent_edge[static_cast<size_t>(v)];
+    if (e < 0) continue;
+    const Edge& edge = edges[static_cast<size_t>(e)];
+    theta[static_cast<size_t>(v)] = edge.j == v ? theta[static_cast<size_t>(edge.i)] + edge.z.theta
+                                                : theta[static_cast<size_t>(edge.j)] - edge.z.theta;
+  }
+
+  // Orientation weights: the inverse marginal variance of the measured angle.
+  r.w_theta.resize(edges.size());
+  for (size_t e = 0; e < edges.size(); ++e)
+    r.w_theta[e] = 1.0 / edges[e].information.inverse()(2, 2);
+
+  std::vector<double> solved = solve_orientations(r, theta);
+  // Re-estimate the wraps from the least-squares orientations (the tree's chained angles drift
+  // along long branches; the solution spreads loop errors) and solve again.
+  int changed = 0;
+  for (const Edge& ed : edges) {
+    if (!t.reached[static_cast<size_t>(ed.i)] || !t.reached[static_cast<size_t>(ed.j)]) continue;
+    const double k0 = std::round((theta[static_cast<size_t>(ed.j)] - theta[static_cast<size_t>(ed.i)] - ed.z.theta) / (2.0 * M_PI));
+    const double k1 = std::round((solved[static_cast<size_t>(ed.j)] - solved[static_cast<size_t>(ed.i)] - ed.z.theta) / (2.0 * M_PI));
+    changed += k0 != k1;
+  }
+  if (changed > 0) solved = solve_orientations(r, solved);
+
+  solve_positions(r, solved, graph);
   return changed;
 }
 

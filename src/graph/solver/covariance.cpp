@@ -84,51 +84,57 @@ Eigen::MatrixXd marginal_covariance(const FactorGraph& graph, VariableId v,
   return MarginalCovariance(graph, {v}, options).covariance(v);
 }
 
-ObservabilityReport analyse_observability(const FactorGraph& graph,
-                                          const std::vector<VariableId>& block,
-                                          double relative_tolerance,
-                                          const LinearSolverOptions& options) {
-  ObservabilityReport rep;
-  rep.relative_tolerance = relative_tolerance;
-  // The block's free parameters, in order.
-  std::vector<int> local_start(static_cast<size_t>(graph.num_variables()), -1);
-  std::vector<std::vector<int>> local_col(static_cast<size_t>(graph.num_variables()));
+namespace {
+
+// The observability block's free parameters: each variable's first column and each parameter's
+// column in the block (-1: fixed, or not in the block), and their names.
+struct BlockColumns {
+  std::vector<int> start;
+  std::vector<std::vector<int>> column;
+  int count = 0;
+};
+
+BlockColumns block_columns(const FactorGraph& graph, const std::vector<VariableId>& block,
+                           std::vector<std::string>* names) {
+  BlockColumns c;
+  c.start.assign(static_cast<size_t>(graph.num_variables()), -1);
+  c.column.resize(static_cast<size_t>(graph.num_variables()));
   int k = 0;
   for (VariableId v : block) {
-    if (local_start[static_cast<size_t>(v)] >= 0)
+    if (c.start[static_cast<size_t>(v)] >= 0)
       throw_invalid_argument("analyse_observability: '" + graph.name(v) + "' twice");
-    local_start[static_cast<size_t>(v)] = k;
-    auto& lc = local_col[static_cast<size_t>(v)];
+    c.start[static_cast<size_t>(v)] = k;
+    auto& lc = c.column[static_cast<size_t>(v)];
     lc.assign(static_cast<size_t>(graph.type(v).dim), -1);
     for (int p = 0; p < graph.type(v).dim; ++p)
       if (!graph.is_parameter_fixed(v, p)) {
         lc[static_cast<size_t>(p)] = k++;
-        rep.parameter_names.push_back(graph.name(v) + "." + graph.parameter_name(v, p));
+        names->push_back(graph.name(v) + "." + graph.parameter_name(v, p));
       }
   }
-  const int nb = k;
-  if (nb == 0) throw_invalid_argument("analyse_observability: the block has no free parameter");
+  c.count = k;
+  return c;
+}
 
-  NormalEquations others(graph, stored_coordinates(options), block);
-  const int no = others.num_columns();
-  Eigen::MatrixXd Hbb = Eigen::MatrixXd::Zero(nb, nb);
-  Eigen::MatrixXd Hob = Eigen::MatrixXd::Zero(no, nb);
+// H's block rows: H_bb (block × block) and H_ob (the other variables' columns of `others` × block),
+// from the factors that touch the block.
+void block_information(const FactorGraph& graph, const BlockColumns& c, const NormalEquations& others,
+                       Eigen::MatrixXd& Hbb, Eigen::MatrixXd& Hob) {
   Eigen::VectorXd r;
   std::vector<Eigen::MatrixXd> J;
   for (int f = 0; f < graph.num_factors(); ++f) {
     const auto& vars = graph.factor(f).variables();
-    if (std::none_of(vars.begin(), vars.end(),
-                     [&](VariableId v) { return local_start[static_cast<size_t>(v)] >= 0; }))
+    if (std::none_of(vars.begin(), vars.end(), [&](VariableId v) { return c.start[static_cast<size_t>(v)] >= 0; }))
       continue;
     linearize_factor(graph, f, r, J);
     for (size_t a = 0; a < vars.size(); ++a) {
-      const auto& la = local_col[static_cast<size_t>(vars[a])];
+      const auto& la = c.column[static_cast<size_t>(vars[a])];
       if (la.empty()) continue;
       for (int pa = 0; pa < J[a].cols(); ++pa) {
         const int ca = la[static_cast<size_t>(pa)];
         if (ca < 0) continue;
         for (size_t b = 0; b < vars.size(); ++b) {
-          const auto& lb = local_col[static_cast<size_t>(vars[b])];
+          const auto& lb = c.column[static_cast<size_t>(vars[b])];
           for (int pb = 0; pb < J[b].cols(); ++pb) {
             const double h = J[a].col(pa).dot(J[b].col(pb));
             if (!lb.empty()) {
@@ -143,20 +149,13 @@ ObservabilityReport analyse_observability(const FactorGraph& graph,
       }
     }
   }
-  Eigen::MatrixXd S = Hbb;
-  if (no > 0) {
-    others.linearize(graph.values().data());
-    if (!others.factorize(0.0, Damping::Marquardt))
-      throw Error(ErrorCode::Failed,
-                  "analyse_observability: the other variables are not determined even with " +
-                      join_names(graph, block) +
-                      " known (is a gauge free? fix a pose), so the marginal information of the "
-                      "block is not defined");
-    S -= Hob.transpose() * others.solve(Hob);
-  }
-  S = 0.5 * (S + S.transpose()).eval();
-  rep.information = S;
+}
 
+// The spectrum of the block's marginal information S scaled to correlations: rank, null space
+// (in the parameters' own units), condition number and the parameters the null space names.
+void analyse_spectrum(const Eigen::MatrixXd& S, const Eigen::MatrixXd& Hbb, double relative_tolerance,
+                      ObservabilityReport& rep) {
+  const int nb = static_cast<int>(S.rows());
   // Scale to correlations. A parameter left with roundoff-sized information is unobservable
   // outright, as scaling its S_ii up to 1 would hide that: when the elimination cancelled its
   // information (S_ii at most relative_tolerance of H_bb,ii: the other variables explain all of
@@ -195,10 +194,43 @@ ObservabilityReport analyse_observability(const FactorGraph& graph,
       if (std::abs(u[p]) >= 0.1) named[static_cast<size_t>(p)] = 1;
   }
   const double low = rep.eigenvalues.minCoeff();
-  rep.condition_number = rep.rank == nb && low > 0.0 ? top / low
-                                                     : std::numeric_limits<double>::infinity();
+  rep.condition_number = rep.rank == nb && low > 0.0 ? top / low : std::numeric_limits<double>::infinity();
   for (int p = 0; p < nb; ++p)
     if (named[static_cast<size_t>(p)]) rep.unobservable.push_back(rep.parameter_names[static_cast<size_t>(p)]);
+}
+
+}  // namespace
+
+ObservabilityReport analyse_observability(const FactorGraph& graph,
+                                          const std::vector<VariableId>& block,
+                                          double relative_tolerance,
+                                          const LinearSolverOptions& options) {
+  ObservabilityReport rep;
+  rep.relative_tolerance = relative_tolerance;
+  const BlockColumns cols = block_columns(graph, block, &rep.parameter_names);
+  const int nb = cols.count;
+  if (nb == 0) throw_invalid_argument("analyse_observability: the block has no free parameter");
+
+  NormalEquations others(graph, stored_coordinates(options), block);
+  const int no = others.num_columns();
+  Eigen::MatrixXd Hbb = Eigen::MatrixXd::Zero(nb, nb);
+  Eigen::MatrixXd Hob = Eigen::MatrixXd::Zero(no, nb);
+  block_information(graph, cols, others, Hbb, Hob);
+  // The block's marginal information: the Schur complement of the other variables.
+  Eigen::MatrixXd S = Hbb;
+  if (no > 0) {
+    others.linearize(graph.values().data());
+    if (!others.factorize(0.0, Damping::Marquardt))
+      throw Error(ErrorCode::Failed,
+                  "analyse_observability: the other variables are not determined even with " +
+                      join_names(graph, block) +
+                      " known (is a gauge free? fix a pose), so the marginal information of the "
+                      "block is not defined");
+    S -= Hob.transpose() * others.solve(Hob);
+  }
+  S = 0.5 * (S + S.transpose()).eval();
+  rep.information = S;
+  analyse_spectrum(S, Hbb, relative_tolerance, rep);
   return rep;
 }
 
