@@ -26,7 +26,7 @@ double at(const Kernel1& a, int k) {
 }
 
 // The kernel of a level-`level` pixel at the origin: the prefilter (or none), then per level the
-// downsampling's taps j = -2 .. 3 at level-(l) pixels 2u + j (kernels/pyramid.cl).
+// downsampling's taps j = -2 .. 3 at level-(l) pixels 2u + j (kernels/image/pyramid.cl).
 Kernel1 chain_kernel(int level, bool prefilter) {
   Kernel1 a = prefilter ? Kernel1{{-1, 0.25}, {0, 0.5}, {1, 0.25}} : Kernel1{{0, 1.0}};
   static const double d[6] = {1 / 32.0, 5 / 32.0, 10 / 32.0, 10 / 32.0, 5 / 32.0, 1 / 32.0};

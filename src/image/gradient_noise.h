@@ -47,7 +47,7 @@ std::vector<cv::Mat> gradient_noise_beta(const cv::Mat& variance_shape, int leve
 // 0 where the model has no value).
 cv::Mat corrected_noise_shape(const cv::Mat& scale);
 
-// Plain C++ reference of the `gradient_decorrelated` kernel (kernels/pyramid.cl): as
+// Plain C++ reference of the `gradient_decorrelated` kernel (kernels/image/pyramid.cl): as
 // gradient_reference (pipeline.h), the gradients less beta (I - mean) where valid.
 cv::Mat decorrelated_gradient_reference(const cv::Mat& level, const cv::Mat& beta, float mean);
 

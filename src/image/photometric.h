@@ -127,7 +127,7 @@ cv::Mat fill_flat_field(const cv::Mat& gain);
 // when it cannot be written; InvalidArgument for another type.
 void write_flat_field(const std::string& path, const cv::Mat& gain);
 
-// Plain C++ reference of the `photometric` kernel (kernels/undistort.cl): raw level-0 intensity
+// Plain C++ reference of the `photometric` kernel (kernels/image/undistort.cl): raw level-0 intensity
 // (kInvalidIntensity where not valid) -> corrected.
 cv::Mat photometric_reference(const cv::Mat& raw, const PhotometricFit& fit, double saturation);
 // Plain C++ reference of the `photometric_rolling` kernel: raw is undistort_rolling_reference's

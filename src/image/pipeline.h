@@ -118,7 +118,7 @@ struct PipelineTimings {
 
 // The pipeline's kernels with their launch shapes: what ImagePipeline enqueues, one call per
 // kernel, on the runtime's queue and without waiting. Tests run each stage on buffers of their
-// own through it. Buffers hold what the kernels in kernels/undistort.cl and kernels/pyramid.cl
+// own through it. Buffers hold what the kernels in kernels/image/undistort.cl and kernels/image/pyramid.cl
 // describe: intensity images are width * height floats (kInvalidIntensity where not valid).
 class PipelineKernels {
  public:

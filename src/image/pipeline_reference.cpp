@@ -1,5 +1,5 @@
-// The plain C++ reference of the image pipeline's kernels (kernels/undistort.cl,
-// kernels/pyramid.cl), stage by stage, in the kernels' float operations and order, so that the
+// The plain C++ reference of the image pipeline's kernels (kernels/image/undistort.cl,
+// kernels/image/pyramid.cl), stage by stage, in the kernels' float operations and order, so that the
 // kernel tests can hold them to a few float roundings.
 #include <algorithm>
 #include <string>

@@ -1,4 +1,4 @@
-// The mosaic's per-frame warp (kernels/mosaic.cl): its parameters, its plain C++ reference, and
+// The mosaic's per-frame warp (kernels/mosaic/mosaic.cl): its parameters, its plain C++ reference, and
 // the host side that runs the kernel. One frame's window of the mosaic grid is mapped through the
 // plane-induced homography (the paper's eq. 3, here from ground-grid pixels to the camera) and
 // the camera's distortion to the frame's pixels, and sampled with a feathering weight

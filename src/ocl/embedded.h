@@ -1,11 +1,11 @@
-// Kernel sources embedded at build time from kernels/*.cl (cmake/EmbedKernels.cmake).
+// Kernel sources embedded at build time from kernels/<layer>/*.cl (cmake/EmbedKernels.cmake).
 #pragma once
 #include <cstddef>
 
 namespace planarvo::ocl {
 
 struct EmbeddedSource {
-  const char* name;  // the file's stem: kernels/render.cl -> "render"
+  const char* name;  // the file's stem: kernels/sim/render.cl -> "render"
   const char* source;
   size_t size;
 };

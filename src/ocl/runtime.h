@@ -67,7 +67,7 @@ struct ProgramStats {
 // The manifest that export_binaries() writes and RuntimeOptions::binaries_dir reads.
 inline constexpr const char* kManifestFileName = "planarvo-kernels.txt";
 
-// The name of the embedded program that is a prelude to all others (kernels/common.cl), never
+// The name of the embedded program that is a prelude to all others (kernels/common/common.cl), never
 // a program by itself.
 inline constexpr const char* kPreludeName = "common";
 
@@ -99,7 +99,7 @@ class Runtime {
   // An in-order queue. The Runtime is not thread-safe: one thread uses it at a time.
   cl::CommandQueue& queue() { return queue_; }
 
-  // The program built from kernels/<name>.cl with the given build options ("-D WG=64 ..."),
+  // The program built from kernels/<layer>/<name>.cl with the given build options ("-D WG=64 ..."),
   // memoised per (name, normalised options). Thread-safe. Adds -cl-std=CL1.2 on devices whose
   // OpenCL C is 1.2 or newer. Throws Error(OpenCL) with the build log on failure; with
   // binaries_dir set, Error(InvalidInput or OpenCL) naming the program, options, device and
@@ -162,8 +162,8 @@ class Runtime {
   ProgramStats stats_;
 };
 
-// The source a program is built from: the prelude kernels/common.cl (when the library embeds
-// one) followed by kernels/<name>.cl, each behind a #line directive so that compiler messages
+// The source a program is built from: the prelude kernels/common/common.cl (when the library embeds
+// one) followed by kernels/<layer>/<name>.cl, each behind a #line directive so that compiler messages
 // name the right file and line. Throws Error(Internal) for a name that is not embedded.
 std::string program_source(const std::string& name);
 // The composition program_source() uses, for any prelude ("" for none).

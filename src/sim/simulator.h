@@ -167,7 +167,7 @@ Extrinsics knocked_extrinsics(const Options& options);
 // ---------------------------------------------------------------------------------------------
 // Rendering. The texture is prefiltered into a float mip pyramid; every output pixel averages
 // supersampling^2 subsamples, each a trilinear lookup at the level matching the subsample's
-// footprint on the ground. The OpenCL kernel (kernels/render.cl) and render_reference() below
+// footprint on the ground. The OpenCL kernel (kernels/sim/render.cl) and render_reference() below
 // compute the same float arithmetic from the same tables.
 
 // Float mip pyramid of a texture whose sides are powers of two: level 0 is the texture, level

@@ -1,5 +1,5 @@
 // The simulator's renderer: mip pyramid, ray tables, per-frame homography, the OpenCL kernel
-// (kernels/render.cl) and its plain C++ reference.
+// (kernels/sim/render.cl) and its plain C++ reference.
 #include <algorithm>
 #include <cmath>
 #include <string>
@@ -39,7 +39,7 @@ void parallel_rows(int rows, F body) {
 }
 
 // Bilinear lookup in one level of the mirror-tiled pyramid: the transliteration of
-// rnd_fold/rnd_bilinear in kernels/render.cl, in the same operations.
+// rnd_fold/rnd_bilinear in kernels/sim/render.cl, in the same operations.
 inline int fold(int i, int w) {
   const int m = i & (2 * w - 1);
   return m < w ? m : 2 * w - 1 - m;

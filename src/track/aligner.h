@@ -5,7 +5,7 @@
 //
 // Each image pair p has its own block of parameters, its planar motion T_p (3) and brightness
 // (a_p, b_p) (2, optional), and all pairs may share the camera's tilt y (2, warp_model.h). Each
-// pair is one fused pass (kernels/warp_reduce.cl, NPARAM 3 or 5: a fixed size whatever the
+// pair is one fused pass (kernels/track/warp_reduce.cl, NPARAM 3 or 5: a fixed size whatever the
 // number of pairs) whose sums give that pair's block of the normal equations; the joint system
 // over all pairs has the block-arrow structure of a bundle adjustment and is solved on the host
 // by eliminating each pair's block (Schur complement onto y). Levenberg damping on the total

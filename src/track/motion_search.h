@@ -1,4 +1,4 @@
-// The search for a motion where no guess is good enough (kernels/motion_search.cl): the first
+// The search for a motion where no guess is good enough (kernels/track/motion_search.cl): the first
 // frames of a robot already at speed, the frames after it was lost, a kick. The aligner converges
 // from within about a pixel of its coarsest level; at 640x480 with four levels that is about 8
 // pixels of the full image, while a robot camera at 0.2 m sees the floor move 40 pixels per frame

@@ -1,5 +1,5 @@
 // The pixels the tracker aligns when it subsamples a level: one per B x B block of a keyframe's
-// level at a hashed offset, a jittered grid (kernels/select_pixels.cl documents the rule, why
+// level at a hashed offset, a jittered grid (kernels/track/select_pixels.cl documents the rule, why
 // not by gradient, and the output). Gathered once per keyframe on the device into a compact
 // grid; the fused pass built with SELECT = 1 and select_block = B (WarpReduceOptions::select_block) then visits
 // only them, so a full-resolution pass costs about what a pass over 1 / B^2 of the pixels costs

@@ -2,7 +2,7 @@
 // pixel of one pyramid level, the last tracked frame's photometric residual against its
 // keyframe at the final alignment, the Huber weight the robust norm gives it and whether the
 // pixel is valid. Made on request by one pass of the fused kernel's DEBUG_OUTPUT variant
-// (kernels/warp_reduce.cl: every pixel of the level, whatever subsampling the tracking used),
+// (kernels/track/warp_reduce.cl: every pixel of the level, whatever subsampling the tracking used),
 // so tracking itself runs no extra work and gives the same results.
 #pragma once
 #include <memory>
@@ -64,7 +64,7 @@ class ResidualImager {
   // lacks (or a live level below 2 x 2 pixels).
   void compute(const AlignmentRecord& alignment, const Extrinsics& extrinsics, int level, ResidualImage* out);
   // texture_residual(image) of texture_residual.h for that residual image, reduced on the device
-  // (kernels/texture_residual.cl) instead of read back: the honest-status check of every frame.
+  // (kernels/track/texture_residual.cl) instead of read back: the honest-status check of every frame.
   double texture_residual(const AlignmentRecord& alignment, const Extrinsics& extrinsics, int level);
 
   static WarpReduceOptions kernel_options(const WarpReduceOptions& tracker_kernel);

@@ -180,7 +180,7 @@ ReduceSums warp_reduce_reference(const LevelView& ref, const LevelView& live,
       const float* R = at(ref, x, y);
       if (R[3] == 0.0f) continue;
       row[static_cast<size_t>(L.ref())] += 1.0;
-      // The pixel: this one, or the block's chosen one (its code, kernels/select_pixels.cl).
+      // The pixel: this one, or the block's chosen one (its code, kernels/track/select_pixels.cl).
       int px = x, py = y;
       if (o.select_block > 0) {
         const int off = static_cast<int>(R[3]) - 1;

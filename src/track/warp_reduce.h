@@ -1,4 +1,4 @@
-// The tracker's fused warp-residual-Jacobian-reduction pass (kernels/warp_reduce.cl): the
+// The tracker's fused warp-residual-Jacobian-reduction pass (kernels/track/warp_reduce.cl): the
 // layout of its per-work-group partial sums, its plain C++ reference, and the host side that
 // runs it and sums the partials in double. What one pass computes is documented at the top of
 // the kernel; the residual is r = gain * I_l(w(p)) + bias - I_r(p) with gain = e^a.
@@ -112,8 +112,8 @@ struct LevelView {
 
 // The kernels' warp of reference pixel (u, v) into a live level, in float in their order (so that
 // a reference decides validity as its kernel does), and the bilinear sample there, valid only when
-// all four neighbours lie inside and are valid: the part of kernels/warp_reduce.cl and
-// kernels/motion_search.cl that their plain C++ references share.
+// all four neighbours lie inside and are valid: the part of kernels/track/warp_reduce.cl and
+// kernels/track/motion_search.cl that their plain C++ references share.
 struct KernelSample {
   float qz = 0, wu = 0, wv = 0;  // q = H (u, v, 1); w = (q.x, q.y) / q.z (clamped to +-1e6)
   double value[3] = {0, 0, 0};   // the live level's (I, dI/du, dI/dv) at w, bilinear, in double

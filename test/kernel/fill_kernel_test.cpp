@@ -1,4 +1,4 @@
-// kernels/fill.cl against its C++ reference: every element of [0, n) written with the value,
+// kernels/ocl/fill.cl against its C++ reference: every element of [0, n) written with the value,
 // nothing beyond n touched, for sizes that are not multiples of the work-group size.
 #include <gtest/gtest.h>
 

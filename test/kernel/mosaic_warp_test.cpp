@@ -1,4 +1,4 @@
-// kernels/mosaic.cl against its plain C++ reference (mosaic_warp_reference), on random frames,
+// kernels/mosaic/mosaic.cl against its plain C++ reference (mosaic_warp_reference), on random frames,
 // cameras (distortion, regions of interest), extrinsics, poses, resolutions and windows; and the
 // reference's geometry against the camera model: a frame rendered from a known ground pattern
 // through CameraModel::unproject (Newton's method on the distortion, in double) must warp back

@@ -1,4 +1,4 @@
-// kernels/motion_search.cl against its plain C++ reference (motion_search_reference, double
+// kernels/track/motion_search.cl against its plain C++ reference (motion_search_reference, double
 // accumulation) on random float4 levels with invalid regions and random homographies, some of
 // which send most pixels outside the live level; sizes that are not multiples of the work-group,
 // several subsampling steps and work-group sizes, 1 to 300 hypotheses. Each comparison follows

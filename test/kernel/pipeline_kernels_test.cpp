@@ -1,4 +1,4 @@
-// Each kernel of the image pipeline (kernels/undistort.cl, kernels/pyramid.cl) against its plain
+// Each kernel of the image pipeline (kernels/image/undistort.cl, kernels/image/pyramid.cl) against its plain
 // C++ reference (src/image/pipeline_reference.cpp), on random input with invalid regions, through
 // PipelineKernels (the launch code ImagePipeline uses), with the output buffers poisoned and
 // longer than the image so that an unwritten element or a write past the end shows.

@@ -1,4 +1,4 @@
-// kernels/render.cl against its plain C++ reference (render_reference), on random textures,
+// kernels/sim/render.cl against its plain C++ reference (render_reference), on random textures,
 // cameras, extrinsics and poses, with a poisoned, padded output buffer.
 #include <cmath>
 #include <cstring>
@@ -242,7 +242,7 @@ TEST(RenderKernel, GlobalShutterBitIdenticalToSingleHomographyKernel) {
   std::string source = ocl::program_source("render");
   auto undo = [&](const std::string& now, const std::string& before) {
     const size_t at = source.find(now);
-    ASSERT_NE(at, std::string::npos) << "kernels/render.cl changed: update this test's reconstruction (" << now << ")";
+    ASSERT_NE(at, std::string::npos) << "kernels/sim/render.cl changed: update this test's reconstruction (" << now << ")";
     source.replace(at, now.size(), before);
   };
   undo("const int out_stride,\n                   __global const float* hrows) {", "const int out_stride) {");

@@ -162,7 +162,7 @@ TEST_F(ResidualImageTest, KernelAgreesWithHostAndFindsThePastedBlob) {
     EXPECT_LT(clear_abs[clear_abs.size() / 2], 2.0);
   }
   // The honest-status check's measure, which the tracker reduces on the device
-  // (kernels/texture_residual.cl), against the host's texture_residual() of the same residual
+  // (kernels/track/texture_residual.cl), against the host's texture_residual() of the same residual
   // image read back: float sums per pixel against double.
   const int tl = texture_residual_level(options_.camera.width, 4);
   const double host_measure = texture_residual(tracker.residuals(tl));

@@ -1,4 +1,4 @@
-// kernels/select_pixels.cl against select_pixels_reference and against the rule itself (each
+// kernels/track/select_pixels.cl against select_pixels_reference and against the rule itself (each
 // block's entry is its level's pixel at the hashed offset, or none where that pixel is invalid or
 // outside; the offsets are spread evenly over the block), and the fused pass over subsampled
 // pixels (warp_reduce.cl with SELECT) against two references: its own plain C++ reference,

@@ -1,4 +1,4 @@
-// kernels/warp_reduce.cl against its plain C++ reference (warp_reduce_reference, double
+// kernels/track/warp_reduce.cl against its plain C++ reference (warp_reduce_reference, double
 // accumulation) on random float4 levels with invalid regions, random homographies and
 // derivative matrices, random brightness and Huber thresholds; sizes that are not multiples of
 // the work-group's span; several work-group shapes, pixels per work-item, parameter counts and

@@ -32,7 +32,7 @@
 // reference pixel (r, weight, valid, rho); not for the fast path).
 //
 // With SELECT = 1 the reference is not a level but its subsampled pixels
-// (kernels/select_pixels.cl) and an argument select_block = B follows huber_k: a grid of
+// (kernels/track/select_pixels.cl) and an argument select_block = B follows huber_k: a grid of
 // ref_w x ref_h entries, one per B x B block of the level, each (I_r, dI_r/du, dI_r/dv, code) of
 // the block's pixel, code = 1 + ox + 256 oy for the pixel (bx B + ox, by B + oy) of block (bx, by),
 // 0 for none. Everything above then applies to that pixel; the work distribution, the partials
@@ -218,7 +218,7 @@ void warp_reduce_store(const float* acc, __local float* scratch, __global float*
 #if LANES == 8
 // Eight pixels at a time. PoCL does not vectorise the per-pixel form below across work-items
 // (its SLP pass first packs one pixel's arithmetic into short vectors, which stops the
-// work-item-loop vectoriser, as in kernels/undistort.cl), so this form does it by hand: a
+// work-item-loop vectoriser, as in kernels/image/undistort.cl), so this form does it by hand: a
 // work-item takes PIX pixels of a row as PIX / 8 runs of 8 consecutive pixels, the runs WG_X * 8
 // apart, and every value below is a float8 of the run's pixels. Only the live level's four
 // neighbours are gathered one pixel at a time (two vload8 each: the neighbours' (I, Gu, Gv, valid)

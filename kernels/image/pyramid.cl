@@ -16,7 +16,7 @@
 #define PYRAMID_WG_Y 4
 #endif
 
-// PV_INVALID and pv_store_head come from kernels/common.cl.
+// PV_INVALID and pv_store_head come from kernels/common/common.cl.
 
 // ---------------------------------------------------------------------------------------------
 // Downsampling: level l (sw x sh) -> level l + 1 (dw x dh = ceil(sw / 2) x ceil(sh / 2)).

@@ -25,7 +25,7 @@
 #define UNDISTORT_WG_Y 4
 #endif
 
-// PV_INVALID, pv_store_head and pv_load_head come from kernels/common.cl.
+// PV_INVALID, pv_store_head and pv_load_head come from kernels/common/common.cl.
 
 __kernel __attribute__((reqd_work_group_size(UNDISTORT_WG_X, UNDISTORT_WG_Y, 1)))
 void undistort(__global const uchar* src, __global const int* index,

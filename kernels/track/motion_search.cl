@@ -8,7 +8,7 @@
 // column and row (an argument) with a valid reference sample R = ref(p):
 //   q = H_h (u, v, 1); w(p) = (q.x / q.z, q.y / q.z)
 //   L = bilinear sample of the live level's intensity at w(p), valid only when all four
-//       neighbours are inside and valid (as kernels/warp_reduce.cl samples it)
+//       neighbours are inside and valid (as kernels/track/warp_reduce.cl samples it)
 //   a = I_r(p) - 128, b = L - 128 (centred, so that the sums of squares keep their precision in
 //   float)
 // and the pixel adds to the hypothesis's row of six sums: (n, sum a, sum b, sum a^2, sum b^2,
