@@ -140,18 +140,6 @@ std::string ImagePipeline::pyramid_build_options(const ImagePipelineOptions& o) 
                                       (o.fast_math ? "-cl-fast-relaxed-math" : ""));
 }
 
-namespace {
-// The default option sets, registered before main() so that `planarvo kernels --export`
-// exports them without a pipeline having been made. The tracker and the roll/pitch estimator
-// (hence tracking and calibration) make their pipelines with the defaults.
-const bool kDefaultOptionsRegistered = [] {
-  const std::vector<std::string> uses = {ocl::kUseTrack, ocl::kUseCalibrate};
-  ocl::Runtime::register_build_options("undistort", ImagePipeline::undistort_build_options(), uses);
-  ocl::Runtime::register_build_options("pyramid", ImagePipeline::pyramid_build_options(), uses);
-  return true;
-}();
-}  // namespace
-
 PipelineKernels::PipelineKernels(ocl::Runtime& runtime, const ImagePipelineOptions& options)
     : runtime_(runtime) {
   const std::string undistort_opts = ImagePipeline::undistort_build_options(options);

@@ -9,6 +9,7 @@
 #include <Eigen/Dense>
 
 #include "core/error.h"
+#include "core/tasks.h"
 
 namespace planarvo::mosaic {
 
@@ -174,7 +175,7 @@ std::string MosaicWarp::build_options() { return ""; }
 namespace {
 // The default, registered before main() so that `planarvo kernels --export` exports it.
 const bool kDefaultOptionsRegistered = [] {
-  ocl::Runtime::register_build_options("mosaic", MosaicWarp::build_options(), {ocl::kUseMosaic});
+  ocl::Runtime::register_build_options("mosaic", MosaicWarp::build_options(), {tasks::kMosaic});
   return true;
 }();
 }  // namespace

@@ -71,14 +71,6 @@ inline constexpr const char* kManifestFileName = "planarvo-kernels.txt";
 // a program by itself.
 inline constexpr const char* kPreludeName = "common";
 
-// The uses that program variants are registered for (Runtime::register_build_options): the
-// engine's tasks, named as the tool's commands that run them, which is also how the C API's
-// planarvo_context_export_kernels_for and the manifest's "for" field name them.
-inline constexpr const char* kUseTrack = "track";          // the tracker: planarvo_tracker_*
-inline constexpr const char* kUseCalibrate = "calibrate";  // roll and pitch, then the tracker
-inline constexpr const char* kUseSimulate = "simulate";    // the simulator's renderer
-inline constexpr const char* kUseMosaic = "mosaic";        // the floor mosaic: planarvo_mosaic_*
-
 // Every platform's devices, in the order `planarvo devices` lists them. Never throws for a
 // machine without OpenCL: returns an empty list. A platform or device that cannot be queried
 // is left out. The first call in a process (this, or a Runtime's construction) may set
@@ -121,10 +113,10 @@ class Runtime {
   void prepare_all();
 
   // Layers declare the build options they will use for a program, so that export_binaries()
-  // can build exactly those variants. uses names what needs the variant in the user's words:
-  // the engine's tasks, which are the tool's commands that run them ("track", "calibrate",
-  // "simulate"); the defaults are registered with them before main(), variants made at run
-  // time from other options without. Registering again adds uses. Thread-safe.
+  // can build exactly those variants. uses names what needs the variant in the user's words,
+  // opaque to ocl: the layers register with the engine's tasks (core/tasks.h), which are the
+  // tool's commands that run them and the manifest's "for" field; the defaults are registered
+  // with them before main(), variants made at run time from other options without. Registering again adds uses. Thread-safe.
   static void register_build_options(const std::string& program, const std::string& options,
                                      const std::vector<std::string>& uses = {});
   // The normalised option sets registered for a program, sorted.

@@ -9,6 +9,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "core/error.h"
+#include "core/tasks.h"
 #include "ocl/runtime.h"
 #include "sim/simulator.h"
 
@@ -312,7 +313,7 @@ namespace {
 // The default, registered before main() so that `planarvo kernels --export` exports it for
 // simulation without a renderer having been made (FPGA flows cannot compile at run time).
 const bool kDefaultOptionsRegistered = [] {
-  ocl::Runtime::register_build_options("render", Renderer::build_options(), {ocl::kUseSimulate});
+  ocl::Runtime::register_build_options("render", Renderer::build_options(), {tasks::kSimulate});
   return true;
 }();
 }  // namespace

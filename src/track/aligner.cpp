@@ -7,6 +7,7 @@
 #include <Eigen/Cholesky>
 
 #include "core/error.h"
+#include "core/tasks.h"
 #include "ocl/runtime.h"
 #include "track/warp_model.h"
 
@@ -42,9 +43,9 @@ WarpReduceOptions kernel_options(const AlignerOptions& o, bool stats) {
 const bool kDefaultVariantsRegistered = [] {
   for (int nparam : {kMotionParams, kMotionParams + kOrientationParams, kMotionParams + kAttitudeParams}) {
     const std::vector<std::string> uses =
-        nparam == kMotionParams ? std::vector<std::string>{ocl::kUseTrack, ocl::kUseCalibrate}
-        : nparam == kMotionParams + kOrientationParams ? std::vector<std::string>{ocl::kUseCalibrate}
-                                                       : std::vector<std::string>{ocl::kUseTrack};
+        nparam == kMotionParams ? std::vector<std::string>{tasks::kTrack, tasks::kCalibrate}
+        : nparam == kMotionParams + kOrientationParams ? std::vector<std::string>{tasks::kCalibrate}
+                                                       : std::vector<std::string>{tasks::kTrack};
     for (bool stats : {false, true})
       ocl::Runtime::register_build_options(
           "warp_reduce", WarpReduce::build_options(nparam, kernel_options(AlignerOptions(), stats)), uses);
@@ -58,8 +59,8 @@ const bool kDefaultVariantsRegistered = [] {
       k.select_block = 2;
       ocl::Runtime::register_build_options("warp_reduce", WarpReduce::build_options(nparam, k),
                                            nparam == kMotionParams
-                                               ? std::vector<std::string>{ocl::kUseTrack, ocl::kUseCalibrate}
-                                               : std::vector<std::string>{ocl::kUseTrack});
+                                               ? std::vector<std::string>{tasks::kTrack, tasks::kCalibrate}
+                                               : std::vector<std::string>{tasks::kTrack});
     }
   return true;
 }();

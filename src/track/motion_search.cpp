@@ -7,6 +7,7 @@
 #include <Eigen/LU>
 
 #include "core/error.h"
+#include "core/tasks.h"
 #include "ocl/runtime.h"
 #include "track/warp_model.h"
 
@@ -19,7 +20,7 @@ constexpr int kSums = 6;  // a row of the kernel's output
 // tracker searches when tracking and when calibrating).
 const bool kDefaultRegistered = [] {
   ocl::Runtime::register_build_options("motion_search", MotionSearch::build_options(64),
-                                       {ocl::kUseTrack, ocl::kUseCalibrate});
+                                       {tasks::kTrack, tasks::kCalibrate});
   return true;
 }();
 

@@ -1,6 +1,7 @@
 #include "track/pixel_selection.h"
 
 #include "core/error.h"
+#include "core/tasks.h"
 #include "ocl/runtime.h"
 
 namespace planarvo::track {
@@ -10,7 +11,7 @@ namespace {
 // The program has no build options; registered for export with the tracker's uses (the
 // calibration's tracking stage subsamples too: the tracker's default levels).
 const bool kRegistered = [] {
-  ocl::Runtime::register_build_options("select_pixels", "", {ocl::kUseTrack, ocl::kUseCalibrate});
+  ocl::Runtime::register_build_options("select_pixels", "", {tasks::kTrack, tasks::kCalibrate});
   return true;
 }();
 

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "core/error.h"
+#include "core/tasks.h"
 #include "ocl/runtime.h"
 #include "track/texture_residual.h"
 #include "track/warp_model.h"
@@ -26,10 +27,10 @@ namespace {
 // binaries hold it: the tracker measures every frame's texture residual with it (the honest-status
 // check, texture_residual.h), and the calibration tracks its drives.
 const bool kDefaultVariantRegistered = [] {
-  ocl::Runtime::register_build_options("texture_residual", "", {ocl::kUseTrack, ocl::kUseCalibrate});
+  ocl::Runtime::register_build_options("texture_residual", "", {tasks::kTrack, tasks::kCalibrate});
   ocl::Runtime::register_build_options(
       "warp_reduce", WarpReduce::build_options(kMotionParams, ResidualImager::kernel_options(WarpReduceOptions())),
-      {ocl::kUseTrack, ocl::kUseCalibrate});
+      {tasks::kTrack, tasks::kCalibrate});
   return true;
 }();
 

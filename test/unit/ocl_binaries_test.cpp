@@ -11,6 +11,7 @@
 #include "common/test_util.h"
 #include "core/error.h"
 #include "core/sha256.h"
+#include "core/tasks.h"
 #include "ocl/manifest.h"
 #include "ocl/runtime.h"
 #include "unit/ocl_test_helpers.h"
@@ -285,7 +286,7 @@ TEST(OclBinariesExport, ForAUseWritesOnlyItsVariantsAndSaysWhatTheyAreFor) {
   EXPECT_EQ(ocl::Runtime::registered_uses("fill", "-D VARIANT=23"),
             (std::vector<std::string>{"fill-use-b"}));
   const std::vector<std::string> known = ocl::Runtime::known_uses();
-  for (const char* u : {"fill-use-a", "fill-use-b", ocl::kUseTrack, ocl::kUseCalibrate, ocl::kUseSimulate})
+  for (const char* u : {"fill-use-a", "fill-use-b", tasks::kTrack, tasks::kCalibrate, tasks::kSimulate})
     EXPECT_NE(std::find(known.begin(), known.end(), u), known.end()) << u;
 
   test::ScratchDir scratch;
@@ -321,7 +322,7 @@ TEST(OclBinariesExport, ForAUseWritesOnlyItsVariantsAndSaysWhatTheyAreFor) {
   const std::string unknown = test::error_message(
       [&] { rt.export_binaries((scratch / "x").string(), {"no-such-use"}); }, ErrorCode::InvalidArgument);
   EXPECT_THAT(unknown, HasSubstr("\"no-such-use\""));
-  EXPECT_THAT(unknown, HasSubstr(ocl::kUseTrack));
+  EXPECT_THAT(unknown, HasSubstr(tasks::kTrack));
 }
 
 TEST(OclManifest, ReadsFormat1And2Lines) {
