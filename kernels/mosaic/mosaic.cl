@@ -11,7 +11,7 @@
 // mosaic_warp_reference() in src/mosaic/mosaic_warp.cpp is the plain C++ reference: keep them in
 // step.
 //
-// prm (see MosaicWarpParam in mosaic_warp.h):
+// prm (kernels/mosaic/mosaic_project.h names the offsets; mosaic_warp.h's MosaicWarpParam uses them):
 //   0..8   H, row-major: (col + 0.5, row + 0.5, 1) of the window -> (X, Y, Z) camera frame
 //   9..12  fx fy cx cy        13..17 k1 k2 p1 p2 k3
 //   18     largest squared radius of an undistorted ray inside the image (the model's domain)
@@ -34,29 +34,7 @@
 #define MOSAIC_WG_Y 4
 #endif
 
-// Window pixel (mx, my) to the distorted frame pixel (*u, *v) through H(s); 0 where the ground
-// point is behind the camera or outside the distortion model's domain.
-inline int mosaic_project(__constant float* prm, float mx, float my, float s, float* u, float* v) {
-  const float w0 = (1.0f - s) * (1.0f - 2.0f * s), wm = 4.0f * s * (1.0f - s), w1 = s * (2.0f * s - 1.0f);
-  const float X = (w0 * prm[0] + wm * prm[27] + w1 * prm[36]) * mx + (w0 * prm[1] + wm * prm[28] + w1 * prm[37]) * my +
-                  (w0 * prm[2] + wm * prm[29] + w1 * prm[38]);
-  const float Y = (w0 * prm[3] + wm * prm[30] + w1 * prm[39]) * mx + (w0 * prm[4] + wm * prm[31] + w1 * prm[40]) * my +
-                  (w0 * prm[5] + wm * prm[32] + w1 * prm[41]);
-  const float Z = (w0 * prm[6] + wm * prm[33] + w1 * prm[42]) * mx + (w0 * prm[7] + wm * prm[34] + w1 * prm[43]) * my +
-                  (w0 * prm[8] + wm * prm[35] + w1 * prm[44]);
-  if (!(Z > 0.0f)) return 0;
-  const float iz = 1.0f / Z;
-  const float x = X * iz, y = Y * iz;
-  const float r2 = x * x + y * y;
-  if (!(r2 <= prm[18])) return 0;
-  const float k1 = prm[13], k2 = prm[14], p1 = prm[15], p2 = prm[16], k3 = prm[17];
-  const float radial = 1.0f + r2 * (k1 + r2 * (k2 + r2 * k3));
-  const float xd = x * radial + 2.0f * p1 * x * y + p2 * (r2 + 2.0f * x * x);
-  const float yd = y * radial + p1 * (r2 + 2.0f * y * y) + 2.0f * p2 * x * y;
-  *u = prm[9] * xd + prm[11];
-  *v = prm[10] * yd + prm[12];
-  return 1;
-}
+#include "kernels/mosaic/mosaic_project.h"
 
 __kernel __attribute__((reqd_work_group_size(MOSAIC_WG_X, MOSAIC_WG_Y, 1)))
 void mosaic_warp(__global const uchar* frame, const int frame_stride, __constant float* prm,
@@ -69,7 +47,7 @@ void mosaic_warp(__global const uchar* frame, const int frame_stride, __constant
   const float mx = (float)col + 0.5f, my = (float)row + 0.5f;
   const float dx = mx - prm[24], dy = my - prm[25];
   float value = 0.0f, weight = 0.0f, u = 0.0f, v = 0.0f;
-  int seen = dx * dx + dy * dy <= prm[26] && mosaic_project(prm, mx, my, 0.0f, &u, &v);
+  int seen = dx * dx + dy * dy <= prm[26] && pv_mosaic_project(prm, mx, my, 0.0f, &u, &v);
   const float inv_rows = prm[45];
   if (seen && inv_rows > 0.0f) {
     // The steps are not clamped to the frame's rows (a clamped step breaks the extrapolation for
@@ -77,18 +55,18 @@ void mosaic_warp(__global const uchar* frame, const int frame_stride, __constant
     // them. Only the answer is clamped to them: a point no row saw (its fixed point beyond the
     // last row) still projects beyond that row from it, since the map's slope is below 1.
     const float s1 = clamp(v * inv_rows, -0.5f, 1.5f);
-    seen = mosaic_project(prm, mx, my, s1, &u, &v);
+    seen = pv_mosaic_project(prm, mx, my, s1, &u, &v);
     const float s2 = clamp(v * inv_rows, -0.5f, 1.5f);
     // f(s) = g(s) - s, g(s) = v(s) / (rows - 1): the root by secant steps, the first through
     // (0, s1) and (s1, s2 - s1), which is Aitken's extrapolation of 0, s1, s2.
     const float f1 = s2 - s1;
     const float den1 = f1 - s1;
     const float sa = fabs(den1) > 1e-7f ? clamp(s1 - f1 * s1 / den1, -0.5f, 1.5f) : s2;
-    seen = seen && mosaic_project(prm, mx, my, sa, &u, &v);
+    seen = seen && pv_mosaic_project(prm, mx, my, sa, &u, &v);
     const float fa = v * inv_rows - sa;
     const float den2 = fa - f1;
     const float sb = fabs(den2) > 1e-7f ? sa - fa * (sa - s1) / den2 : sa + fa;
-    seen = seen && mosaic_project(prm, mx, my, clamp(sb, 0.0f, 1.0f), &u, &v);
+    seen = seen && pv_mosaic_project(prm, mx, my, clamp(sb, 0.0f, 1.0f), &u, &v);
   }
   // All four bilinear neighbours inside the region of interest.
   if (seen && u >= prm[19] && v >= prm[20] && u < prm[21] && v < prm[22]) {

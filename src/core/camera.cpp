@@ -7,6 +7,7 @@
 #include <Eigen/Dense>
 
 #include "core/error.h"
+#include "kernels/common/distortion.h"
 
 namespace planarvo {
 
@@ -17,11 +18,9 @@ Eigen::Matrix3d CameraModel::K() const {
 }
 
 Eigen::Vector2d CameraModel::distort(const Eigen::Vector2d& xn) const {
-  const double x = xn.x(), y = xn.y();
-  const double r2 = x * x + y * y;
-  const double radial = 1.0 + r2 * (k1 + r2 * (k2 + r2 * k3));
-  return {x * radial + 2.0 * p1 * x * y + p2 * (r2 + 2.0 * x * x),
-          y * radial + p1 * (r2 + 2.0 * y * y) + 2.0 * p2 * x * y};
+  Eigen::Vector2d xd;
+  pv_distort_double(xn.x(), xn.y(), k1, k2, p1, p2, k3, &xd.x(), &xd.y());
+  return xd;
 }
 
 Eigen::Vector2d CameraModel::undistort(const Eigen::Vector2d& xd) const {
@@ -31,7 +30,7 @@ Eigen::Vector2d CameraModel::undistort(const Eigen::Vector2d& xd) const {
   for (int it = 0; it < 50; ++it) {
     const double u = x.x(), v = x.y();
     const double r2 = u * u + v * v;
-    const double radial = 1.0 + r2 * (k1 + r2 * (k2 + r2 * k3));
+    const double radial = pv_radial_double(r2, k1, k2, k3);
     const double dradial = k1 + r2 * (2.0 * k2 + 3.0 * r2 * k3);  // d radial / d r2
     // The Jacobian is symmetric, [a b; b c], and near the identity inside the model's domain:
     // its inverse in closed form (an LU of a 2x2 matrix cost more than the rest of the step).

@@ -108,26 +108,7 @@ namespace {
 // The kernel's projection of window pixel (mx, my) at readout fraction s: false where the ground
 // point is behind the camera or outside the distortion model's domain.
 bool project_reference(const WarpParams& prm, float mx, float my, float s, float* u, float* v) {
-  const float w0 = (1.0f - s) * (1.0f - 2.0f * s), wm = 4.0f * s * (1.0f - s), w1 = s * (2.0f * s - 1.0f);
-  float h[9];
-  for (int i = 0; i < 9; ++i)
-    h[i] = w0 * prm[static_cast<size_t>(kParamH + i)] + wm * prm[static_cast<size_t>(kParamHMiddle + i)] +
-           w1 * prm[static_cast<size_t>(kParamHLast + i)];
-  const float X = h[0] * mx + h[1] * my + h[2];
-  const float Y = h[3] * mx + h[4] * my + h[5];
-  const float Z = h[6] * mx + h[7] * my + h[8];
-  if (!(Z > 0.0f)) return false;
-  const float iz = 1.0f / Z;
-  const float x = X * iz, y = Y * iz;
-  const float r2 = x * x + y * y;
-  if (!(r2 <= prm[18])) return false;
-  const float k1 = prm[13], k2 = prm[14], p1 = prm[15], p2 = prm[16], k3 = prm[17];
-  const float radial = 1.0f + r2 * (k1 + r2 * (k2 + r2 * k3));
-  const float xd = x * radial + 2.0f * p1 * x * y + p2 * (r2 + 2.0f * x * x);
-  const float yd = y * radial + p1 * (r2 + 2.0f * y * y) + 2.0f * p2 * x * y;
-  *u = prm[9] * xd + prm[11];
-  *v = prm[10] * yd + prm[12];
-  return true;
+  return pv_mosaic_project(prm.data(), mx, my, s, u, v) != 0;
 }
 
 }  // namespace

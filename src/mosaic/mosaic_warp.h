@@ -10,9 +10,10 @@
 #include <Eigen/Core>
 #include <opencv2/core.hpp>
 
+#include "core/camera.h"
 #include "core/extrinsics.h"
 #include "core/se2.h"
-#include "core/camera.h"
+#include "kernels/mosaic/mosaic_project.h"
 #include "ocl/runtime.h"
 
 namespace planarvo::mosaic {
@@ -36,22 +37,23 @@ struct Window {
   bool empty() const { return width <= 0 || height <= 0; }
 };
 
+// The parameter block's layout: kernels/mosaic/mosaic_project.h's, which the kernel reads by.
 enum MosaicWarpParam {
-  kParamH = 0,            // 9: window pixel (col + 0.5, row + 0.5, 1) -> camera-frame ground point
-  kParamIntrinsics = 9,   // fx fy cx cy
-  kParamDistortion = 13,  // k1 k2 p1 p2 k3
-  kParamMaxRadius2 = 18,  // the distortion model's domain: squared undistorted radius
-  kParamRegion = 19,      // first column, first row, last column, last row (inclusive)
-  kParamInvFeather = 23,  // 1 / the feathering ramp in frame pixels
-  kParamFoot = 24,        // 2: the camera's foot point in window pixels
-  kParamRange2 = 26,      // squared range limit in mosaic pixels
+  kParamH = PV_MOSAIC_H,                      // 9: window pixel (col + 0.5, row + 0.5, 1) -> camera-frame ground point
+  kParamIntrinsics = PV_MOSAIC_INTRINSICS,    // fx fy cx cy
+  kParamDistortion = PV_MOSAIC_DISTORTION,    // k1 k2 p1 p2 k3
+  kParamMaxRadius2 = PV_MOSAIC_MAX_RADIUS2,   // the distortion model's domain: squared undistorted radius
+  kParamRegion = PV_MOSAIC_REGION,            // first column, first row, last column, last row (inclusive)
+  kParamInvFeather = PV_MOSAIC_INV_FEATHER,   // 1 / the feathering ramp in frame pixels
+  kParamFoot = PV_MOSAIC_FOOT,                // 2: the camera's foot point in window pixels
+  kParamRange2 = PV_MOSAIC_RANGE2,            // squared range limit in mosaic pixels
   // A rolling shutter (docs/conventions.md: row r is read at stamp + r / (rows - 1) * readout):
   // the homographies of the robot's poses when the middle row and the last row were read (kParamH
   // is the first row's), and 1 / (rows - 1) of the frame; 0 there for a global shutter.
-  kParamHMiddle = 27,     // 9
-  kParamHLast = 36,       // 9
-  kParamInvRows = 45,
-  kParamCount = 46
+  kParamHMiddle = PV_MOSAIC_H_MIDDLE,         // 9
+  kParamHLast = PV_MOSAIC_H_LAST,             // 9
+  kParamInvRows = PV_MOSAIC_INV_ROWS,
+  kParamCount = PV_MOSAIC_PARAM_COUNT
 };
 using WarpParams = std::array<float, kParamCount>;
 
