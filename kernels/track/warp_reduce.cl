@@ -74,30 +74,32 @@
 #endif
 
 #define NJ (NPARAM + 2)
-#define NH (NJ * (NJ + 1) / 2)
+#define NH PV_REDUCE_NH(NJ)
 #define WG (WG_X * WG_Y)
-// Row layout (ReduceLayout in warp_reduce.h). The statistics after OUT_REF are only in the
-// STATS variant, which the tracker runs once per level: each extra sum costs every pixel. The
-// histogram counts only each work-item's first pixel (one in PIX).
-#define OUT_JTJ 0                    // NH: upper triangle of J^T W J, row by row
-#define OUT_JTR (NH)                 // NJ: J^T W r
-#define OUT_COST (NH + NJ)           // sum of Huber costs
-#define OUT_WRR (OUT_COST + 1)       // sum of weight * r^2
-#define OUT_VALID (OUT_COST + 2)     // pixels with a valid reference and a valid live sample
-#define OUT_INLIER (OUT_COST + 3)    // of those, |r| <= k
-#define OUT_REF (OUT_COST + 4)       // pixels with a valid reference
+// Row layout: kernels/track/warp_reduce_layout.h, which ReduceLayout (warp_reduce.h) reads by.
+// The statistics after OUT_REF are only in the STATS variant, which the tracker runs once per
+// level: each extra sum costs every pixel. The histogram counts only each work-item's first
+// pixel (one in PIX).
+#include "kernels/track/warp_reduce_layout.h"
+#define OUT_JTJ PV_REDUCE_JTJ
+#define OUT_JTR PV_REDUCE_JTR(NJ)
+#define OUT_COST PV_REDUCE_COST(NJ)
+#define OUT_WRR PV_REDUCE_WRR(NJ)
+#define OUT_VALID PV_REDUCE_VALID(NJ)
+#define OUT_INLIER PV_REDUCE_INLIER(NJ)
+#define OUT_REF PV_REDUCE_REF(NJ)
 #if STATS
-#define OUT_RR (OUT_COST + 5)        // sum of r^2
-#define OUT_IREF (OUT_COST + 6)      // sum of (I_r - 128) over valid pairs
-#define OUT_IREF2 (OUT_COST + 7)     // sum of (I_r - 128)^2 over valid pairs
-#define OUT_GLIVE (OUT_COST + 8)     // sum of |grad I_l(w(p))|^2 over valid pairs (live pixels)
-#define OUT_GREF (OUT_COST + 9)      // sum of |grad I_r(p)|^2 over valid pairs
-#define OUT_HVALID (OUT_COST + 10)   // valid pixels in the histogram's subsample
-#define OUT_HIST (OUT_COST + 11)     // HIST_BINS: counts of |r| < 0.25 * 2^(j / 2) in it
-#define OUT_JTJ_IN (OUT_HIST + HIST_BINS)  // NH: upper triangle of J^T J over the inliers (|r| <= k)
-#define NOUT (OUT_JTJ_IN + NH)
+#define OUT_RR PV_REDUCE_RR(NJ)
+#define OUT_IREF PV_REDUCE_IREF(NJ)
+#define OUT_IREF2 PV_REDUCE_IREF2(NJ)
+#define OUT_GLIVE PV_REDUCE_GLIVE(NJ)
+#define OUT_GREF PV_REDUCE_GREF(NJ)
+#define OUT_HVALID PV_REDUCE_HVALID(NJ)
+#define OUT_HIST PV_REDUCE_HIST(NJ)
+#define OUT_JTJ_IN PV_REDUCE_JTJ_IN(NJ, HIST_BINS)
+#define NOUT PV_REDUCE_STATS_COUNT(NJ, HIST_BINS)
 #else
-#define NOUT (OUT_COST + 5)
+#define NOUT PV_REDUCE_PLAIN_COUNT(NJ)
 #endif
 
 // The sample of the live level at (x, y): all four neighbours must lie inside and be valid.

@@ -10,6 +10,8 @@
 #include <CL/opencl.hpp>
 #include <Eigen/Core>
 
+#include "kernels/track/warp_reduce_layout.h"
+
 namespace planarvo::ocl {
 class Runtime;
 }
@@ -21,33 +23,33 @@ inline constexpr int kMaxParams = 8;
 inline constexpr int kMaxJacobian = kMaxParams + 2;  // plus brightness (a, b)
 inline constexpr int kMaxHistBins = 24;
 
-// Where each sum sits in a row of partials (mirrors the OUT_* macros of warp_reduce.cl). The
-// statistics from rr() on exist only in the STATS variant.
+// Where each sum sits in a row of partials: kernels/track/warp_reduce_layout.h, the layout the
+// kernel writes by. The statistics from rr() on exist only in the STATS variant.
 struct ReduceLayout {
   int nparam = 3;
   bool stats = false;
   int hist_bins = 16;  // with stats only
 
   int nj() const { return nparam + 2; }
-  int nh() const { return nj() * (nj() + 1) / 2; }
+  int nh() const { return PV_REDUCE_NH(nj()); }
   // Upper triangle of J^T W J, row by row; i <= j.
-  int jtj(int i, int j) const { return i * nj() - i * (i - 1) / 2 + (j - i); }
-  int jtr(int i) const { return nh() + i; }
-  int cost() const { return nh() + nj(); }
-  int wrr() const { return cost() + 1; }
-  int valid() const { return cost() + 2; }
-  int inlier() const { return cost() + 3; }
-  int ref() const { return cost() + 4; }
-  int rr() const { return cost() + 5; }
-  int iref() const { return cost() + 6; }
-  int iref2() const { return cost() + 7; }
-  int glive() const { return cost() + 8; }
-  int gref() const { return cost() + 9; }
-  int hvalid() const { return cost() + 10; }  // valid pixels in the histogram's subsample
-  int hist(int j) const { return cost() + 11 + j; }
+  int jtj(int i, int j) const { return PV_REDUCE_JTJ + PV_REDUCE_JTJ_AT(nj(), i, j); }
+  int jtr(int i) const { return PV_REDUCE_JTR(nj()) + i; }
+  int cost() const { return PV_REDUCE_COST(nj()); }
+  int wrr() const { return PV_REDUCE_WRR(nj()); }
+  int valid() const { return PV_REDUCE_VALID(nj()); }
+  int inlier() const { return PV_REDUCE_INLIER(nj()); }
+  int ref() const { return PV_REDUCE_REF(nj()); }
+  int rr() const { return PV_REDUCE_RR(nj()); }
+  int iref() const { return PV_REDUCE_IREF(nj()); }
+  int iref2() const { return PV_REDUCE_IREF2(nj()); }
+  int glive() const { return PV_REDUCE_GLIVE(nj()); }
+  int gref() const { return PV_REDUCE_GREF(nj()); }
+  int hvalid() const { return PV_REDUCE_HVALID(nj()); }  // valid pixels in the histogram's subsample
+  int hist(int j) const { return PV_REDUCE_HIST(nj()) + j; }
   // Upper triangle of J^T J over the inliers (|r| <= k, unweighted), row by row; i <= j.
-  int jtj_inlier(int i, int j) const { return hist(0) + hist_bins + jtj(i, j); }
-  int count() const { return stats ? hist(0) + hist_bins + nh() : cost() + 5; }
+  int jtj_inlier(int i, int j) const { return PV_REDUCE_JTJ_IN(nj(), hist_bins) + PV_REDUCE_JTJ_AT(nj(), i, j); }
+  int count() const { return stats ? PV_REDUCE_STATS_COUNT(nj(), hist_bins) : PV_REDUCE_PLAIN_COUNT(nj()); }
   // Histogram bin j counts |r| < hist_threshold(j) = 0.25 * 2^(j / 2) grey levels.
   static double hist_threshold(int j);
 };
