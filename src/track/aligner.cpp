@@ -375,6 +375,197 @@ Eigen::Matrix2d joint_orientation_information(const std::vector<ReduceSums>& sum
   return S;
 }
 
+// The prior's information per pair at a subsampled level (empty: none), formed once for the
+// level: the level before it's estimate as a Gaussian prior with its J^T W J (in this level's
+// noise units, (sigma_here / sigma_there)^2), so that the subsample adds the fine texture's
+// information to the coarser level's instead of replacing it. The prior's parameters are the
+// sums' own first n (motion, the local plane's attitudes, brightness), so its indices in the sums
+// are 0 .. n-1 (the shared tilt has no such prior).
+void Aligner::form_level_priors(const std::vector<AlignmentPair>& pairs, const Level& lv) {
+  const size_t P = pairs.size();
+  prior_H_.assign(P, MatrixL());
+  if (!(options_.subsample_prior && have_prev_ && !with_orientation_ && prev_attitudes_ == lv.att)) return;
+  for (size_t p = 0; p < P; ++p)
+    if (selection_at(pairs[p], lv.level) != nullptr && prev_sigma_[p] > 0.0) {
+      prior_H_[p] = std::pow(measured_[p] / prev_sigma_[p], 2) * sums_block(prev_sums_[p], lv.n);
+      prior_H_[p] *= prior_scale_of(cur_[p], prior_H_[p], prior_error(prev_state_[p], pairs[p], lv.att, lv.brightness),
+                                    measured_[p], options_.prior_chi2);
+    }
+}
+
+// Adds information H (cost units) on the sums' parameters `first` .. first + e.size() - 1 at the
+// state's error e from its mean.
+void Aligner::add_prior(size_t p, const PriorMatrix& H, const PriorVector& e, int first, ReduceSums* sums) const {
+  const VectorL He = H * e;
+  // For the covariance's sandwich (tracker.cpp): the prior is the Huber cost's Hessian too, and
+  // its score, H e with e's covariance sigma_there^2 A_there^-1, has the covariance sigma_here^2 H
+  // in this level's units.
+  const int nj = static_cast<int>(sums->JtWJ.rows());
+  const bool bread = sums->has_stats && sums->JtJ_inlier.rows() == nj;
+  const bool meat = sums->score_outer.rows() == nj;
+  const double s2 = measured_[p] * measured_[p];
+  const int m = static_cast<int>(e.size());
+  for (int i = 0; i < m; ++i) {
+    for (int j = 0; j < m; ++j) {
+      sums->JtWJ(first + i, first + j) += H(i, j);
+      if (bread) sums->JtJ_inlier(first + i, first + j) += H(i, j);
+      if (meat) sums->score_outer(first + i, first + j) += s2 * H(i, j);
+    }
+    sums->JtWr(first + i) += He(i);
+  }
+  sums->cost += 0.5 * e.dot(He);
+}
+
+// The attitudes' Gaussian prior (radians^-2) in this level's cost units: sigma^2 of the residuals
+// (the data's J^T W J is the Hessian of sigma^2 times the negative log-likelihood).
+PriorMatrix Aligner::attitude_prior(size_t p, const AlignmentPair& state) const {
+  return measured_[p] * measured_[p] * state.attitude_prior_information;
+}
+
+void Aligner::apply_prior(size_t p, const AlignmentPair& state, const Level& lv, ReduceSums* sums) const {
+  if (prior_H_[p].rows() > 0)
+    add_prior(p, prior_H_[p], prior_error(prev_state_[p], state, lv.att, lv.brightness), 0, sums);
+  // The coarser level's information (prior_H) holds the data only: its own attitude prior was
+  // taken out (finish_level), so that the consistency scale, which weakens prior_H when the
+  // motions disagree, does not weaken the attitudes' prior.
+  if (lv.attitude_priors) add_prior(p, attitude_prior(p, state), VectorL(attitude_error(state)), kMotionParams, sums);
+}
+
+// Each pair's first pass at the level, and the level's robust scale from its residuals. The
+// threshold in use came with the pair (a tracker's previous frame); when the scale has moved by
+// more than rescale_ratio (the robot starts moving after standing still, the exposure jumps,
+// something covers the ground), the level restarts with the new threshold: one more pass, and the
+// cost stays one function within the level. The reason and the pair when a pair cannot be aligned.
+const char* Aligner::measure_level(std::vector<AlignmentPair>& pairs, const Extrinsics& ext, const Level& lv,
+                                   int* passes, size_t* failed) {
+  for (size_t p = 0; p < pairs.size(); ++p) {
+    AlignmentPair& pair = pairs[p];
+    evaluate(pair, ext, lv.level, true, &cur_[p], lv.att);
+    ++*passes;
+    *failed = p;
+    if (!(cur_[p].valid >= options_.min_valid_fraction * reference_size(pair, lv.level))) return kAlignFewValid;
+    if (!(cur_[p].glive >= options_.min_texture_ratio * cur_[p].gref)) return kAlignNoLiveTexture;
+    measured_[p] = std::clamp(kMadToSigma * cur_[p].median_abs_residual(), options_.min_sigma, options_.max_sigma);
+    double& used = pair.sigma[lv.L];
+    if (!(measured_[p] <= used * options_.rescale_ratio && measured_[p] >= used / options_.rescale_ratio)) {
+      used = measured_[p];
+      evaluate(pair, ext, lv.level, true, &cur_[p], lv.att);
+      ++*passes;
+    }
+  }
+  return nullptr;
+}
+
+// The candidates of the solved step (cand_) and the largest pixel displacement they make.
+double Aligner::candidate_step(const std::vector<AlignmentPair>& pairs, const Extrinsics& ext,
+                               const Extrinsics& cand_ext, const Level& lv) {
+  double step_px = 0.0;
+  for (size_t p = 0; p < pairs.size(); ++p) {
+    cand_[p] = pairs[p];
+    const PyramidLevel& R = pairs[p].reference->levels[lv.L];
+    if (model_ == AlignerModel::LocalPlane) {
+      const VectorL& d = dense_step_;
+      cand_[p].motion = pairs[p].motion * SE2::exp(d.head<3>());
+      int i = kMotionParams;
+      if (lv.att) {
+        cand_[p].reference_attitude = {pairs[p].reference_attitude.roll + d(3), pairs[p].reference_attitude.pitch + d(4)};
+        cand_[p].live_attitude = {pairs[p].live_attitude.roll + d(5), pairs[p].live_attitude.pitch + d(6)};
+        i += kAttitudeParams;
+      }
+      if (lv.brightness) {
+        cand_[p].log_gain = pairs[p].log_gain + d(i);
+        cand_[p].bias = pairs[p].bias + d(i + 1);
+      }
+      auto H = [&](const AlignmentPair& a) {
+        return ground_homography(lv.Kl, on_plane(ext, a.reference_attitude), on_plane(ext, a.live_attitude),
+                                 a.motion.matrix3d());
+      };
+      step_px = std::max(step_px, max_pixel_displacement(H(pairs[p]), H(cand_[p]), R.width, R.height));
+      continue;
+    }
+    const Vector5d& d = step_.local[p];
+    cand_[p].motion = pairs[p].motion * SE2::exp(d.head<3>());
+    cand_[p].log_gain = pairs[p].log_gain + d(3);
+    cand_[p].bias = pairs[p].bias + d(4);
+    step_px = std::max(step_px, max_pixel_displacement(lv.Kl, ext, pairs[p].motion, cand_ext, cand_[p].motion,
+                                                       R.width, R.height));
+  }
+  return step_px;
+}
+
+// Levenberg-Marquardt at the level: a damped step of the joint system (or the local plane's dense
+// one), checked by a pass over every pair unless it is below the convergence threshold.
+void Aligner::iterate_level(std::vector<AlignmentPair>& pairs, Extrinsics* ext, const Level& lv, int* passes) {
+  const size_t P = pairs.size();
+  double lambda = 0.0;
+  int steps = 0;
+  const int max_steps = std::max(1, options_.max_iterations[lv.L]);
+  cand_ = pairs;
+  while (steps < max_steps) {
+    const bool solved = model_ == AlignerModel::LocalPlane
+                            ? solve_dense(cur_[0], lv.n, lambda, &dense_step_)
+                            : solve_joint(cur_, lv.brightness, with_orientation_, lambda, &step_);
+    if (!solved) {
+      if (lambda >= 1e8) break;
+      lambda = lambda == 0.0 ? options_.lambda_min : lambda * options_.lambda_up;
+      continue;
+    }
+    ++steps;
+    const Extrinsics cand_ext = with_orientation_ ? rotate_orientation(*ext, step_.orientation) : *ext;
+    const double step_px = candidate_step(pairs, *ext, cand_ext, lv);
+    if (!(step_px < 1e6)) {
+      lambda = lambda == 0.0 ? options_.lambda_min : lambda * options_.lambda_up;
+      continue;
+    }
+    // A step below the convergence threshold, or a small last one, is applied without the passes
+    // that would check it.
+    if (step_px < options_.convergence_px || (steps == max_steps && step_px < 0.5)) {
+      std::copy(cand_.begin(), cand_.end(), pairs.begin());  // elements, not buffers: callers keep references
+      *ext = cand_ext;
+      break;
+    }
+    bool valid = true;
+    for (size_t p = 0; p < P; ++p) {
+      evaluate(cand_[p], cand_ext, lv.level, false, &next_[p], lv.att);
+      apply_prior(p, cand_[p], lv, &next_[p]);
+      ++*passes;
+      valid = valid && next_[p].valid >= options_.min_valid_fraction * reference_size(pairs[p], lv.level);
+    }
+    if (valid && mean_cost(next_) <= mean_cost(cur_)) {
+      std::copy(cand_.begin(), cand_.end(), pairs.begin());  // elements, not buffers: callers keep references
+      *ext = cand_ext;
+      cur_.swap(next_);
+      lambda = lambda / options_.lambda_down < options_.lambda_min ? 0.0 : lambda / options_.lambda_down;
+    } else {
+      lambda = lambda == 0.0 ? options_.lambda_min : lambda * options_.lambda_up;
+    }
+  }
+}
+
+// What the next level and the report keep of this one.
+void Aligner::finish_level(std::vector<AlignmentPair>& pairs, const Level& lv, bool finest, AlignmentReport& report) {
+  const size_t P = pairs.size();
+  if (finest) {
+    report.finest_huber_k.resize(P);
+    for (size_t p = 0; p < P; ++p) report.finest_huber_k[p] = options_.huber_factor * pairs[p].sigma[lv.L];
+  }
+  for (size_t p = 0; p < P; ++p) pairs[p].sigma[lv.L] = measured_[p];
+  if (lv.att) {
+    report.attitude_level = lv.level;
+    report.attitude_sums = cur_[0];
+  }
+  if (finest) report.finest_nparam = lv.att ? kMotionParams + kAttitudeParams : nparam_;
+  prev_attitudes_ = lv.att;
+  prev_sums_ = cur_;
+  if (lv.attitude_priors)
+    for (size_t p = 0; p < P; ++p)
+      prev_sums_[p].JtWJ.block(kMotionParams, kMotionParams, kAttitudeParams, kAttitudeParams) -=
+          attitude_prior(p, pairs[p]);
+  prev_state_ = pairs;
+  prev_sigma_ = measured_;
+  have_prev_ = true;
+}
+
 AlignmentReport Aligner::align(std::vector<AlignmentPair>& pairs, Extrinsics* extrinsics,
                                const AlignmentLevels& levels) {
   AlignmentReport report;
@@ -382,8 +573,7 @@ AlignmentReport Aligner::align(std::vector<AlignmentPair>& pairs, Extrinsics* ex
   cur_.resize(P);
   next_.resize(P);
   report.finest_sigma.assign(P, 0.0);
-  std::vector<double>& measured = measured_;
-  measured.assign(P, 0.0);
+  measured_.assign(P, 0.0);
   Extrinsics ext = *extrinsics;
   const bool local_plane = model_ == AlignerModel::LocalPlane;
   if (local_plane && P != 1) throw_invalid_argument("Aligner: the local plane aligns one image pair");
@@ -401,185 +591,28 @@ AlignmentReport Aligner::align(std::vector<AlignmentPair>& pairs, Extrinsics* ex
 
   for (int level = levels.coarsest; level >= levels.finest; --level) {
     ++report.levels_used;
+    Level lv;
+    lv.level = level;
+    lv.L = static_cast<size_t>(level);
     // This level estimates the local plane's attitudes (the seven-parameter pass), or holds them.
-    const bool att = local_plane && attitude_level(pairs[0], level, levels);
+    lv.att = local_plane && attitude_level(pairs[0], level, levels);
+    lv.brightness = options_.estimate_brightness;
+    lv.n = (lv.att ? kMotionParams + kAttitudeParams : nparam_) + (lv.brightness ? 2 : 0);
+    lv.attitude_priors = lv.att && !pairs[0].attitude_prior_information.isZero();
+    lv.Kl = level_camera_matrix(K_, level);
     const auto level_start = std::chrono::steady_clock::now();
-    const auto L = static_cast<size_t>(level);
-    const Eigen::Matrix3d Kl = level_camera_matrix(K_, level);
-    int& passes = report.passes[L];
-    for (size_t p = 0; p < P; ++p) {
-      AlignmentPair& pair = pairs[p];
-      evaluate(pair, ext, level, true, &cur_[p], att);
-      ++passes;
-      if (!(cur_[p].valid >= options_.min_valid_fraction * reference_size(pair, level))) return fail(kAlignFewValid, p);
-      if (!(cur_[p].glive >= options_.min_texture_ratio * cur_[p].gref)) return fail(kAlignNoLiveTexture, p);
-      // The level's robust scale from this pass's residuals. The threshold in use came with the
-      // pair (a tracker's previous frame); when the scale has moved by more than rescale_ratio
-      // (the robot starts moving after standing still, the exposure jumps, something covers the
-      // ground), the level restarts with the new threshold: one more pass, and the cost stays
-      // one function within the level.
-      measured[p] = std::clamp(kMadToSigma * cur_[p].median_abs_residual(), options_.min_sigma, options_.max_sigma);
-      double& used = pair.sigma[L];
-      if (!(measured[p] <= used * options_.rescale_ratio && measured[p] >= used / options_.rescale_ratio)) {
-        used = measured[p];
-        evaluate(pair, ext, level, true, &cur_[p], att);
-        ++passes;
-      }
-    }
-    if (level == levels.finest) report.finest_sigma = measured;
+    int& passes = report.passes[lv.L];
+    size_t failed = 0;
+    if (const char* why = measure_level(pairs, ext, lv, &passes, &failed)) return fail(why, failed);
+    if (level == levels.finest) report.finest_sigma = measured_;
     if (level == std::max(levels.finest, std::min(1, levels.coarsest))) report.match_stats = cur_;
-    // A subsampled level is solved together with what the level before it found: that level's
-    // estimate as a Gaussian prior with its J^T W J (in this level's noise units, (sigma_here /
-    // sigma_there)^2), so that the subsample adds the fine texture's information to the coarser
-    // level's instead of replacing it.
-    // The prior's information per pair (empty: none), formed once for the level.
-    // The prior's parameters are the sums' own first n (motion, the local plane's attitudes,
-    // brightness), so its indices in the sums are 0 .. n-1 (the shared tilt has no such prior).
-    const bool brightness = options_.estimate_brightness;
-    const int n = (att ? kMotionParams + kAttitudeParams : nparam_) + (brightness ? 2 : 0);
-    std::vector<MatrixL>& prior_H = prior_H_;
-    prior_H.assign(P, MatrixL());
-    if (options_.subsample_prior && have_prev_ && !with_orientation_ && prev_attitudes_ == att)
-      for (size_t p = 0; p < P; ++p)
-        if (selection_at(pairs[p], level) != nullptr && prev_sigma_[p] > 0.0) {
-          prior_H[p] = std::pow(measured[p] / prev_sigma_[p], 2) * sums_block(prev_sums_[p], n);
-          prior_H[p] *= prior_scale_of(cur_[p], prior_H[p], prior_error(prev_state_[p], pairs[p], att, brightness),
-                                       measured[p], options_.prior_chi2);
-        }
-    // Adds information H (cost units) on the sums' parameters `first` .. first + e.size() - 1 at
-    // the state's error e from its mean.
-    auto add_prior = [&](size_t p, const MatrixL& H, const VectorL& e, int first, ReduceSums* sums) {
-      const VectorL He = H * e;
-      // For the covariance's sandwich (tracker.cpp): the prior is the Huber cost's Hessian too,
-      // and its score, H e with e's covariance sigma_there^2 A_there^-1, has the covariance
-      // sigma_here^2 H in this level's units.
-      const int nj = static_cast<int>(sums->JtWJ.rows());
-      const bool bread = sums->has_stats && sums->JtJ_inlier.rows() == nj;
-      const bool meat = sums->score_outer.rows() == nj;
-      const double s2 = measured[p] * measured[p];
-      const int m = static_cast<int>(e.size());
-      for (int i = 0; i < m; ++i) {
-        for (int j = 0; j < m; ++j) {
-          sums->JtWJ(first + i, first + j) += H(i, j);
-          if (bread) sums->JtJ_inlier(first + i, first + j) += H(i, j);
-          if (meat) sums->score_outer(first + i, first + j) += s2 * H(i, j);
-        }
-        sums->JtWr(first + i) += He(i);
-      }
-      sums->cost += 0.5 * e.dot(He);
-    };
-    // The attitudes' Gaussian prior (radians^-2) in this level's cost units: sigma^2 of the
-    // residuals (the data's J^T W J is the Hessian of sigma^2 times the negative log-likelihood).
-    auto attitude_prior = [&](size_t p, const AlignmentPair& state) -> MatrixL {
-      return measured[p] * measured[p] * state.attitude_prior_information;
-    };
-    const bool attitude_priors = att && !pairs[0].attitude_prior_information.isZero();
-    auto apply_prior = [&](size_t p, const AlignmentPair& state, ReduceSums* sums) {
-      if (prior_H[p].rows() > 0)
-        add_prior(p, prior_H[p], prior_error(prev_state_[p], state, att, brightness), 0, sums);
-      // The coarser level's information (prior_H) holds the data only: its own attitude prior
-      // was taken out (below), so that the consistency scale, which weakens prior_H when the
-      // motions disagree, does not weaken the attitudes' prior.
-      if (attitude_priors) add_prior(p, attitude_prior(p, state), VectorL(attitude_error(state)), kMotionParams, sums);
-    };
-    for (size_t p = 0; p < P; ++p) apply_prior(p, pairs[p], &cur_[p]);
+    form_level_priors(pairs, lv);
+    for (size_t p = 0; p < P; ++p) apply_prior(p, pairs[p], lv, &cur_[p]);
     if (level == levels.finest) report.finest_stats = cur_;  // with the prior (if any), for the covariance
-    if (att) report.attitude_stats = cur_[0];
-
-    double lambda = 0.0;
-    int steps = 0;
-    const int max_steps = std::max(1, options_.max_iterations[L]);
-    JointStep& step = step_;
-    std::vector<AlignmentPair>& cand = cand_;
-    cand = pairs;
-    while (steps < max_steps) {
-      const bool solved = local_plane ? solve_dense(cur_[0], n, lambda, &dense_step_)
-                                      : solve_joint(cur_, brightness, with_orientation_, lambda, &step);
-      if (!solved) {
-        if (lambda >= 1e8) break;
-        lambda = lambda == 0.0 ? options_.lambda_min : lambda * options_.lambda_up;
-        continue;
-      }
-      ++steps;
-      const Extrinsics cand_ext = with_orientation_ ? rotate_orientation(ext, step.orientation) : ext;
-      double step_px = 0.0;
-      for (size_t p = 0; p < P; ++p) {
-        cand[p] = pairs[p];
-        const PyramidLevel& R = pairs[p].reference->levels[L];
-        if (local_plane) {
-          const VectorL& d = dense_step_;
-          cand[p].motion = pairs[p].motion * SE2::exp(d.head<3>());
-          int i = kMotionParams;
-          if (att) {
-            cand[p].reference_attitude = {pairs[p].reference_attitude.roll + d(3), pairs[p].reference_attitude.pitch + d(4)};
-            cand[p].live_attitude = {pairs[p].live_attitude.roll + d(5), pairs[p].live_attitude.pitch + d(6)};
-            i += kAttitudeParams;
-          }
-          if (brightness) {
-            cand[p].log_gain = pairs[p].log_gain + d(i);
-            cand[p].bias = pairs[p].bias + d(i + 1);
-          }
-          auto H = [&](const AlignmentPair& a) {
-            return ground_homography(Kl, on_plane(ext, a.reference_attitude), on_plane(ext, a.live_attitude),
-                                     a.motion.matrix3d());
-          };
-          step_px = std::max(step_px, max_pixel_displacement(H(pairs[p]), H(cand[p]), R.width, R.height));
-          continue;
-        }
-        const Vector5d& d = step.local[p];
-        cand[p].motion = pairs[p].motion * SE2::exp(d.head<3>());
-        cand[p].log_gain = pairs[p].log_gain + d(3);
-        cand[p].bias = pairs[p].bias + d(4);
-        step_px = std::max(step_px, max_pixel_displacement(Kl, ext, pairs[p].motion, cand_ext, cand[p].motion,
-                                                           R.width, R.height));
-      }
-      if (!(step_px < 1e6)) {
-        lambda = lambda == 0.0 ? options_.lambda_min : lambda * options_.lambda_up;
-        continue;
-      }
-      // A step below the convergence threshold, or a small last one, is applied without the
-      // passes that would check it.
-      if (step_px < options_.convergence_px || (steps == max_steps && step_px < 0.5)) {
-        std::copy(cand.begin(), cand.end(), pairs.begin());  // elements, not buffers: callers keep references
-        ext = cand_ext;
-        break;
-      }
-      bool valid = true;
-      for (size_t p = 0; p < P; ++p) {
-        evaluate(cand[p], cand_ext, level, false, &next_[p], att);
-        apply_prior(p, cand[p], &next_[p]);
-        ++passes;
-        valid = valid && next_[p].valid >= options_.min_valid_fraction * reference_size(pairs[p], level);
-      }
-      if (valid && mean_cost(next_) <= mean_cost(cur_)) {
-        std::copy(cand.begin(), cand.end(), pairs.begin());  // elements, not buffers: callers keep references
-        ext = cand_ext;
-        cur_.swap(next_);
-        lambda = lambda / options_.lambda_down < options_.lambda_min ? 0.0 : lambda / options_.lambda_down;
-      } else {
-        lambda = lambda == 0.0 ? options_.lambda_min : lambda * options_.lambda_up;
-      }
-    }
-    if (level == levels.finest) {
-      report.finest_huber_k.resize(P);
-      for (size_t p = 0; p < P; ++p) report.finest_huber_k[p] = options_.huber_factor * pairs[p].sigma[L];
-    }
-    for (size_t p = 0; p < P; ++p) pairs[p].sigma[L] = measured[p];
-    if (att) {
-      report.attitude_level = level;
-      report.attitude_sums = cur_[0];
-    }
-    if (level == levels.finest) report.finest_nparam = att ? kMotionParams + kAttitudeParams : nparam_;
-    prev_attitudes_ = att;
-    prev_sums_ = cur_;
-    if (attitude_priors)
-      for (size_t p = 0; p < P; ++p)
-        prev_sums_[p].JtWJ.block(kMotionParams, kMotionParams, kAttitudeParams, kAttitudeParams) -=
-            attitude_prior(p, pairs[p]);
-    prev_state_ = pairs;
-    prev_sigma_ = measured;
-    have_prev_ = true;
-    report.level_ms[L] =
+    if (lv.att) report.attitude_stats = cur_[0];
+    iterate_level(pairs, &ext, lv, &passes);
+    finish_level(pairs, lv, level == levels.finest, report);
+    report.level_ms[lv.L] =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - level_start).count();
     for (size_t p = 0; p < P; ++p)
       if (!finite(pairs[p].motion) || !std::isfinite(pairs[p].log_gain) || !std::isfinite(pairs[p].bias) ||

@@ -248,6 +248,27 @@ class Aligner {
  private:
   void evaluate(const AlignmentPair& pair, const Extrinsics& e, int level, bool stats, ReduceSums* out,
                 bool attitudes = false);
+  // align()'s steps, level by level (aligner.cpp): what a level is, its first passes and robust
+  // scale, the subsample's prior, the damped iterations, and what the next level keeps.
+  struct Level {
+    int level = 0;
+    size_t L = 0;
+    bool att = false;         // the local plane's attitudes are estimated at this level
+    bool brightness = false;  // gain and bias are estimated
+    int n = 0;                // the prior's parameters: the sums' first n
+    bool attitude_priors = false;
+    Eigen::Matrix3d Kl;       // the level's camera matrix
+  };
+  const char* measure_level(std::vector<AlignmentPair>& pairs, const Extrinsics& ext, const Level& lv, int* passes,
+                            size_t* failed);
+  void form_level_priors(const std::vector<AlignmentPair>& pairs, const Level& lv);
+  void add_prior(size_t p, const PriorMatrix& H, const PriorVector& e, int first, ReduceSums* sums) const;
+  PriorMatrix attitude_prior(size_t p, const AlignmentPair& state) const;
+  void apply_prior(size_t p, const AlignmentPair& state, const Level& lv, ReduceSums* sums) const;
+  double candidate_step(const std::vector<AlignmentPair>& pairs, const Extrinsics& ext, const Extrinsics& cand_ext,
+                        const Level& lv);
+  void iterate_level(std::vector<AlignmentPair>& pairs, Extrinsics* ext, const Level& lv, int* passes);
+  void finish_level(std::vector<AlignmentPair>& pairs, const Level& lv, bool finest, AlignmentReport& report);
   // AlignerModel::LocalPlane: whether `level` estimates the attitudes (attitude_max_width).
   bool attitude_level(const AlignmentPair& pair, int level, const AlignmentLevels& levels) const;
   // The reference's size at `level` as the pass sees it: the level's pixels, or its selection's grid.
