@@ -750,6 +750,199 @@ struct Tracker::Impl {
     return true;
   }
 
+  // track()'s steps. The frame's time: the interval, a gap or a bad stamp, and the
+  // constant-velocity prediction.
+  struct FrameTiming {
+    std::chrono::steady_clock::time_point start;
+    double dt = 0.0;
+    const char* problem = nullptr;  // kBadTime, kTimeGap or none
+    bool predict = false;
+    SE2 predicted;
+  };
+
+  // A timestamp that is not finite or not after the last one is not used (the usual interval is
+  // assumed).
+  FrameTiming advance_time(double t) {
+    FrameTiming ft;
+    if (has_t) {
+      ft.dt = std::isfinite(t) ? t - last_t : HUGE_VAL;
+      if (!(ft.dt > 0.0) || !std::isfinite(ft.dt)) {
+        ft.problem = kBadTime;
+        ft.dt = nominal_dt;
+      } else if (nominal_dt > 0.0 && ft.dt > opt.max_gap_factor * nominal_dt) {
+        ft.problem = kTimeGap;
+      } else {
+        nominal_dt = nominal_dt > 0.0 ? 0.9 * nominal_dt + 0.1 * ft.dt : ft.dt;
+      }
+    }
+    if (std::isfinite(t) && (!has_t || t > last_t)) {
+      last_t = t;
+      has_t = true;
+    }
+    since_good += ft.dt;
+    ft.predict = ft.dt > 0.0 && since_good <= opt.max_gap_seconds;
+    ft.predicted = ft.predict ? SE2::exp(velocity * ft.dt) : SE2();
+    return ft;
+  }
+
+  static FrameResult finished(FrameResult& r, const FrameTiming& ft) {
+    r.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - ft.start).count();
+    return r;
+  }
+
+  // A Lost frame. can_be_keyframe: it could replace the keyframe (its own texture allows). It does
+  // only when the frame before it failed too, the prediction has lapsed (a gap), or the light
+  // fixed to the camera held it: a single bad frame (a patch, a dropped half, a flash) must not
+  // become the reference of the good frames after it. Until then the next frame is aligned with
+  // the old keyframe.
+  FrameResult lose(FrameResult& res, const Pyramid& live, const char* why, bool can_be_keyframe, const FrameTiming& ft) {
+    res.status = Status::Lost;
+    res.reason = why;
+    res.motion.value = ft.predicted;
+    res.motion.covariance = res.alignment_covariance = lost_covariance();
+    if (opt.local_plane) {
+      res.attitude = prev.att_live;
+      res.attitude_covariance = plane.prior_covariance();
+    }
+    pose = pose * ft.predicted;
+    ++lost_in_a_row;
+    // A frame misaligned by the light fixed to the camera is not a bad frame: the keyframe and
+    // the light's model are what failed, and a new keyframe takes a new model into use.
+    if (can_be_keyframe && (lost_in_a_row >= 2 || !ft.predict || why == kMisaligned)) {
+      if (opt.local_plane) plane.take_keyframe(prev.att_live, plane.prior_covariance());
+      make_keyframe(live);
+      keyframe_twist_measured = false;
+      res.keyframe = true;
+    } else {
+      // The next motion is from this predicted pose: as uncertain as this one.
+      prev.T = prev.T * ft.predicted;
+      prev_covariance = lost_covariance();
+      prev_predicted = true;
+    }
+    if (since_good > opt.max_gap_seconds) {
+      velocity.setZero();
+      readout_twist.reset();
+    }
+    return finished(res, ft);
+  }
+
+  // The first frame with texture of its own becomes the keyframe.
+  FrameResult start(FrameResult& res, const Pyramid& live, const FrameTiming& ft) {
+    missing = nullptr;  // nothing to align with: not a failure of this frame's alignment
+    if (!has_own_texture(live)) {
+      res.status = Status::Lost;
+      res.reason = kNoTexture;
+      return finished(res, ft);
+    }
+    make_keyframe(live);
+    keyframe_twist_measured = false;
+    lost_in_a_row = 0;
+    res.status = Status::First;
+    if (opt.local_plane) {
+      res.attitude = plane.keyframe();
+      res.attitude_covariance = plane.keyframe_covariance();
+    }
+    res.keyframe = true;
+    since_good = 0.0;
+    return finished(res, ft);
+  }
+
+  // Align with the keyframe from the prediction; if that fails on the residual, once more from
+  // the previous frame's pose (the prediction may be what failed, e.g. after a gap); still lost, a
+  // search for the motion around the previous frame's pose (no prior may hold); held by the light
+  // fixed to the camera, once more with the photometric model made now.
+  bool align_with_retries(const Pyramid& live, const FrameTiming& ft, FrameResult* res, Estimate* est,
+                          const char** reason) {
+    Estimate init = prev;
+    init.T = prev.T * ft.predicted;
+    bool ok = align(live, init, est, res, reason);
+    if (ok) finish(res, *est, live);
+    if ((!ok || res->status == Status::Lost) && *reason != kAlignNoLiveTexture &&
+        !(ft.predicted.x == 0 && ft.predicted.y == 0 && ft.predicted.theta == 0)) {
+      FrameResult retry;
+      Estimate est2;
+      if (align_again(live, prev, *res, &retry, &est2) && retry.status != Status::Lost) {
+        *res = retry;
+        *est = est2;
+        ok = true;
+      }
+    }
+    if ((!ok || res->status == Status::Lost) && *reason != kAlignNoLiveTexture && opt.search_motion) {
+      FrameResult found;
+      Estimate est4;
+      if (search_again(live, *res, &found, &est4)) {
+        *res = found;
+        *est = est4;
+        ok = true;
+      }
+    }
+    if (ok && res->status == Status::Lost && res->reason == kMisaligned && correct_again(live)) {
+      FrameResult again;
+      Estimate est3;
+      if (align_again(live, init, *res, &again, &est3)) {
+        *res = again;
+        *est = est3;
+      }
+    }
+    return ok;
+  }
+
+  // An Ok frame is Degraded when its time was bad or a gap, its shutter unknown, or the frame
+  // before it was lost (its pose is right, but the motion from that frame carries that frame's
+  // prediction error; the two motions together are right).
+  void grade(FrameResult* res, const char* time_problem) {
+    if (time_problem && res->status == Status::Ok) {
+      res->status = Status::Degraded;
+      res->reason = time_problem;
+    }
+    if ((shutter_unknown || keyframe_shear_assumed) && res->status == Status::Ok) {
+      res->status = Status::Degraded;
+      res->reason = kShutterUnknown;
+    }
+    if (prev_predicted && res->status == Status::Ok) {
+      res->status = Status::Degraded;
+      res->reason = kAfterLost;
+    }
+    prev_predicted = false;
+  }
+
+  // The frame-to-frame motion from the keyframe-relative estimates, its covariance and tilt
+  // Jacobian, the pose and velocity; a new keyframe when the overlap or the scale asks.
+  void commit(FrameResult* res, Estimate& est, const Pyramid& live, double t, double dt) {
+    // With prev.T = P exp(xi_p) and est.T = E exp(xi_e), the motion is m exp(xi_e - Ad(m^-1) xi_p);
+    // prev_covariance already holds xi_p's covariance less the part shared with xi_e.
+    res->motion.value = prev.T.inverse() * est.T;
+    const Eigen::Matrix3d ad = res->motion.value.inverse().adjoint();
+    res->motion.covariance = res->alignment_covariance + ad * prev_covariance * ad.transpose();
+    // Its tilt Jacobian the same way: xi_e's and Ad(m^-1) xi_p's (before a new keyframe).
+    Eigen::Matrix<double, 3, 2> tilt = Eigen::Matrix<double, 3, 2>::Zero();
+    if (opt.tilt_jacobian) {
+      if (!tilt_jacobian) tilt_jacobian = std::make_unique<TiltJacobian>(rt, opt.kernel);
+      tilt = (*tilt_jacobian)(keyframe, live, camera.K(), ext, est.T, est.a, est.b, est.huber_k, opt.estimate_brightness);
+      res->motion_tilt_jacobian = tilt - ad * prev_tilt;
+    }
+    if (!res->motion.covariance.allFinite()) res->motion.covariance = lost_covariance();
+    pose = pose * res->motion.value;
+    if (dt > 0.0) velocity = res->motion.value.log() / dt;
+    if (has_live_c) readout_twist.commit(live_c, live_tc);
+    watch_mounting(t, dt, res, &est);
+    since_good = 0.0;
+    lost_in_a_row = 0;
+    if (res->overlap < opt.keyframe_overlap ||
+        log_scale_change(camera.K(), ext, est.T, camera.region()) > opt.keyframe_scale_change) {
+      if (opt.local_plane) plane.take_keyframe(est.att_live, res->attitude_covariance);
+      make_keyframe(live);
+      keyframe_twist_measured = true;
+      // Frames aligned with it carry its own shutter offset, which the motions from it must not.
+      prev.T = SE2::exp(live_offset);
+      res->keyframe = true;
+    } else {
+      prev = est;
+      prev_tilt = tilt;
+      prev_covariance = (1.0 - 2.0 * opt.consecutive_alignment_correlation) * res->alignment_covariance;
+    }
+  }
+
   FrameResult track(const Pyramid& live, double t) {
     const auto t0 = std::chrono::steady_clock::now();
     has_live_c = false;
@@ -766,190 +959,29 @@ struct Tracker::Impl {
     last_odometry = next_odometry;
     next_odometry.reset();
     shutter_unknown = false;
-
-    // Time: the interval, gaps, and the constant-velocity prediction. A timestamp that is not
-    // finite or not after the last one is not used (the usual interval is assumed).
-    double dt = 0.0;
-    const char* time_problem = nullptr;
-    if (has_t) {
-      dt = std::isfinite(t) ? t - last_t : HUGE_VAL;
-      if (!(dt > 0.0) || !std::isfinite(dt)) {
-        time_problem = kBadTime;
-        dt = nominal_dt;
-      } else if (nominal_dt > 0.0 && dt > opt.max_gap_factor * nominal_dt) {
-        time_problem = kTimeGap;
-      } else {
-        nominal_dt = nominal_dt > 0.0 ? 0.9 * nominal_dt + 0.1 * dt : dt;
-      }
-    }
-    if (std::isfinite(t) && (!has_t || t > last_t)) {
-      last_t = t;
-      has_t = true;
-    }
-    since_good += dt;
-    const bool predict = dt > 0.0 && since_good <= opt.max_gap_seconds;
-    const SE2 predicted = predict ? SE2::exp(velocity * dt) : SE2();
-
-    auto done = [&](FrameResult& r) -> FrameResult {
-      r.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-      return r;
-    };
-    // A Lost frame. can_be_keyframe: it could replace the keyframe (its own texture allows). It
-    // does only when the frame before it failed too, the prediction has lapsed (a gap), or the
-    // light fixed to the camera held it: a single bad frame (a patch, a dropped half, a flash)
-    // must not become the reference of the good frames after it. Until then the next frame is
-    // aligned with the old keyframe.
-    auto lost = [&](const char* why, bool can_be_keyframe) -> FrameResult {
-      res.status = Status::Lost;
-      res.reason = why;
-      res.motion.value = predicted;
-      res.motion.covariance = res.alignment_covariance = lost_covariance();
-      if (opt.local_plane) {
-        res.attitude = prev.att_live;
-        res.attitude_covariance = plane.prior_covariance();
-      }
-      pose = pose * predicted;
-      ++lost_in_a_row;
-      // A frame misaligned by the light fixed to the camera is not a bad frame: the keyframe and
-      // the light's model are what failed, and a new keyframe takes a new model into use.
-      if (can_be_keyframe && (lost_in_a_row >= 2 || !predict || why == kMisaligned)) {
-        if (opt.local_plane) plane.take_keyframe(prev.att_live, plane.prior_covariance());
-        make_keyframe(live);
-        keyframe_twist_measured = false;
-        res.keyframe = true;
-      } else {
-        // The next motion is from this predicted pose: as uncertain as this one.
-        prev.T = prev.T * predicted;
-        prev_covariance = lost_covariance();
-        prev_predicted = true;
-      }
-      if (since_good > opt.max_gap_seconds) {
-        velocity.setZero();
-        readout_twist.reset();
-      }
-      return done(res);
-    };
+    FrameTiming ft = advance_time(t);
+    ft.start = t0;
 
     if (!right_size(live)) {
       missing = kWrongSize;
-      return lost(kWrongSize, false);
+      return lose(res, live, kWrongSize, false, ft);
     }
+    if (!has_keyframe) return start(res, live, ft);
 
-    if (!has_keyframe) {
-      missing = nullptr;  // nothing to align with: not a failure of this frame's alignment
-      // The frame's own texture decides whether it can be the keyframe.
-      if (!has_own_texture(live)) {
-        res.status = Status::Lost;
-        res.reason = kNoTexture;
-        return done(res);
-      }
-      make_keyframe(live);
-      keyframe_twist_measured = false;
-      lost_in_a_row = 0;
-      res.status = Status::First;
-      if (opt.local_plane) {
-        res.attitude = plane.keyframe();
-        res.attitude_covariance = plane.keyframe_covariance();
-      }
-      res.keyframe = true;
-      since_good = 0.0;
-      return done(res);
-    }
-
-    // Align with the keyframe from the prediction; if that fails on the residual, once more
-    // from the previous frame's pose (the prediction may be what failed, e.g. after a gap).
-    Estimate init = prev;
-    init.T = prev.T * predicted;
     Estimate est;
     const char* reason = "";
-    bool ok = align(live, init, &est, &res, &reason);
-    if (ok) finish(&res, est, live);
-    if ((!ok || res.status == Status::Lost) && reason != kAlignNoLiveTexture &&
-        !(predicted.x == 0 && predicted.y == 0 && predicted.theta == 0)) {
-      FrameResult retry;
-      Estimate est2;
-      if (align_again(live, prev, res, &retry, &est2) && retry.status != Status::Lost) {
-        res = retry;
-        est = est2;
-        ok = true;
-      }
-    }
-    // Still lost: search for the motion around the previous frame's pose (no prior may hold).
-    if ((!ok || res.status == Status::Lost) && reason != kAlignNoLiveTexture && opt.search_motion) {
-      FrameResult found;
-      Estimate est4;
-      if (search_again(live, res, &found, &est4)) {
-        res = found;
-        est = est4;
-        ok = true;
-      }
-    }
-    // Held by the light fixed to the camera: once more with the photometric model made now.
-    if (ok && res.status == Status::Lost && res.reason == kMisaligned && correct_again(live)) {
-      FrameResult again;
-      Estimate est3;
-      if (align_again(live, init, res, &again, &est3)) {
-        res = again;
-        est = est3;
-      }
-    }
-    const SE2 shutter_offset = ok && res.status != Status::Lost ? take_out_shutter(live, t, dt, &res, &est) : SE2();
+    const bool ok = align_with_retries(live, ft, &res, &est, &reason);
+    const SE2 shutter_offset = ok && res.status != Status::Lost ? take_out_shutter(live, t, ft.dt, &res, &est) : SE2();
     if (ok) remember(live, est);  // before a new keyframe replaces the one aligned with
     else missing = reason;
     est.T = est.T * shutter_offset;
     // "No texture in the live frame" compares it with the keyframe: a frame with texture of its
     // own may still replace a keyframe whose texture the frames after it no longer show.
-    if (!ok) return lost(reason, reason != kAlignNoLiveTexture || has_own_texture(live));
-    if (res.status == Status::Lost) return lost(res.reason, true);
-    if (time_problem && res.status == Status::Ok) {
-      res.status = Status::Degraded;
-      res.reason = time_problem;
-    }
-    if ((shutter_unknown || keyframe_shear_assumed) && res.status == Status::Ok) {
-      res.status = Status::Degraded;
-      res.reason = kShutterUnknown;
-    }
-    // Its pose is right, but the motion from the frame before carries that frame's prediction
-    // error (the two motions together are right).
-    if (prev_predicted && res.status == Status::Ok) {
-      res.status = Status::Degraded;
-      res.reason = kAfterLost;
-    }
-    prev_predicted = false;
-
-    // Frame-to-frame motion from the keyframe-relative estimates, and its covariance: with
-    // prev.T = P exp(xi_p) and est.T = E exp(xi_e), the motion is m exp(xi_e - Ad(m^-1) xi_p);
-    // prev_covariance already holds xi_p's covariance less the part shared with xi_e.
-    res.motion.value = prev.T.inverse() * est.T;
-    const Eigen::Matrix3d ad = res.motion.value.inverse().adjoint();
-    res.motion.covariance = res.alignment_covariance + ad * prev_covariance * ad.transpose();
-    // Its tilt Jacobian the same way: xi_e's and Ad(m^-1) xi_p's (before a new keyframe).
-    Eigen::Matrix<double, 3, 2> tilt = Eigen::Matrix<double, 3, 2>::Zero();
-    if (opt.tilt_jacobian) {
-      if (!tilt_jacobian) tilt_jacobian = std::make_unique<TiltJacobian>(rt, opt.kernel);
-      tilt = (*tilt_jacobian)(keyframe, live, camera.K(), ext, est.T, est.a, est.b, est.huber_k, opt.estimate_brightness);
-      res.motion_tilt_jacobian = tilt - ad * prev_tilt;
-    }
-    if (!res.motion.covariance.allFinite()) res.motion.covariance = lost_covariance();
-    pose = pose * res.motion.value;
-    if (dt > 0.0) velocity = res.motion.value.log() / dt;
-    if (has_live_c) readout_twist.commit(live_c, live_tc);
-    watch_mounting(t, dt, &res, &est);
-    since_good = 0.0;
-    lost_in_a_row = 0;
-    if (res.overlap < opt.keyframe_overlap || log_scale_change(camera.K(), ext, est.T, camera.region()) > opt.keyframe_scale_change) {
-      if (opt.local_plane) plane.take_keyframe(est.att_live, res.attitude_covariance);
-      make_keyframe(live);
-      keyframe_twist_measured = true;
-      // Frames aligned with it carry its own shutter offset, which the motions from it must not.
-      prev.T = SE2::exp(live_offset);
-      res.keyframe = true;
-    } else {
-      prev = est;
-      prev_tilt = tilt;
-      prev_covariance = (1.0 - 2.0 * opt.consecutive_alignment_correlation) * res.alignment_covariance;
-    }
-    return done(res);
+    if (!ok) return lose(res, live, reason, reason != kAlignNoLiveTexture || has_own_texture(live), ft);
+    if (res.status == Status::Lost) return lose(res, live, res.reason, true, ft);
+    grade(&res, ft.problem);
+    commit(&res, est, live, t, ft.dt);
+    return finished(res, ft);
   }
 };
 
