@@ -397,12 +397,8 @@ struct RollPitchEstimator::Impl {
     return run;
   }
 
-  RollPitchResult estimate() {
-    RollPitchResult res;
-    res.frames_used = frames;
-    res.keyframes = static_cast<int>(keyframes.size());
-    res.keyframe_frames = keyframe_frames;
-    res.track_ms = track_ms;
+  // Refuses, with the reason, a map too small or a camera that moved too little. False then.
+  bool enough_motion(RollPitchResult& res) const {
     const int K = res.keyframes;
     if (K < opt.min_keyframes) {
       if (untextured * 2 > frames || K == 0) {
@@ -416,52 +412,47 @@ struct RollPitchEstimator::Impl {
                      " needed): drive over the ground (forwards, backwards or along an arc) while these frames are "
                      "taken, or give more frames";
       }
-      return res;
+      return false;
     }
     for (const SE2& m : motions) res.motion += std::hypot(m.x, m.y) + std::abs(m.theta);
     if (res.motion < opt.min_motion) {
       res.status = RollPitchResult::Status::TooLittleMotion;
       res.reason = "the camera moved " + std::to_string(res.motion) + " (camera heights plus radians) over the map, " +
                    std::to_string(opt.min_motion) + " needed: drive or turn while these frames are taken";
-      return res;
+      return false;
     }
+    return true;
+  }
 
-    const auto t0 = Clock::now();
-    final_light();
-    const AlignmentLevels levels = aligner.levels(keyframes.front(), keyframes.back());
-    Run best = start(opt.initial_roll, opt.initial_pitch);
-    rounds(&best, levels, opt.max_rounds);
-    drop_unaligned(&best, levels);
-    res.rounds = best.rounds;
-    res.passes = best.passes;
-    if (opt.search && (!best.report.ok || best.ratio > opt.search_residual_ratio)) {
-      // A coarse search over the two angles: each start aligned at the coarse levels only (one
-      // round), the best by its residual taken down to full resolution.
-      AlignmentLevels coarse = levels;
-      coarse.finest = std::max(levels.finest, levels.coarsest - 1);
-      const int n = static_cast<int>(std::floor(opt.search_range / opt.search_step + 1e-9));
-      Run found;
-      for (int i = -n; i <= n; ++i)
-        for (int j = -n; j <= n; ++j) {
-          Run r = start(opt.initial_roll + i * opt.search_step, opt.initial_pitch + j * opt.search_step);
-          rounds(&r, coarse, 1);
-          res.rounds += r.rounds;
-          res.passes += r.passes;
-          if (r.report.ok && (!found.report.ok || r.ratio < found.ratio)) found = std::move(r);
-        }
-      if (found.report.ok) {
-        rounds(&found, levels, opt.max_rounds);
-        drop_unaligned(&found, levels);
-        res.rounds += found.rounds;
-        res.passes += found.passes;
-        if (found.report.ok && (!best.report.ok || found.ratio < best.ratio)) best = std::move(found);
+  // A coarse search over the two angles: each start aligned at the coarse levels only (one
+  // round), the best by its residual taken down to full resolution; it replaces `best` when it
+  // aligns better.
+  void search_angles(Run& best, const AlignmentLevels& levels, RollPitchResult& res) {
+    AlignmentLevels coarse = levels;
+    coarse.finest = std::max(levels.finest, levels.coarsest - 1);
+    const int n = static_cast<int>(std::floor(opt.search_range / opt.search_step + 1e-9));
+    Run found;
+    for (int i = -n; i <= n; ++i)
+      for (int j = -n; j <= n; ++j) {
+        Run r = start(opt.initial_roll + i * opt.search_step, opt.initial_pitch + j * opt.search_step);
+        rounds(&r, coarse, 1);
+        res.rounds += r.rounds;
+        res.passes += r.passes;
+        if (r.report.ok && (!found.report.ok || r.ratio < found.ratio)) found = std::move(r);
       }
+    if (found.report.ok) {
+      rounds(&found, levels, opt.max_rounds);
+      drop_unaligned(&found, levels);
+      res.rounds += found.rounds;
+      res.passes += found.passes;
+      if (found.report.ok && (!best.report.ok || found.ratio < best.ratio)) best = std::move(found);
     }
-    // Which pairs align, the search and the refusals are judged on the keyframes as the pipeline
-    // made them (their residual against their intensity's variance: a band-passed faint floor's
-    // variance is mostly noise, the ratio near 1 when aligned). The orientation is then refined on
-    // the band-passed keyframes (image/band_pass.h), from that result.
-    const double ratio_as_made = best.ratio;
+  }
+
+  // The orientation refined on the band-passed keyframes and, for a rolling shutter, on keyframes
+  // undistorted again with the motion measured, until it settles.
+  void refine(Run& best, const AlignmentLevels& levels, RollPitchResult& res) {
+    // On the band-passed keyframes (image/band_pass.h), from the result on the keyframes as made.
     if (best.report.ok && opt.band_pass_sigma > 0.0 && !band_passed) {
       band_passed = true;
       for (Pyramid& k : keyframes) band_pass(rt, k, opt.band_pass_sigma);
@@ -483,21 +474,11 @@ struct RollPitchEstimator::Impl {
       ++res.unrolls;
       if (std::hypot(best.ext.roll - before.roll, best.ext.pitch - before.pitch) < opt.unroll_tolerance) break;
     }
-    res.align_ms = ms_since(t0);
-    if (!best.report.ok) {
-      res.status = RollPitchResult::Status::Failed;
-      res.reason = std::string("the joint alignment of the keyframes failed: ") + best.report.reason;
-      return res;
-    }
-    res.residual_ratio = ratio_as_made;
-    res.pairs = static_cast<int>(best.pairs.size());
-    res.roll = best.ext.roll;
-    res.pitch = best.ext.pitch;
-    for (const AlignmentPair& p : best.pairs)
-      res.pair_motions.push_back({static_cast<int>(p.reference - keyframes.data()),
-                                  static_cast<int>(p.live - keyframes.data()), p.motion});
+  }
 
-    // sigma^2 S^-1, with every pair's motion and brightness marginalised (aligner.h).
+  // sigma^2 S^-1 with every pair's motion and brightness marginalised (aligner.h), and what the
+  // jackknife's covariance has beyond it.
+  void covariance(const Run& best, const AlignmentLevels& levels, RollPitchResult& res) {
     const double dof = std::max(1.0, best.report.total_valid - static_cast<double>(
                                           best.pairs.size() * static_cast<size_t>(aligner.local_size()) + 2));
     const double s2 = std::max(best.report.total_wrr / dof, opt.align.min_sigma * opt.align.min_sigma);
@@ -518,6 +499,44 @@ struct RollPitchEstimator::Impl {
       }
       res.jackknife_covariance = jk;
     }
+  }
+
+  RollPitchResult estimate() {
+    RollPitchResult res;
+    res.frames_used = frames;
+    res.keyframes = static_cast<int>(keyframes.size());
+    res.keyframe_frames = keyframe_frames;
+    res.track_ms = track_ms;
+    if (!enough_motion(res)) return res;
+
+    const auto t0 = Clock::now();
+    final_light();
+    const AlignmentLevels levels = aligner.levels(keyframes.front(), keyframes.back());
+    Run best = start(opt.initial_roll, opt.initial_pitch);
+    rounds(&best, levels, opt.max_rounds);
+    drop_unaligned(&best, levels);
+    res.rounds = best.rounds;
+    res.passes = best.passes;
+    if (opt.search && (!best.report.ok || best.ratio > opt.search_residual_ratio)) search_angles(best, levels, res);
+    // Which pairs align, the search and the refusals are judged on the keyframes as the pipeline
+    // made them (their residual against their intensity's variance: a band-passed faint floor's
+    // variance is mostly noise, the ratio near 1 when aligned).
+    const double ratio_as_made = best.ratio;
+    refine(best, levels, res);
+    res.align_ms = ms_since(t0);
+    if (!best.report.ok) {
+      res.status = RollPitchResult::Status::Failed;
+      res.reason = std::string("the joint alignment of the keyframes failed: ") + best.report.reason;
+      return res;
+    }
+    res.residual_ratio = ratio_as_made;
+    res.pairs = static_cast<int>(best.pairs.size());
+    res.roll = best.ext.roll;
+    res.pitch = best.ext.pitch;
+    for (const AlignmentPair& p : best.pairs)
+      res.pair_motions.push_back({static_cast<int>(p.reference - keyframes.data()),
+                                  static_cast<int>(p.live - keyframes.data()), p.motion});
+    covariance(best, levels, res);
     const double worst_sigma = std::sqrt(std::max(res.covariance(0, 0), res.covariance(1, 1)));
     if (!(worst_sigma <= opt.max_sigma)) {
       res.status = RollPitchResult::Status::TooLittleMotion;
