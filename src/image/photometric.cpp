@@ -97,6 +97,86 @@ PhotometricFit identity_photometric(int width, int height) {
   return f;
 }
 
+namespace {
+
+// The floor's contrast as the pixel sees it: the spread of the values over the box and the frames
+// together (the texture within the box varies from the first frame on), relative to the level.
+cv::Mat relative_spread(const cv::Mat& m, const cv::Mat& q) {
+  cv::Mat rel(m.size(), CV_32FC1);
+  for (int y = 0; y < m.rows; ++y) {
+    const float *mm = m.ptr<float>(y), *qq = q.ptr<float>(y);
+    float* rr = rel.ptr<float>(y);
+    for (int x = 0; x < m.cols; ++x) rr[x] = mm[x] > 0 ? std::sqrt(std::max(qq[x] - mm[x] * mm[x], 0.0f)) / mm[x] : 0.0f;
+  }
+  return rel;
+}
+
+// The pixels with no value (each test on smoothed statistics, so that it marks regions: the
+// pyramid leaves out every coarse pixel that has one fine pixel without a value, so scattered
+// holes would empty the coarse levels):
+// - faint: the floor's texture shows too faintly against what the light adds (saturated spots,
+//   a reflection's core, static structure), relative to the median pixel;
+// - an edge of the light: the box's spread relative to its level far above the median's (a
+//   shadow's edge, a reflection's rim), which a smooth model cannot follow.
+// Specks smaller than 5 x 5 pixels are noise of the tests, not light. own_sd: empty, or the
+// pixel's own spread over the frames.
+cv::Mat unusable_pixels(const cv::Mat& valid, const cv::Mat& m, const cv::Mat& rel, const cv::Mat& own_sd,
+                        double rel_ref, const PhotometricOptions& o) {
+  const bool own = !own_sd.empty();
+  cv::Mat bad(m.size(), CV_8UC1, cv::Scalar(0));
+  for (int y = 0; y < m.rows; ++y) {
+    const uint8_t* k = valid.ptr<uint8_t>(y);
+    const float* mm = m.ptr<float>(y);
+    const float* rr = rel.ptr<float>(y);
+    uint8_t* b = bad.ptr<uint8_t>(y);
+    for (int x = 0; x < m.cols; ++x) {
+      if (!k[x]) continue;
+      const bool faint = rr[x] < o.min_contrast * rel_ref ||
+                         (own && mm[x] > 0 && own_sd.at<float>(y, x) / mm[x] < o.min_contrast * rel_ref);
+      const bool edge = rr[x] > kMaxRelativeSpread * rel_ref;
+      b[x] = !(mm[x] > 0) || faint || edge ? 255 : 0;
+    }
+  }
+  cv::morphologyEx(bad, bad, cv::MORPH_OPEN, cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(5, 5)));
+  return bad;
+}
+
+// The fraction of the valid pixels that have no value.
+double unusable_fraction(const cv::Mat& valid, const cv::Mat& bad, const cv::Mat& m) {
+  long n_valid = 0, n_unusable = 0;
+  for (int y = 0; y < m.rows; ++y) {
+    const uint8_t* k = valid.ptr<uint8_t>(y);
+    const uint8_t* b = bad.ptr<uint8_t>(y);
+    const float* mm = m.ptr<float>(y);
+    for (int x = 0; x < m.cols; ++x) {
+      if (!k[x]) continue;
+      ++n_valid;
+      if (b[x] || !(mm[x] > 0)) ++n_unusable;
+    }
+  }
+  return n_valid > 0 ? static_cast<double>(n_unusable) / static_cast<double>(n_valid) : 0.0;
+}
+
+// The settled light level (light_level.h): fitted to the pixels that do not reach the camera's
+// white level (a mean within 2.5 of its own standard deviations of it), since a saturated spot's
+// clipped mean would pull its surroundings' level down (by 1-3 % over 40 pixels around the
+// reflection's core), and to the pixels that have a value: a plane across a shadow's edge,
+// sharpened, rings 3-8 % beside the edge's band.
+cv::Mat settled_level(const cv::Mat& mean, const cv::Mat& own_var, const cv::Mat& valid, const cv::Mat& bad,
+                      int radius, const PhotometricOptions& o) {
+  cv::Mat support(mean.size(), CV_8UC1, cv::Scalar(0));
+  for (int y = 0; y < mean.rows; ++y) {
+    const uint8_t *k = valid.ptr<uint8_t>(y), *b = bad.ptr<uint8_t>(y);
+    const float *mm = mean.ptr<float>(y), *v = own_var.ptr<float>(y);
+    uint8_t* s = support.ptr<uint8_t>(y);
+    for (int x = 0; x < mean.cols; ++x)
+      s[x] = k[x] && !b[x] && mm[x] > 0 && mm[x] + 2.5f * std::sqrt(v[x]) < o.saturation;
+  }
+  return settled_light_level(mean, support, radius);
+}
+
+}  // namespace
+
 PhotometricFit fit_photometric(const cv::Mat& mean, const cv::Mat& square, const cv::Mat& valid,
                                int frames, const PhotometricOptions& o, bool needed) {
   if (mean.type() != CV_32FC1 || square.type() != CV_32FC1 || valid.type() != CV_8UC1 ||
@@ -113,16 +193,7 @@ PhotometricFit fit_photometric(const cv::Mat& mean, const cv::Mat& square, const
   const int radius = o.radius > 0 ? o.radius : std::max(1, (mean.cols + 20) / 40);
   const cv::Mat den = box_count(valid01, radius);
   const cv::Mat m = masked_box(mean, valid01, den, radius);
-  // The floor's contrast as the pixel sees it: the spread of the values over the box and the
-  // frames together (the texture within the box varies from the first frame on), relative to
-  // the level.
-  const cv::Mat q = masked_box(square, valid01, den, radius);
-  cv::Mat rel(mean.size(), CV_32FC1);
-  for (int y = 0; y < mean.rows; ++y) {
-    const float *mm = m.ptr<float>(y), *qq = q.ptr<float>(y);
-    float* rr = rel.ptr<float>(y);
-    for (int x = 0; x < mean.cols; ++x) rr[x] = mm[x] > 0 ? std::sqrt(std::max(qq[x] - mm[x] * mm[x], 0.0f)) / mm[x] : 0.0f;
-  }
+  const cv::Mat rel = relative_spread(m, masked_box(square, valid01, den, radius));
   const std::vector<double> m_quantiles = masked_quantiles(m, valid, {0.5, 0.1, 0.9});
   const double mean_ref = m_quantiles[0];
   const double rel_ref = masked_quantiles(rel, valid, {0.5})[0];
@@ -141,41 +212,8 @@ PhotometricFit fit_photometric(const cv::Mat& mean, const cv::Mat& square, const
   const bool own = frames >= kOwnVarianceFrames;
   cv::Mat own_sd;
   if (own) cv::sqrt(masked_box(own_var, valid01, box_count(valid01, 2), 2), own_sd);
-  // No value (each test on smoothed statistics, so that it marks regions: the pyramid leaves
-  // out every coarse pixel that has one fine pixel without a value, so scattered holes would
-  // empty the coarse levels):
-  // - faint: the floor's texture shows too faintly against what the light adds (saturated spots,
-  //   a reflection's core, static structure), relative to the median pixel;
-  // - an edge of the light: the box's spread relative to its level far above the median's (a
-  //   shadow's edge, a reflection's rim), which a smooth model cannot follow.
-  cv::Mat bad(mean.size(), CV_8UC1, cv::Scalar(0));
-  for (int y = 0; y < mean.rows; ++y) {
-    const uint8_t* k = valid.ptr<uint8_t>(y);
-    const float* mm = m.ptr<float>(y);
-    const float* rr = rel.ptr<float>(y);
-    uint8_t* b = bad.ptr<uint8_t>(y);
-    for (int x = 0; x < mean.cols; ++x) {
-      if (!k[x]) continue;
-      const bool faint = rr[x] < o.min_contrast * rel_ref ||
-                         (own && mm[x] > 0 && own_sd.at<float>(y, x) / mm[x] < o.min_contrast * rel_ref);
-      const bool edge = rr[x] > kMaxRelativeSpread * rel_ref;
-      b[x] = !(mm[x] > 0) || faint || edge ? 255 : 0;
-    }
-  }
-  // Specks smaller than 5 x 5 pixels are noise of the tests, not light.
-  cv::morphologyEx(bad, bad, cv::MORPH_OPEN, cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(5, 5)));
-  long n_valid = 0, n_unusable = 0;
-  for (int y = 0; y < mean.rows; ++y) {
-    const uint8_t* k = valid.ptr<uint8_t>(y);
-    const uint8_t* b = bad.ptr<uint8_t>(y);
-    const float* mm = m.ptr<float>(y);
-    for (int x = 0; x < mean.cols; ++x) {
-      if (!k[x]) continue;
-      ++n_valid;
-      if (b[x] || !(mm[x] > 0)) ++n_unusable;
-    }
-  }
-  f.unusable = n_valid > 0 ? static_cast<double>(n_unusable) / static_cast<double>(n_valid) : 0.0;
+  const cv::Mat bad = unusable_pixels(valid, m, rel, own_sd, rel_ref, o);
+  f.unusable = unusable_fraction(valid, bad, m);
   // Nothing fixed to the camera that the statistics can tell from their own noise: the mean
   // level varies over the image by less than uniform_spread (10th to 90th percentile, relative
   // to the median), and no pixel lacks a value. The correction would only add its own noise (a
@@ -195,24 +233,8 @@ PhotometricFit fit_photometric(const cv::Mat& mean, const cv::Mat& square, const
     return f;
   }
   // Once settled: the young statistics' noise, not the box's bias, is their error (sharpened at
-  // 8-10 frames, anti_skid_tiles' first model put two frames' brightness 2x off). The level is
-  // fitted to the pixels that do not reach the camera's white level (a mean within 2.5 of its
-  // own standard deviations of it): a saturated spot's clipped mean would pull its
-  // surroundings' level down (by 1-3 % over 40 pixels around the reflection's core); and to the
-  // pixels that have a value: a plane across a shadow's edge, sharpened, rings 3-8 % beside the
-  // edge's band.
-  cv::Mat level = m;
-  if (frames >= kPhotometricSettledFrames) {
-    cv::Mat support(mean.size(), CV_8UC1, cv::Scalar(0));
-    for (int y = 0; y < mean.rows; ++y) {
-      const uint8_t *k = valid.ptr<uint8_t>(y), *b = bad.ptr<uint8_t>(y);
-      const float *mm = mean.ptr<float>(y), *v = own_var.ptr<float>(y);
-      uint8_t* s = support.ptr<uint8_t>(y);
-      for (int x = 0; x < mean.cols; ++x)
-        s[x] = k[x] && !b[x] && mm[x] > 0 && mm[x] + 2.5f * std::sqrt(v[x]) < o.saturation;
-    }
-    level = settled_light_level(mean, support, radius);
-  }
+  // 8-10 frames, anti_skid_tiles' first model put two frames' brightness 2x off).
+  const cv::Mat level = frames >= kPhotometricSettledFrames ? settled_level(mean, own_var, valid, bad, radius, o) : m;
   for (int y = 0; y < mean.rows; ++y) {
     const uint8_t* k = valid.ptr<uint8_t>(y);
     const uint8_t* b = bad.ptr<uint8_t>(y);
