@@ -171,6 +171,75 @@ std::string mounting_warning(const planarvo_track_result& r, double origin, doub
 
 }  // namespace
 
+namespace {
+
+// A warning beside the progress bar, or on stderr without one.
+void warn(Progress* progress, const std::string& warning) {
+  if (progress) progress->warn(warning);
+  else std::fprintf(stderr, "%s\n", warning.c_str());
+}
+
+// The files `track` writes once the frames are tracked.
+void write_outputs(const TrackOutputs& outputs, const Tracked& k, double origin, const TrackRun& run,
+                   const planarvo_extrinsics& mounting, const std::vector<planarvo_motion_pair>& pairs,
+                   planarvo_tracker* tracker, Progress* progress) {
+  if (!outputs.trajectory.empty()) {
+    std::vector<double> stamps(k.t);
+    for (double& t : stamps) t += origin;
+    check(planarvo_write_tum(outputs.trajectory.c_str(), stamps.data(), k.pose.data(), k.t.size()));
+  }
+  if (!outputs.plane.empty()) check(planarvo_write_plane(outputs.plane.c_str(), k.plane.data(), k.plane.size()));
+  if (!outputs.mounting.empty()) {
+    const std::string note = run.mounting_changes > 0
+                                 ? "the mounting after the last change the local plane found while tracking"
+                                 : "the mounting given: no change found while tracking";
+    check(planarvo_extrinsics_save(outputs.mounting.c_str(), &mounting, nullptr, nullptr, "track --local-plane",
+                                   note.c_str()));
+  }
+  if (!outputs.motions.empty()) check(planarvo_motion_pairs_save(outputs.motions.c_str(), pairs.data(), pairs.size()));
+  if (!outputs.flat_field.empty()) {
+    const planarvo_status s = planarvo_tracker_save_flat_field(tracker, outputs.flat_field.c_str());
+    if (s == PLANARVO_ERROR_FAILED) {
+      warn(progress, std::string("planarvo track: warning: ") + planarvo_last_error());
+    } else {
+      check(s);
+    }
+  }
+}
+
+// The body's lean in turns fitted to the local plane's attitudes (planarvo_fit_body_lean).
+void fit_lean(const Tracked& k, TrackRun* run) {
+  std::vector<double> roll(k.t.size()), pitch(k.t.size());
+  std::vector<int32_t> use(k.t.size());
+  for (size_t i = 0; i < k.t.size(); ++i) {
+    roll[i] = k.plane[i].roll;
+    pitch[i] = k.plane[i].pitch;
+    use[i] = k.status[i] == PLANARVO_TRACK_OK || k.status[i] == PLANARVO_TRACK_DEGRADED;
+  }
+  run->lean.struct_size = sizeof run->lean;
+  check(planarvo_fit_body_lean(k.t.data(), k.motion.data(), roll.data(), pitch.data(), use.data(), k.t.size(),
+                               &run->lean));
+  run->has_lean = true;
+}
+
+// The statistics row of a tracked frame (with the local plane's attitude when it is estimated).
+planarvo_frame_stats frame_row(const planarvo_frame_data& fd, double dt, const planarvo_track_result& r,
+                               double origin, bool local_plane) {
+  planarvo_frame_stats row = stats_row(fd, dt, r);
+  row.timestamp += origin;
+  if (local_plane) {
+    row.has_attitude = 1;
+    row.roll = r.roll;
+    row.pitch = r.pitch;
+    row.sigma_roll = std::sqrt(std::max(0.0, r.attitude_covariance[0]));
+    row.sigma_pitch = std::sqrt(std::max(0.0, r.attitude_covariance[3]));
+    row.mounting_changed = r.mounting_changed;
+  }
+  return row;
+}
+
+}  // namespace
+
 TrackRun track_dataset(planarvo_context* ctx, planarvo_dataset* ds, const planarvo_extrinsics& extrinsics,
                        const planarvo_tracker_options& options, const TrackOutputs& outputs, Progress* progress) {
   planarvo_dataset_info info{};
@@ -201,9 +270,7 @@ TrackRun track_dataset(planarvo_context* ctx, planarvo_dataset* ds, const planar
     planarvo_image img{};
     const planarvo_status read = planarvo_dataset_frame(ds, static_cast<int64_t>(i), &img);
     if (read == PLANARVO_ERROR_INVALID_INPUT && outputs.skip_bad_frames) {
-      const std::string warning = "planarvo track: skipping frame " + std::to_string(i) + ": " + planarvo_last_error();
-      if (progress) progress->warn(warning);
-      else std::fprintf(stderr, "%s\n", warning.c_str());
+      warn(progress, "planarvo track: skipping frame " + std::to_string(i) + ": " + planarvo_last_error());
       ++run.skipped;
       if (stats) {
         planarvo_frame_stats row{};
@@ -222,22 +289,11 @@ TrackRun track_dataset(planarvo_context* ctx, planarvo_dataset* ds, const planar
     if (r.mounting_changed) {
       ++run.mounting_changes;
       mounting = r.changed_mounting;
-      const std::string warning = mounting_warning(r, origin, fd.timestamp, options.on_mounting_change);
-      if (progress) progress->warn(warning);
-      else std::fprintf(stderr, "%s\n", warning.c_str());
+      warn(progress, mounting_warning(r, origin, fd.timestamp, options.on_mounting_change));
     }
     const bool first = k.t.empty();
     if (stats) {
-      planarvo_frame_stats row = stats_row(fd, first ? 0 : fd.timestamp - k.t.back(), r);
-      row.timestamp += origin;
-      if (options.local_plane) {
-        row.has_attitude = 1;
-        row.roll = r.roll;
-        row.pitch = r.pitch;
-        row.sigma_roll = std::sqrt(std::max(0.0, r.attitude_covariance[0]));
-        row.sigma_pitch = std::sqrt(std::max(0.0, r.attitude_covariance[3]));
-        row.mounting_changed = r.mounting_changed;
-      }
+      const planarvo_frame_stats row = frame_row(fd, first ? 0 : fd.timestamp - k.t.back(), r, origin, options.local_plane != 0);
       check(planarvo_stats_writer_add(stats.get(), &row));
     }
     planarvo_motion_pair p;
@@ -254,45 +310,10 @@ TrackRun track_dataset(planarvo_context* ctx, planarvo_dataset* ds, const planar
   }
   if (progress) Progress::callback(progress, 1.0, "tracking");
   if (stats) check(planarvo_stats_writer_close(stats.release()));
-  if (!outputs.trajectory.empty()) {
-    std::vector<double> stamps(k.t);
-    for (double& t : stamps) t += origin;
-    check(planarvo_write_tum(outputs.trajectory.c_str(), stamps.data(), k.pose.data(), k.t.size()));
-  }
-  if (!outputs.plane.empty()) check(planarvo_write_plane(outputs.plane.c_str(), k.plane.data(), k.plane.size()));
-  if (!outputs.mounting.empty()) {
-    const std::string note = run.mounting_changes > 0
-                                 ? "the mounting after the last change the local plane found while tracking"
-                                 : "the mounting given: no change found while tracking";
-    check(planarvo_extrinsics_save(outputs.mounting.c_str(), &mounting, nullptr, nullptr, "track --local-plane",
-                                   note.c_str()));
-  }
-  if (!outputs.motions.empty()) check(planarvo_motion_pairs_save(outputs.motions.c_str(), pairs.data(), pairs.size()));
-  if (!outputs.flat_field.empty()) {
-    const planarvo_status s = planarvo_tracker_save_flat_field(tracker.get(), outputs.flat_field.c_str());
-    if (s == PLANARVO_ERROR_FAILED) {
-      const std::string warning = std::string("planarvo track: warning: ") + planarvo_last_error();
-      if (progress) progress->warn(warning);
-      else std::fprintf(stderr, "%s\n", warning.c_str());
-    } else {
-      check(s);
-    }
-  }
+  write_outputs(outputs, k, origin, run, mounting, pairs, tracker.get(), progress);
   account_lost(k, &run);
   evaluate(k, &run);
-  if (options.local_plane && k.t.size() >= 3) {
-    std::vector<double> roll(k.t.size()), pitch(k.t.size());
-    std::vector<int32_t> use(k.t.size());
-    for (size_t i = 0; i < k.t.size(); ++i) {
-      roll[i] = k.plane[i].roll;
-      pitch[i] = k.plane[i].pitch;
-      use[i] = k.status[i] == PLANARVO_TRACK_OK || k.status[i] == PLANARVO_TRACK_DEGRADED;
-    }
-    run.lean.struct_size = sizeof run.lean;
-    check(planarvo_fit_body_lean(k.t.data(), k.motion.data(), roll.data(), pitch.data(), use.data(), k.t.size(),
-                                 &run.lean));
-    run.has_lean = true;
-  }
+  if (options.local_plane && k.t.size() >= 3) fit_lean(k, &run);
   return run;
 }
 
@@ -351,7 +372,10 @@ void print_track_run(const TrackRun& run) {
   }
 }
 
-int cmd_track(int argc, char** argv) {
+namespace {
+
+// The options of `planarvo track`.
+std::vector<OptionSpec> track_options() {
   std::vector<OptionSpec> specs = {
       {"extrinsics", "FILE", "camera extrinsics YAML", "DATASET/extrinsics.yaml"},
       {"output", "FILE", "write the trajectory (TUM) to FILE (also -o)", ""},
@@ -398,20 +422,11 @@ int cmd_track(int argc, char** argv) {
       {"help", "", "show this help", ""}};
   for (auto& b : bag_options()) specs.push_back(b);
   for (auto& d : device_options()) specs.push_back(d);
-  Args args(specs, argc, argv, 1);
-  if (args.has("help")) {
-    std::printf("usage: planarvo track DATASET [--extrinsics FILE] [-o trajectory.txt] [--stats stats.csv]\n"
-                "       planarvo track BAG --extrinsics FILE [--image-topic T] [--camera-info-topic T | --camera FILE]\n"
-                "                          [--odom-topic T] [--groundtruth-topic T] [-o trajectory.txt]\n\n"
-                "Dense planar visual odometry over a data set folder, a ROS 1 bag or an MCAP file (ROS 2): prints\n"
-                "a summary, and the accuracy against the ground truth when there is one.\n\n%s",
-                format_options(specs).c_str());
-    return kExitOk;
-  }
-  args.expect_positionals(1, "DATASET, the data set folder or a bag");
-  const std::string dir = args.positionals()[0];
-  // The options first: a usage error is reported before any file is read.
-  args.expect_output_files({"output", "stats", "motions-out", "save-flat-field", "plane-out", "mounting-out"});
+  return specs;
+}
+
+// The tracker's options from the command line; o.flat_field points into *flat_field.
+planarvo_tracker_options tracker_options_from(const Args& args, std::string* flat_field) {
   planarvo_tracker_options o;
   planarvo_tracker_options_init(&o);
   o.levels = args.get_int_in("levels", o.levels, 1, 8);
@@ -441,8 +456,31 @@ int cmd_track(int argc, char** argv) {
     if (!(sigma > 0.0 && sigma <= 90.0)) throw UsageError("--plane-prior must be a positive number of degrees (up to 90)");
     o.local_plane_prior_sigma = sigma * kDeg;
   }
-  const std::string flat_field = args.get("flat-field");  // outlives o
-  o.flat_field = flat_field.empty() ? nullptr : flat_field.c_str();
+  *flat_field = args.get("flat-field");
+  o.flat_field = flat_field->empty() ? nullptr : flat_field->c_str();
+  return o;
+}
+
+}  // namespace
+
+int cmd_track(int argc, char** argv) {
+  const std::vector<OptionSpec> specs = track_options();
+  Args args(specs, argc, argv, 1);
+  if (args.has("help")) {
+    std::printf("usage: planarvo track DATASET [--extrinsics FILE] [-o trajectory.txt] [--stats stats.csv]\n"
+                "       planarvo track BAG --extrinsics FILE [--image-topic T] [--camera-info-topic T | --camera FILE]\n"
+                "                          [--odom-topic T] [--groundtruth-topic T] [-o trajectory.txt]\n\n"
+                "Dense planar visual odometry over a data set folder, a ROS 1 bag or an MCAP file (ROS 2): prints\n"
+                "a summary, and the accuracy against the ground truth when there is one.\n\n%s",
+                format_options(specs).c_str());
+    return kExitOk;
+  }
+  args.expect_positionals(1, "DATASET, the data set folder or a bag");
+  const std::string dir = args.positionals()[0];
+  // The options first: a usage error is reported before any file is read.
+  args.expect_output_files({"output", "stats", "motions-out", "save-flat-field", "plane-out", "mounting-out"});
+  std::string flat_field;  // outlives o
+  const planarvo_tracker_options o = tracker_options_from(args, &flat_field);
   const std::optional<planarvo_region> roi = parse_roi(args);  // before any file is read
   const std::optional<double> readout = parse_readout(args);
   const double max_lost = args.get_double("max-lost", 5.0);
