@@ -384,15 +384,14 @@ cl::Program Runtime::build_with_cache(const std::string& name, const std::string
   return p;
 }
 
-cl::Program Runtime::load_from_binaries(const std::string& name, const std::string& options) {
-  const std::string& dir = options_.binaries_dir;
-  const fs::path manifest_path = fs::path(dir) / kManifestFileName;
-  const std::string what = "program " + quote(name) + " with options " + quote(options) +
-                           " on device " + quote(info_.device_name) + " (driver " +
-                           info_.driver_version + ")";
-  const std::string where = "the prebuilt binaries directory " + quote(dir) +
-                            " (--kernel-binaries)";
+namespace {
 
+// The manifest's entry for the program and options on this device and driver; InvalidInput naming
+// what is missing or mismatched, and how to export it. what: the program, options and device;
+// where: the directory, as the messages say them.
+detail::ManifestEntry manifest_entry(const std::string& dir, const std::string& name, const std::string& options,
+                                     const DeviceInfo& info, const std::string& what, const std::string& where) {
+  const fs::path manifest_path = fs::path(dir) / kManifestFileName;
   std::error_code ec;
   if (fs::exists(manifest_path, ec) && !fs::is_regular_file(manifest_path, ec))
     throw_invalid_input("the manifest " + quote(manifest_path.string()) + " is not a file (" + where + ")");
@@ -430,8 +429,8 @@ cl::Program Runtime::load_from_binaries(const std::string& name, const std::stri
   }
   const detail::ManifestEntry* entry = nullptr;
   for (const auto* e : candidates) {
-    if ((e->device == "*" || e->device == info_.device_name) &&
-        (e->driver == "*" || e->driver == info_.driver_version)) {
+    if ((e->device == "*" || e->device == info.device_name) &&
+        (e->driver == "*" || e->driver == info.driver_version)) {
       entry = e;
       break;
     }
@@ -443,11 +442,20 @@ cl::Program Runtime::load_from_binaries(const std::string& name, const std::stri
                    ", manifest line " + std::to_string(e->line) + ")";
     throw_invalid_input("mismatched binary for " + name + " with options " + quote(options) +
                         " in " + where + ": built for " + built_for + ", this device is " +
-                        quote(info_.device_name) + " (driver " + info_.driver_version +
+                        quote(info.device_name) + " (driver " + info.driver_version +
                         "); export the binaries on this device and driver (`planarvo kernels " +
                         "--export " + dir + "` adds them beside the others)");
   }
 
+  return *entry;
+}
+
+// The binary file of a manifest entry, checked before the driver parses it: a truncated binary
+// crashed a driver, and one program's binary under another's name ran and tracked nothing.
+std::vector<unsigned char> checked_binary(const std::string& dir, const detail::ManifestEntry& e,
+                                          const std::string& what, const std::string& where) {
+  const detail::ManifestEntry* entry = &e;
+  std::error_code ec;
   const fs::path file = fs::path(dir) / entry->file;
   if (fs::exists(file, ec) && !fs::is_regular_file(file, ec))
     throw_invalid_input("the binary file " + quote(file.string()) + " for " + what + " is not a file (" + where +
@@ -460,8 +468,6 @@ cl::Program Runtime::load_from_binaries(const std::string& name, const std::stri
   if (binary->empty())
     throw_invalid_input("the binary file " + quote(file.string()) + " for " + what +
                         " is empty (" + where + ")");
-  // Checked before the driver parses it: a truncated binary crashed a driver, and one program's
-  // binary under another's name ran and tracked nothing.
   const std::string manifest_line = where + ", manifest line " + std::to_string(entry->line);
   if (entry->size >= 0 && static_cast<long long>(binary->size()) != entry->size)
     throw_invalid_input("the binary file " + quote(file.string()) + " for " + what + " is " +
@@ -472,11 +478,27 @@ cl::Program Runtime::load_from_binaries(const std::string& name, const std::stri
                         " does not have the SHA-256 the manifest records (corrupted or another program's? " +
                         manifest_line + "); export the binaries again");
 
+  return *binary;
+}
+
+}  // namespace
+
+cl::Program Runtime::load_from_binaries(const std::string& name, const std::string& options) {
+  const std::string& dir = options_.binaries_dir;
+  const std::string what = "program " + quote(name) + " with options " + quote(options) +
+                           " on device " + quote(info_.device_name) + " (driver " +
+                           info_.driver_version + ")";
+  const std::string where = "the prebuilt binaries directory " + quote(dir) +
+                            " (--kernel-binaries)";
+
+  const detail::ManifestEntry entry = manifest_entry(dir, name, options, info_, what, where);
+  const fs::path file = fs::path(dir) / entry.file;
+  const std::vector<unsigned char> bytes = checked_binary(dir, entry, what, where);
   const std::string effective = effective_build_options(options);
   cl::Program p;
   std::vector<cl_int> status;
   try {
-    p = cl::Program(context_, std::vector<cl::Device>{device_}, cl::Program::Binaries{*binary},
+    p = cl::Program(context_, std::vector<cl::Device>{device_}, cl::Program::Binaries{bytes},
                     &status);
   } catch (const cl::Error& e) {
     const cl_int code = !status.empty() && status[0] != CL_SUCCESS ? status[0] : e.err();
