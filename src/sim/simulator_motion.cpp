@@ -62,117 +62,126 @@ class Profile {
   double end_ = 0.0;
 };
 
-Profile make_profile(const Options& o, double duration, Random& rng) {
-  Profile p(o.max_acceleration, o.max_angular_acceleration);
-  const double vm = o.max_speed, wm = o.max_turn_rate;
+// Each kind's segments, until the profile reaches `duration`.
   // Each segment's random parts are drawn into named values, the duration first, then the turn
   // rate, then the speed: C++ leaves the order of a call's arguments unspecified, and these were
   // once drawn inside p.add(v, w, seconds)'s arguments, so that clang (left to right) made
   // another drive for a seed than GCC (right to left). GCC's order is kept: every drive measured
   // on the simulator stays the same.
+void add_mixed(Profile& p, double duration, double vm, double wm, Random& rng) {
+  // One cycle takes 7 to 9.5 s at the default limits, so a 10 s sequence has every
+  // manoeuvre: driving forwards, arcs turning both ways, stops, turning in place both
+  // ways, reversing.
+  while (p.end() < duration) {
+    const int turn = rng.sign(), spin = rng.sign();
+    p.add(0.0, 0.0, rng.uniform(0.2, 0.35));  // stop
+    {
+      const double s = rng.uniform(0.4, 0.7), w = rng.uniform(-0.05, 0.05) * wm, v = rng.uniform(0.6, 1.0) * vm;
+      p.add(v, w, s);
+    }
+    {
+      const double s = rng.uniform(0.4, 0.7), w = turn * rng.uniform(0.4, 0.8) * wm, v = rng.uniform(0.35, 0.6) * vm;
+      p.add(v, w, s);
+    }
+    p.add(0.0, 0.0, rng.uniform(0.1, 0.2));  // stop
+    {
+      const double s = rng.uniform(0.3, 0.5), w = spin * rng.uniform(0.6, 1.0) * wm;  // in place
+      p.add(0.0, w, s);
+    }
+    {
+      const double s = rng.uniform(0.3, 0.5), w = -spin * rng.uniform(0.6, 1.0) * wm;
+      p.add(0.0, w, s);
+    }
+    {
+      const double s = rng.uniform(0.5, 0.8), w = -turn * rng.uniform(0.1, 0.5) * wm, v = -rng.uniform(0.35, 0.6) * vm;
+      p.add(v, w, s);
+    }
+    {
+      const double s = rng.uniform(0.4, 0.7), w = -turn * rng.uniform(0.4, 0.8) * wm, v = rng.uniform(0.35, 0.6) * vm;
+      p.add(v, w, s);
+    }
+  }
+}
+
+void add_straight(Profile& p, double duration, double vm, Random& rng) {
+  while (p.end() < duration) {
+    p.add(0.0, 0.0, rng.uniform(0.2, 0.4));
+    {
+      const double s = rng.uniform(0.8, 1.5), v = rng.uniform(0.5, 1.0) * vm;
+      p.add(v, 0.0, s);
+    }
+    p.add(0.0, 0.0, rng.uniform(0.2, 0.4));
+    {
+      const double s = rng.uniform(0.8, 1.5), v = -rng.uniform(0.5, 1.0) * vm;
+      p.add(v, 0.0, s);
+    }
+  }
+}
+
+void add_circle(Profile& p, double vm, double wm, Random& rng) {
+  // v and omega blend together, so the curvature is the same from the first interval on.
+  const double radius = rng.uniform(0.3, 1.0);
+  double v = rng.uniform(0.4, 0.7) * vm;
+  if (v / radius > 0.9 * wm) v = 0.9 * wm * radius;
+  p.add(0.0, 0.0, 0.2);
+  p.add(v, rng.sign() * v / radius, std::numeric_limits<double>::infinity());
+}
+
+void add_spin(Profile& p, double duration, double wm, Random& rng) {
+  while (p.end() < duration) {
+    const int sign = rng.sign();
+    p.add(0.0, 0.0, rng.uniform(0.2, 0.4));
+    {
+      const double s = rng.uniform(0.8, 1.5), w = sign * rng.uniform(0.5, 1.0) * wm;
+      p.add(0.0, w, s);
+    }
+    p.add(0.0, 0.0, rng.uniform(0.2, 0.4));
+    {
+      const double s = rng.uniform(0.8, 1.5), w = -sign * rng.uniform(0.5, 1.0) * wm;
+      p.add(0.0, w, s);
+    }
+  }
+}
+
+void add_car(Profile& p, const Options& o, double duration, double vm, double wm, Random& rng) {
+  // Curvature k with |k| <= 1/R; omega = k v, so blends between two levels of the same
+  // direction (v and omega blend alike) and through a stop keep |omega| <= |v| / R.
+  const double kmax = o.min_turn_radius > 0 ? 1.0 / o.min_turn_radius : HUGE_VAL;
+  auto turn = [&](double v, double k) { return std::clamp(k * v, -wm, wm); };
+  auto curvature = [&](double share) {
+    const double k = share * kmax;
+    return std::isfinite(k) ? k : share * 4.0;  // no radius given: up to 4 rad per metre
+  };
+  // v is drawn before its segment (a statement of its own); then the duration, then the turn.
+  const auto add_turning = [&](double v, double share_min, double share_max, double side, double s_min,
+                               double s_max) {
+    const double s = rng.uniform(s_min, s_max), share = side * rng.uniform(share_min, share_max);
+    p.add(v, turn(v, curvature(share)), s);
+  };
+  while (p.end() < duration) {
+    const int side = rng.sign();
+    p.add(0.0, 0.0, rng.uniform(0.3, 0.6));  // stop
+    double v = rng.uniform(0.6, 1.0) * vm;
+    add_turning(v, -0.1, 0.1, 1.0, 1.0, 2.0);  // straight on
+    v = rng.uniform(0.4, 0.8) * vm;
+    add_turning(v, 0.6, 1.0, side, 1.0, 2.0);  // a bend
+    v = rng.uniform(0.6, 1.0) * vm;
+    add_turning(v, 0.3, 1.0, -side, 0.8, 1.5);
+    p.add(0.0, 0.0, rng.uniform(0.3, 0.6));  // stop
+    v = -rng.uniform(0.1, 0.25) * vm;     // reverse
+    add_turning(v, 0.5, 1.0, side, 1.0, 2.0);
+  }
+}
+
+Profile make_profile(const Options& o, double duration, Random& rng) {
+  Profile p(o.max_acceleration, o.max_angular_acceleration);
+  const double vm = o.max_speed, wm = o.max_turn_rate;
   switch (o.motion) {
-    case MotionProfile::Mixed:
-      // One cycle takes 7 to 9.5 s at the default limits, so a 10 s sequence has every
-      // manoeuvre: driving forwards, arcs turning both ways, stops, turning in place both
-      // ways, reversing.
-      while (p.end() < duration) {
-        const int turn = rng.sign(), spin = rng.sign();
-        p.add(0.0, 0.0, rng.uniform(0.2, 0.35));  // stop
-        {
-          const double s = rng.uniform(0.4, 0.7), w = rng.uniform(-0.05, 0.05) * wm, v = rng.uniform(0.6, 1.0) * vm;
-          p.add(v, w, s);
-        }
-        {
-          const double s = rng.uniform(0.4, 0.7), w = turn * rng.uniform(0.4, 0.8) * wm, v = rng.uniform(0.35, 0.6) * vm;
-          p.add(v, w, s);
-        }
-        p.add(0.0, 0.0, rng.uniform(0.1, 0.2));  // stop
-        {
-          const double s = rng.uniform(0.3, 0.5), w = spin * rng.uniform(0.6, 1.0) * wm;  // in place
-          p.add(0.0, w, s);
-        }
-        {
-          const double s = rng.uniform(0.3, 0.5), w = -spin * rng.uniform(0.6, 1.0) * wm;
-          p.add(0.0, w, s);
-        }
-        {
-          const double s = rng.uniform(0.5, 0.8), w = -turn * rng.uniform(0.1, 0.5) * wm, v = -rng.uniform(0.35, 0.6) * vm;
-          p.add(v, w, s);
-        }
-        {
-          const double s = rng.uniform(0.4, 0.7), w = -turn * rng.uniform(0.4, 0.8) * wm, v = rng.uniform(0.35, 0.6) * vm;
-          p.add(v, w, s);
-        }
-      }
-      break;
-    case MotionProfile::Straight:
-      while (p.end() < duration) {
-        p.add(0.0, 0.0, rng.uniform(0.2, 0.4));
-        {
-          const double s = rng.uniform(0.8, 1.5), v = rng.uniform(0.5, 1.0) * vm;
-          p.add(v, 0.0, s);
-        }
-        p.add(0.0, 0.0, rng.uniform(0.2, 0.4));
-        {
-          const double s = rng.uniform(0.8, 1.5), v = -rng.uniform(0.5, 1.0) * vm;
-          p.add(v, 0.0, s);
-        }
-      }
-      break;
-    case MotionProfile::Circle: {
-      // v and omega blend together, so the curvature is the same from the first interval on.
-      const double radius = rng.uniform(0.3, 1.0);
-      double v = rng.uniform(0.4, 0.7) * vm;
-      if (v / radius > 0.9 * wm) v = 0.9 * wm * radius;
-      p.add(0.0, 0.0, 0.2);
-      p.add(v, rng.sign() * v / radius, std::numeric_limits<double>::infinity());
-      break;
-    }
-    case MotionProfile::Spin:
-      while (p.end() < duration) {
-        const int sign = rng.sign();
-        p.add(0.0, 0.0, rng.uniform(0.2, 0.4));
-        {
-          const double s = rng.uniform(0.8, 1.5), w = sign * rng.uniform(0.5, 1.0) * wm;
-          p.add(0.0, w, s);
-        }
-        p.add(0.0, 0.0, rng.uniform(0.2, 0.4));
-        {
-          const double s = rng.uniform(0.8, 1.5), w = -sign * rng.uniform(0.5, 1.0) * wm;
-          p.add(0.0, w, s);
-        }
-      }
-      break;
-    case MotionProfile::Car: {
-      // Curvature k with |k| <= 1/R; omega = k v, so blends between two levels of the same
-      // direction (v and omega blend alike) and through a stop keep |omega| <= |v| / R.
-      const double kmax = o.min_turn_radius > 0 ? 1.0 / o.min_turn_radius : HUGE_VAL;
-      auto turn = [&](double v, double k) { return std::clamp(k * v, -wm, wm); };
-      auto curvature = [&](double share) {
-        const double k = share * kmax;
-        return std::isfinite(k) ? k : share * 4.0;  // no radius given: up to 4 rad per metre
-      };
-      // v is drawn before its segment (a statement of its own); then the duration, then the turn.
-      const auto add_turning = [&](double v, double share_min, double share_max, double side, double s_min,
-                                   double s_max) {
-        const double s = rng.uniform(s_min, s_max), share = side * rng.uniform(share_min, share_max);
-        p.add(v, turn(v, curvature(share)), s);
-      };
-      while (p.end() < duration) {
-        const int side = rng.sign();
-        p.add(0.0, 0.0, rng.uniform(0.3, 0.6));  // stop
-        double v = rng.uniform(0.6, 1.0) * vm;
-        add_turning(v, -0.1, 0.1, 1.0, 1.0, 2.0);  // straight on
-        v = rng.uniform(0.4, 0.8) * vm;
-        add_turning(v, 0.6, 1.0, side, 1.0, 2.0);  // a bend
-        v = rng.uniform(0.6, 1.0) * vm;
-        add_turning(v, 0.3, 1.0, -side, 0.8, 1.5);
-        p.add(0.0, 0.0, rng.uniform(0.3, 0.6));  // stop
-        v = -rng.uniform(0.1, 0.25) * vm;     // reverse
-        add_turning(v, 0.5, 1.0, side, 1.0, 2.0);
-      }
-      break;
-    }
+    case MotionProfile::Mixed: add_mixed(p, duration, vm, wm, rng); break;
+    case MotionProfile::Straight: add_straight(p, duration, vm, rng); break;
+    case MotionProfile::Circle: add_circle(p, vm, wm, rng); break;
+    case MotionProfile::Spin: add_spin(p, duration, wm, rng); break;
+    case MotionProfile::Car: add_car(p, o, duration, vm, wm, rng); break;
   }
   return p;
 }
