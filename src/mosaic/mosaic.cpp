@@ -362,13 +362,10 @@ std::vector<int64_t> match_frames(const std::vector<double>& frame_times, const 
   return out;
 }
 
-Mosaic build_mosaic(ocl::Runtime& runtime, io::Dataset& dataset, const Extrinsics& extrinsics,
-                    const std::vector<PosedFrame>& frames, const MosaicOptions& options) {
-  const Clock::time_point t0 = Clock::now();
-  check_options(options);
-  if (!extrinsics.finite() || !(extrinsics.z > 0))
-    throw_invalid_argument("mosaic: the extrinsics must be finite numbers with a height z > 0");
-  if (frames.empty()) throw_invalid_input("mosaic: no poses: the trajectory is empty");
+namespace {
+
+// Every pose names a frame of the data set and is a finite place within reach of the origin.
+void check_frames(const io::Dataset& dataset, const std::vector<PosedFrame>& frames) {
   for (const PosedFrame& f : frames) {
     if (f.frame < 0 || f.frame >= dataset.frame_count())
       throw_invalid_argument("mosaic: frame " + std::to_string(f.frame) + " is not in the data set (it has " +
@@ -380,17 +377,11 @@ Mosaic build_mosaic(ocl::Runtime& runtime, io::Dataset& dataset, const Extrinsic
                           ", y " + num(f.pose.y, -1) + " m) is beyond " + num(kMaxPositionMetres, -1) +
                           " m from the origin: a corrupt trajectory or another unit");
   }
-  const CameraModel& cam = dataset.camera();
-  const PixelRegion region = cam.region();
-  const double max_range = options.max_range > 0 ? options.max_range : 4.0 * extrinsics.z;
-  const WarpSetup setup =
-      make_warp_setup(cam, extrinsics, max_range, options.feather * std::min(region.width, region.height));
-  const std::vector<Eigen::Vector2d> fp = footprint(setup);
-  if (fp.empty()) throw_invalid_input("mosaic: the camera sees no ground within the range limit");
-  Box robot_box;
-  for (const Eigen::Vector2d& p : fp) robot_box.add(p);
-  // A frame must cover pixels: at a resolution coarser than a few pixels per footprint, every
-  // frame would fall between pixel centres and the image would be empty.
+}
+
+// A frame must cover pixels: at a resolution coarser than a few pixels per footprint, every frame
+// would fall between pixel centres and the image would be empty.
+void check_resolution(const Box& robot_box, const MosaicOptions& options) {
   const double footprint_side = std::min(robot_box.x1 - robot_box.x0, robot_box.y1 - robot_box.y0);
   if (!(footprint_side / options.resolution >= kMinFootprintPixels))
     throw_invalid_argument("mosaic: the resolution " + num(options.resolution, -1) +
@@ -398,39 +389,20 @@ Mosaic build_mosaic(ocl::Runtime& runtime, io::Dataset& dataset, const Extrinsic
                            num(footprint_side, -1) + " m across): a frame would cover fewer than " +
                            std::to_string(kMinFootprintPixels) + " pixels across; give " +
                            num(footprint_side / kMinFootprintPixels, -1) + " m per pixel or finer");
-  const double spacing = options.frame_spacing != 0
-                             ? options.frame_spacing
-                             : std::min(robot_box.x1 - robot_box.x0, robot_box.y1 - robot_box.y0) / 8.0;
-  const std::vector<size_t> used = select_frames(frames, extrinsics.t_vc().head<2>(), spacing);
+}
 
-  // Each frame's poses while its rows were read (all three its pose for a global shutter); its
-  // window holds the ground seen from any of them.
-  std::vector<double> times(frames.size());
-  for (size_t k = 0; k < frames.size(); ++k) times[k] = dataset.timestamp(frames[k].frame);
-  std::vector<std::array<SE2, 3>> row_poses;
-  std::vector<Box> boxes;
-  Box all;
-  for (size_t k : used) {
-    row_poses.push_back(readout_poses(frames, times, k, cam));
-    Box b;
-    for (const SE2& pose : row_poses.back()) b.add(frame_box(fp, pose));
-    boxes.push_back(b);
-    all.add(boxes.back());
-  }
-  Mosaic m;
-  m.grid = make_grid(all, options);
-  std::vector<Window> windows;
-  for (const Box& b : boxes) windows.push_back(window_of(b, m.grid));
-
+// Each used frame warped onto its window of the mosaic and blended in (gains matched to what is
+// already there), decoded one ahead on a second thread (the only user of the data set meanwhile)
+// so that decoding overlaps the warp and the blending. The seconds spent waiting for frames.
+double warp_and_blend(ocl::Runtime& runtime, io::Dataset& dataset, const std::vector<PosedFrame>& frames,
+                      const std::vector<size_t>& used, const std::vector<std::array<SE2, 3>>& row_poses,
+                      const std::vector<Window>& windows, const WarpSetup& setup, const MosaicOptions& options,
+                      Mosaic& m) {
+  const CameraModel& cam = dataset.camera();
   MosaicWarp warp(runtime, cam.width, cam.height);
   Blender blender(m.grid, options.tile_size, windows);
   cv::Mat samples;
   double last_gain = 1.0;
-  m.stats.frames_given = static_cast<int64_t>(frames.size());
-  m.stats.frames_used = static_cast<int64_t>(used.size());
-  m.stats.gain_min = m.stats.gain_max = 1.0;
-  // Frames are decoded one ahead on a second thread (the only user of the data set meanwhile),
-  // so decoding overlaps the warp and the blending.
   double decode_seconds = 0;  // the decoding thread's, read after each get()
   const auto decode = [&](size_t k) {
     const Clock::time_point t = Clock::now();
@@ -462,10 +434,61 @@ Mosaic build_mosaic(ocl::Runtime& runtime, io::Dataset& dataset, const Extrinsic
     blender.finish_after(k, &m.stats.covered_pixels);
     m.stats.seconds_blend += seconds_since(t);
   }
-  m.stats.seconds_decode = decode_seconds;
-  if (options.progress) options.progress(1.0, "mosaic");
   m.image = blender.image();
   m.stats.peak_tile_bytes = blender.peak_bytes();
+  return decode_seconds;
+}
+
+}  // namespace
+
+Mosaic build_mosaic(ocl::Runtime& runtime, io::Dataset& dataset, const Extrinsics& extrinsics,
+                    const std::vector<PosedFrame>& frames, const MosaicOptions& options) {
+  const Clock::time_point t0 = Clock::now();
+  check_options(options);
+  if (!extrinsics.finite() || !(extrinsics.z > 0))
+    throw_invalid_argument("mosaic: the extrinsics must be finite numbers with a height z > 0");
+  if (frames.empty()) throw_invalid_input("mosaic: no poses: the trajectory is empty");
+  check_frames(dataset, frames);
+  const CameraModel& cam = dataset.camera();
+  const PixelRegion region = cam.region();
+  const double max_range = options.max_range > 0 ? options.max_range : 4.0 * extrinsics.z;
+  const WarpSetup setup =
+      make_warp_setup(cam, extrinsics, max_range, options.feather * std::min(region.width, region.height));
+  const std::vector<Eigen::Vector2d> fp = footprint(setup);
+  if (fp.empty()) throw_invalid_input("mosaic: the camera sees no ground within the range limit");
+  Box robot_box;
+  for (const Eigen::Vector2d& p : fp) robot_box.add(p);
+  check_resolution(robot_box, options);
+  const double spacing = options.frame_spacing != 0
+                             ? options.frame_spacing
+                             : std::min(robot_box.x1 - robot_box.x0, robot_box.y1 - robot_box.y0) / 8.0;
+  const std::vector<size_t> used = select_frames(frames, extrinsics.t_vc().head<2>(), spacing);
+
+  // Each frame's poses while its rows were read (all three its pose for a global shutter); its
+  // window holds the ground seen from any of them.
+  std::vector<double> times(frames.size());
+  for (size_t k = 0; k < frames.size(); ++k) times[k] = dataset.timestamp(frames[k].frame);
+  std::vector<std::array<SE2, 3>> row_poses;
+  std::vector<Box> boxes;
+  Box all;
+  for (size_t k : used) {
+    row_poses.push_back(readout_poses(frames, times, k, cam));
+    Box b;
+    for (const SE2& pose : row_poses.back()) b.add(frame_box(fp, pose));
+    boxes.push_back(b);
+    all.add(boxes.back());
+  }
+  Mosaic m;
+  m.grid = make_grid(all, options);
+  std::vector<Window> windows;
+  for (const Box& b : boxes) windows.push_back(window_of(b, m.grid));
+
+  m.stats.frames_given = static_cast<int64_t>(frames.size());
+  m.stats.frames_used = static_cast<int64_t>(used.size());
+  m.stats.gain_min = m.stats.gain_max = 1.0;
+  const double decode_seconds = warp_and_blend(runtime, dataset, frames, used, row_poses, windows, setup, options, m);
+  m.stats.seconds_decode = decode_seconds;
+  if (options.progress) options.progress(1.0, "mosaic");
   if (m.stats.covered_pixels == 0)
     throw Error(ErrorCode::Failed, "mosaic: no frame covered a pixel of the mosaic (" + std::to_string(used.size()) +
                                        " frames placed), so there is no image to write");
