@@ -63,36 +63,11 @@ void write_simulation_yaml(const std::string& path, const Options& o, const Eige
 
 }  // namespace
 
-void simulate(ocl::Runtime& runtime, const Options& options, const std::string& out_dir,
-              SimulationStats* stats) {
-  SimulationStats st;
-  auto t0 = Clock::now();
-  validate(options);
-  if (options.texture.empty()) throw_invalid_argument("simulator options: no texture given");
-  if (out_dir.empty()) throw_invalid_argument("simulate: no output directory given");
-  if (!std::filesystem::is_regular_file(options.texture))
-    throw_invalid_input(options.texture + ": no such file (the simulator's texture)");
-  const cv::Mat texture = cv::imread(options.texture, cv::IMREAD_GRAYSCALE);
-  if (texture.empty())
-    throw_invalid_input(options.texture + ": cannot be read as an image (the simulator's texture)");
+namespace {
 
-  report(options, 0.0, "setting up");
-  const Trajectory tr = generate_trajectory(options);
-  // The renderer (its kernel program) before the directory: a device that cannot have the
-  // program (e.g. no prebuilt binary of it) leaves nothing behind.
-  Renderer renderer(runtime, texture, options);
-  const std::vector<Exposure> exposure = exposure_series(options, tr.t);
-  const Lighting lighting = camera_lighting(options);
-
-  namespace fs = std::filesystem;
-  const fs::path dir(out_dir), images = dir / "images";
-  std::error_code ec;
-  fs::create_directories(images, ec);
-  if (ec || !fs::is_directory(images))
-    throw Error(ErrorCode::Io, images.string() + ": cannot create the directory (" + ec.message() + ")");
-  st.setup = seconds_since(t0);
-
-  t0 = Clock::now();
+// The data set's files besides the images: camera.yaml, the true extrinsics (and the knocked
+// ones), ground truth and odometry (TUM), direction labels, the body's attitude.
+void write_truth(const Options& options, const Trajectory& tr, const std::filesystem::path& dir) {
   CameraModel camera = options.camera;
   camera.rolling_shutter_readout = options.readout_time;
   camera.exposure_time = options.exposure_time;
@@ -128,10 +103,56 @@ void simulate(ocl::Runtime& runtime, const Options& options, const std::string& 
                     std::to_string(options.seed) + ")";
     io::write_extrinsics_yaml((dir / "extrinsics_knocked.yaml").string(), knocked);
   }
+}
+
+// One frame's PNG (compression 1: fast, lossless); Io naming the file when it cannot be written.
+void write_png(const std::string& path, const cv::Mat& image) {
+  static const std::vector<int> png = {cv::IMWRITE_PNG_COMPRESSION, 1};
+  bool ok = false;
+  try {
+    ok = cv::imwrite(path, image, png);
+  } catch (const cv::Exception& e) {
+    throw Error(ErrorCode::Io, path + ": cannot be written (" + e.err + ")");
+  }
+  if (!ok) throw Error(ErrorCode::Io, path + ": cannot be written");
+}
+
+}  // namespace
+
+void simulate(ocl::Runtime& runtime, const Options& options, const std::string& out_dir,
+              SimulationStats* stats) {
+  SimulationStats st;
+  auto t0 = Clock::now();
+  validate(options);
+  if (options.texture.empty()) throw_invalid_argument("simulator options: no texture given");
+  if (out_dir.empty()) throw_invalid_argument("simulate: no output directory given");
+  if (!std::filesystem::is_regular_file(options.texture))
+    throw_invalid_input(options.texture + ": no such file (the simulator's texture)");
+  const cv::Mat texture = cv::imread(options.texture, cv::IMREAD_GRAYSCALE);
+  if (texture.empty())
+    throw_invalid_input(options.texture + ": cannot be read as an image (the simulator's texture)");
+
+  report(options, 0.0, "setting up");
+  const Trajectory tr = generate_trajectory(options);
+  // The renderer (its kernel program) before the directory: a device that cannot have the
+  // program (e.g. no prebuilt binary of it) leaves nothing behind.
+  Renderer renderer(runtime, texture, options);
+  const std::vector<Exposure> exposure = exposure_series(options, tr.t);
+  const Lighting lighting = camera_lighting(options);
+
+  namespace fs = std::filesystem;
+  const fs::path dir(out_dir), images = dir / "images";
+  std::error_code ec;
+  fs::create_directories(images, ec);
+  if (ec || !fs::is_directory(images))
+    throw Error(ErrorCode::Io, images.string() + ": cannot create the directory (" + ec.message() + ")");
+  st.setup = seconds_since(t0);
+
+  t0 = Clock::now();
+  write_truth(options, tr, dir);
   write_simulation_yaml((dir / "simulation.yaml").string(), options, renderer.texel());
   st.write += seconds_since(t0);
 
-  const std::vector<int> png = {cv::IMWRITE_PNG_COMPRESSION, 1};
   std::vector<io::FrameEntry> frames;
   const size_t n = tr.t.size();
   for (size_t k = 0; k < n; ++k) {
@@ -149,14 +170,7 @@ void simulate(ocl::Runtime& runtime, const Options& options, const std::string& 
     t0 = Clock::now();
     char name[32];
     std::snprintf(name, sizeof name, "images/%06zu.png", k);
-    const std::string path = (dir / name).string();
-    bool ok = false;
-    try {
-      ok = cv::imwrite(path, image, png);
-    } catch (const cv::Exception& e) {
-      throw Error(ErrorCode::Io, path + ": cannot be written (" + e.err + ")");
-    }
-    if (!ok) throw Error(ErrorCode::Io, path + ": cannot be written");
+    write_png((dir / name).string(), image);
     frames.push_back({tr.t[k], name, 0});
     st.write += seconds_since(t0);
   }
