@@ -137,6 +137,73 @@ void MountingWatch::fit_lean(size_t end) {
   }
 }
 
+// One angle's judgement over the window against the history before it (test()): the window's
+// median level, the step from the history's level, its standard deviation, and whether the window
+// was steady and driven comparably enough to judge.
+MountingWatch::AngleJudgement MountingWatch::judge_angle(int angle, size_t begin) const {
+  const size_t n = samples_.size();
+  auto in_history = [&](size_t i) { return i < begin && samples_[i].t >= since_[angle]; };
+  AngleJudgement j;
+  std::vector<double> win, hist, x_win, x_hist;
+  double var_w = 0.0, var_h = 0.0;
+  for (size_t i = 0; i < n; ++i) {
+    const double var = angle == 0 ? samples_[i].var_roll : samples_[i].var_pitch;
+    const double x = angle == 0 ? samples_[i].w : samples_[i].a;
+    if (i >= begin) {
+      x_win.push_back(x);
+      win.push_back(residual(samples_[i], angle));
+      var_w += var;
+    } else if (in_history(i)) {
+      x_hist.push_back(x);
+      hist.push_back(residual(samples_[i], angle));
+      var_h += var;
+    }
+  }
+  const double med = median(win);
+  double worst = 0.0;
+  for (double r : win) worst = std::max(worst, std::abs(r - med));
+  const bool has_history = hist.size() >= 10;
+  // A window driven otherwise than the history (a turn after a straight, braking after cruising)
+  // may lean by its own drive: no level to compare with, unless the roll's slope is known.
+  const double x_spread = angle == 0 ? opt_.min_yaw_rate_spread : opt_.min_acceleration_spread;
+  const double x_base = has_history ? median(x_hist) : 0.0;
+  const bool comparable = (angle == 0 && lean_known_) || std::abs(median(x_win) - x_base) <= x_spread;
+  j.base = has_history ? median(hist) : (angle == 0 ? level_.roll : level_.pitch);
+  j.median = med;
+  j.step = med - j.base;
+  const double nw = static_cast<double>(win.size());
+  const double sw = robust_scale(win, med);
+  double var = (sw * sw + var_w / nw) / nw;
+  if (has_history) {
+    const double nh = static_cast<double>(hist.size());
+    const double sh = robust_scale(hist, j.base);
+    var += (sh * sh + var_h / nh) / nh;
+  }
+  j.sigma = std::sqrt(var);
+  j.judged = worst <= opt_.steady_tolerance && comparable;
+  j.stepped = j.judged && std::abs(j.step) >= opt_.min_step;
+  return j;
+}
+
+// When the new level began: after the last frame before the window that was still at the old one
+// (frames at neither, a bump's, are passed over).
+size_t MountingWatch::change_start(size_t begin, const bool stepped[2], const double bases[2],
+                                   const double medians[2]) const {
+  size_t first = begin;
+  int at_old = 0;  // consecutive frames at the old level (a bump passing through it is not one)
+  for (size_t i = begin; i-- > 0 && at_old < 5;) {
+    bool old = true;
+    for (int angle = 0; angle < 2; ++angle)
+      if (stepped[angle] && (samples_[i].t < since_[angle] ||
+                             std::abs(residual(samples_[i], angle) - bases[angle]) > opt_.steady_tolerance))
+        old = false;
+    at_old = old ? at_old + 1 : 0;
+    const int a = stepped[0] ? 0 : 1;
+    if (std::abs(residual(samples_[i], a) - medians[a]) <= opt_.steady_tolerance) first = i;
+  }
+  return first;
+}
+
 std::optional<MountingChange> MountingWatch::test() {
   // The window: the most recent samples over window_metres and window_seconds.
   const Sample& last = samples_.back();
@@ -154,69 +221,23 @@ std::optional<MountingChange> MountingWatch::test() {
   }
   fit_lean(begin);
 
-  const size_t n = samples_.size();
-  auto in_history = [&](size_t i, int angle) { return i < begin && samples_[i].t >= since_[angle]; };
   MountingChange change;
   bool stepped[2] = {false, false};  // held a new level by min_step at least
   bool judged[2] = {false, false};   // steady and comparable: its step is measured
   double steps[2] = {0.0, 0.0}, medians[2] = {0.0, 0.0}, bases[2] = {0.0, 0.0};
   for (int angle = 0; angle < 2; ++angle) {
-    std::vector<double> win, hist, x_win, x_hist;
-    double var_w = 0.0, var_h = 0.0;
-    for (size_t i = 0; i < n; ++i) {
-      const double var = angle == 0 ? samples_[i].var_roll : samples_[i].var_pitch;
-      const double x = angle == 0 ? samples_[i].w : samples_[i].a;
-      if (i >= begin) {
-        x_win.push_back(x);
-        win.push_back(residual(samples_[i], angle));
-        var_w += var;
-      } else if (in_history(i, angle)) {
-        x_hist.push_back(x);
-        hist.push_back(residual(samples_[i], angle));
-        var_h += var;
-      }
-    }
-    const double med = median(win);
-    double worst = 0.0;
-    for (double r : win) worst = std::max(worst, std::abs(r - med));
-    const bool has_history = hist.size() >= 10;
-    // A window driven otherwise than the history (a turn after a straight, braking after cruising)
-    // may lean by its own drive: no level to compare with, unless the roll's slope is known.
-    const double x_spread = angle == 0 ? opt_.min_yaw_rate_spread : opt_.min_acceleration_spread;
-    const double x_base = has_history ? median(x_hist) : 0.0;
-    const bool comparable = (angle == 0 && lean_known_) || std::abs(median(x_win) - x_base) <= x_spread;
-    bases[angle] = has_history ? median(hist) : (angle == 0 ? level_.roll : level_.pitch);
-    medians[angle] = med;
-    steps[angle] = med - bases[angle];
-    const double nw = static_cast<double>(win.size());
-    const double sw = robust_scale(win, med);
-    double var = (sw * sw + var_w / nw) / nw;
-    if (has_history) {
-      const double nh = static_cast<double>(hist.size());
-      const double sh = robust_scale(hist, bases[angle]);
-      var += (sh * sh + var_h / nh) / nh;
-    }
-    change.sigma(angle) = std::sqrt(var);
-    judged[angle] = worst <= opt_.steady_tolerance && comparable;
-    stepped[angle] = judged[angle] && std::abs(steps[angle]) >= opt_.min_step;
+    const AngleJudgement j = judge_angle(angle, begin);
+    bases[angle] = j.base;
+    medians[angle] = j.median;
+    steps[angle] = j.step;
+    change.sigma(angle) = j.sigma;
+    judged[angle] = j.judged;
+    stepped[angle] = j.stepped;
   }
   if (std::optional<MountingChange> r = refine(begin, judged, medians, change.sigma)) return r;
   if (!stepped[0] && !stepped[1]) return test_height(bases);
 
-  // When the new level began: after the last frame before the window that was still at the old one
-  // (frames at neither, a bump's, are passed over).
-  size_t first = begin;
-  int at_old = 0;  // consecutive frames at the old level (a bump passing through it is not one)
-  for (size_t i = begin; i-- > 0 && at_old < 5;) {
-    bool old = true;
-    for (int angle = 0; angle < 2; ++angle)
-      if (stepped[angle] && (samples_[i].t < since_[angle] ||
-                             std::abs(residual(samples_[i], angle) - bases[angle]) > opt_.steady_tolerance))
-        old = false;
-    at_old = old ? at_old + 1 : 0;
-    const int a = stepped[0] ? 0 : 1;
-    if (std::abs(residual(samples_[i], a) - medians[a]) <= opt_.steady_tolerance) first = i;
-  }
+  const size_t first = change_start(begin, stepped, bases, medians);
   change.time = samples_[first].t;
   change.detected_time = last.t;
   last_bases_[0] = bases[0];

@@ -119,6 +119,13 @@ class MountingWatch {
   };
   void fit_lean(size_t end);
   std::optional<MountingChange> test();
+  struct AngleJudgement {
+    double base = 0.0, median = 0.0, step = 0.0, sigma = 0.0;
+    bool judged = false;   // steady and comparable: its step is measured
+    bool stepped = false;  // held a new level by min_step at least
+  };
+  AngleJudgement judge_angle(int angle, size_t begin) const;
+  size_t change_start(size_t begin, const bool stepped[2], const double bases[2], const double medians[2]) const;
   std::optional<MountingChange> test_height(const double levels[2]);
   // An attitude change's yaw: the window [begin, end) against the history before `first`.
   void measure_yaw(size_t begin, size_t first, MountingChange* change) const;
