@@ -301,6 +301,46 @@ int cmd_info(int argc, char** argv) {
   return kExitOk;
 }
 
+namespace {
+
+// The demo's accuracy table: the simulated wheel odometry's and the tracker's against ground truth.
+void print_demo_accuracy(const DriveSummary& s, const TrackRun& run, double odometry_noise) {
+  std::printf("\n   accuracy against ground truth       end-point error     heading error   per-frame RMS\n");
+  if (s.has_odometry)
+    std::printf("   wheel odometry (simulated, %2.0f%%)   %8.2f mm (%5.3f%%) %9.3f deg %11.4f mm\n",
+                odometry_noise * 100, s.odo_end_error * 1e3, 100 * s.odo_end_error / std::max(s.distance, 1e-9),
+                s.odo_heading_error / kDeg, s.odo_rms_step * 1e3);
+  if (run.has_accuracy) {
+    const planarvo_motion_accuracy& a = run.accuracy;
+    std::printf("   visual odometry (planarvo)          %8.2f mm (%5.3f%%) %9.3f deg %11.4f mm\n",
+                a.endpoint_error * 1e3, 100 * a.endpoint_drift, a.endpoint_heading / kDeg, a.rms_translation * 1e3);
+    std::printf("   visual odometry velocity slopes: linear %.4f, angular %.4f; gross errors (> 1 mm): %d\n",
+                a.slope_linear, a.slope_angular, a.gross_errors);
+  }
+
+}
+
+// The demo's calibration table: each parameter estimated, true, its error and sigma.
+void print_demo_calibration(planarvo_status cs, const planarvo_camera_calibration_result& cr,
+                            const planarvo_extrinsics& truth) {
+  if (cs == PLANARVO_ERROR_FAILED) {
+    std::printf("   not determined: %s\n", cr.reason);
+  } else {
+    const planarvo_extrinsics& t = truth;
+    const planarvo_extrinsics& e = cr.extrinsics;
+    const double est[6] = {e.x, e.y, e.z, e.roll, e.pitch, e.yaw}, tru[6] = {t.x, t.y, t.z, t.roll, t.pitch, t.yaw};
+    std::printf("   %-6s %12s %12s %10s %10s\n", "", "estimated", "true", "error", "sigma");
+    for (int i = 0; i < 6; ++i) {
+      const double k = i < 3 ? 1e3 : 1 / kDeg;
+      std::printf("   %-6s %8.3f %-3s %8.3f %-3s %10.3f %10.3f\n", planarvo_extrinsics_name(i), est[i] * k, i < 3 ? "mm" : "deg",
+                  tru[i] * k, i < 3 ? "mm" : "deg", std::remainder(est[i] - tru[i], 2 * M_PI) * k,
+                  std::sqrt(std::max(0.0, cr.covariance[i * 7])) * k);
+    }
+  }
+}
+
+}  // namespace
+
 int cmd_demo(int argc, char** argv) {
   std::vector<OptionSpec> specs = simulate_options();
   specs.erase(std::remove_if(specs.begin(), specs.end(), [](const OptionSpec& s) { return s.name == "out"; }),
@@ -363,18 +403,7 @@ int cmd_demo(int argc, char** argv) {
               seconds_since(t0), static_cast<long long>(run.ok), static_cast<long long>(run.degraded),
               static_cast<long long>(run.lost), run.engine_ms / static_cast<double>(std::max<int64_t>(run.frames, 1)),
               1000.0 * static_cast<double>(run.frames) / run.engine_ms);
-  std::printf("\n   accuracy against ground truth       end-point error     heading error   per-frame RMS\n");
-  if (s.has_odometry)
-    std::printf("   wheel odometry (simulated, %2.0f%%)   %8.2f mm (%5.3f%%) %9.3f deg %11.4f mm\n",
-                o.odometry_noise * 100, s.odo_end_error * 1e3, 100 * s.odo_end_error / std::max(s.distance, 1e-9),
-                s.odo_heading_error / kDeg, s.odo_rms_step * 1e3);
-  if (run.has_accuracy) {
-    const planarvo_motion_accuracy& a = run.accuracy;
-    std::printf("   visual odometry (planarvo)          %8.2f mm (%5.3f%%) %9.3f deg %11.4f mm\n",
-                a.endpoint_error * 1e3, 100 * a.endpoint_drift, a.endpoint_heading / kDeg, a.rms_translation * 1e3);
-    std::printf("   visual odometry velocity slopes: linear %.4f, angular %.4f; gross errors (> 1 mm): %d\n",
-                a.slope_linear, a.slope_angular, a.gross_errors);
-  }
+  print_demo_accuracy(s, run, o.odometry_noise);
 
   // 5. The camera's calibration from the images and the wheel odometry alone.
   t0 = std::chrono::steady_clock::now();
@@ -384,20 +413,7 @@ int cmd_demo(int argc, char** argv) {
   const planarvo_status cs = calibrate_dataset(ctx.get(), ds.get(), &co, &progress, &cr);
   std::printf("\n5. calibrated the camera from the images and the wheel odometry in %.1f s (planarvo calibrate):\n",
               seconds_since(t0));
-  if (cs == PLANARVO_ERROR_FAILED) {
-    std::printf("   not determined: %s\n", cr.reason);
-  } else {
-    const planarvo_extrinsics& t = info.extrinsics_gt;
-    const planarvo_extrinsics& e = cr.extrinsics;
-    const double est[6] = {e.x, e.y, e.z, e.roll, e.pitch, e.yaw}, tru[6] = {t.x, t.y, t.z, t.roll, t.pitch, t.yaw};
-    std::printf("   %-6s %12s %12s %10s %10s\n", "", "estimated", "true", "error", "sigma");
-    for (int i = 0; i < 6; ++i) {
-      const double k = i < 3 ? 1e3 : 1 / kDeg;
-      std::printf("   %-6s %8.3f %-3s %8.3f %-3s %10.3f %10.3f\n", planarvo_extrinsics_name(i), est[i] * k, i < 3 ? "mm" : "deg",
-                  tru[i] * k, i < 3 ? "mm" : "deg", std::remainder(est[i] - tru[i], 2 * M_PI) * k,
-                  std::sqrt(std::max(0.0, cr.covariance[i * 7])) * k);
-    }
-  }
+  print_demo_calibration(cs, cr, info.extrinsics_gt);
   std::printf("\nLook at the frames in %s/images; `planarvo info %s` describes the data set.\n", out.c_str(),
               out.c_str());
   return kExitOk;
