@@ -50,7 +50,7 @@ struct AlignerOptions {
   // the level below A on every pixel; 0: stop at A. When the level below A is subsampled, A is
   // too, on one pixel per auto_coarse_block x auto_coarse_block block (2: at 640x480 level 1 at
   // 1/4 with level 2 as its prior: that pass in 0.64 of the time, the frame 9-10 % faster, the
-  // same per-frame RMS on the benchmark's scenes; src/track/README.md, "Speed (issue 28 ...)");
+  // same per-frame RMS on the benchmark's scenes; test/bench/results/track.md, "Speed (issue 28 ...)");
   // 0 or 1: A on every pixel.
   int finest_level = -1;
   int min_finest_width = 320;

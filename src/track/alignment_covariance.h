@@ -1,4 +1,4 @@
-// The covariance of a tracked alignment (src/track/README.md, "Covariance"): the M-estimator's
+// The covariance of a tracked alignment (src/track/README.md, "The tracker"; its measured NEES: test/bench/results/track.md): the M-estimator's
 // sandwich from the fused pass's sums, with the scores clustered over neighbouring pixels, plus
 // the part of the last, unchecked Gauss-Newton step the estimate is still off by.
 #pragma once

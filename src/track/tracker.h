@@ -75,7 +75,7 @@ struct TrackerOptions : AlignerOptions {
   // measure 0.2-0.55 on the simulator, frames held by the light 0.85-1.1 (src/track/README.md,
   // "Honest status under the camera's own light"). Infinite: not measured (no cost).
   double max_texture_residual = 0.7;
-  // Covariance (src/track/README.md, "Covariance"). The alignment's is the M-estimator's
+  // Covariance (src/track/README.md, "The tracker"; its measured NEES: test/bench/results/track.md). The alignment's is the M-estimator's
   // sandwich B^-1 M B^-1 (B: J^T J over the Huber inliers, M: the scores' outer product over
   // clusters of neighbouring pixels, ReduceSums::score_outer) plus (f delta)(f delta)^T, delta
   // the finest level's last Gauss-Newton step, f = covariance_step_fraction: that step is

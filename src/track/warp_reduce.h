@@ -154,7 +154,7 @@ struct WarpReduceOptions {
   // nearest cluster_width pixels, and as many rows of them as come nearest 1 / cluster_bands of
   // the level's height (a fixed share of the view, so a fixed patch of ground at every level and
   // image size: 128 x 60 pixels at 640 x 480, 128 x 30 at 320 x 240; measured in
-  // src/track/README.md, "Covariance (simulator)").
+  // test/bench/results/track.md, "Covariance (simulator)").
   int cluster_width = 128, cluster_bands = 8;
 };
 

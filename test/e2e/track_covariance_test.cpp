@@ -2,7 +2,7 @@
 // simulated sequences (5 s at 320x240, mixed motion up to 0.8 m/s and 1.5 rad/s, noise 1 grey
 // level, gain drift, lens distortion), tracked through the camera-frame API: the mean NEES of
 // the frame-to-frame motions with FrameResult::motion.covariance must be that of a covariance
-// that is right (3 for three parameters; src/track/README.md, "Covariance (simulator)":
+// that is right (3 for three parameters; test/bench/results/track.md, "Covariance (simulator)":
 // 1.6-6.6 per 5-s sequence over 48 sequences, 3.2 on average), not that of independent pixels
 // (8.6-217). Observed: 2.50 and 3.45, pooled 2.97.
 #include <cmath>
