@@ -735,6 +735,36 @@ PLANARVO_API void planarvo_calibration_options_init(planarvo_calibration_options
 PLANARVO_API planarvo_status planarvo_calibrate(const planarvo_motion_pair* pairs, size_t count,
                                                 const planarvo_calibration_options* options,
                                                 planarvo_calibration_result* result);
+/* A motion pair's residual at the calibration's estimate, as the odometry method weighs it: the
+ * robot's motion between the pair's poses eliminated exactly, d = the odometry's (x, y, theta) less
+ * the sensor's motion mapped into the robot frame (robot frame at the interval's start; m, m, rad,
+ * the angle wrapped), with the covariance the calibration gave it (the odometry's, fitted or the
+ * model's, plus the sensor's carried into the robot frame) and chi2 = d^T covariance^-1 d. Summed
+ * over the pairs, the solver's chi2 at the estimate. */
+typedef struct planarvo_pair_residual {
+  int32_t has_odometry;   /* 0: the pair has no odometry (d, covariance and chi2 are 0) */
+  int32_t outlier;        /* gated out as a gross error (its sensor motion not used) */
+  double d[3];
+  double covariance[9];   /* row-major */
+  double chi2;
+} planarvo_pair_residual;
+
+/* The wheel odometry's noise model the calibration used for pairs without a covariance of their
+ * own: fitted to its residuals (estimate_odometry_noise), or not. Variance of component c (x along
+ * the motion's start frame, y, theta): variance[3c] + variance[3c + 1] |t|^2 + variance[3c + 2]
+ * theta^2 (m^2, m^2 per m^2 of travel, per rad^2 of turn; rad^2 ... for theta). */
+typedef struct planarvo_odometry_noise {
+  int32_t fitted;         /* 0: the options' odometry_sigma_* model was used (variance all 0 here) */
+  double variance[9];
+} planarvo_odometry_noise;
+
+/* planarvo_calibrate, and what plots draw: per pair its residual at the estimate (residuals: count
+ * elements, or NULL) and the odometry's noise model (noise, or NULL). */
+PLANARVO_API planarvo_status planarvo_calibrate_residuals(const planarvo_motion_pair* pairs, size_t count,
+                                                          const planarvo_calibration_options* options,
+                                                          planarvo_calibration_result* result,
+                                                          planarvo_pair_residual* residuals,
+                                                          planarvo_odometry_noise* noise);
 /* Writes a motion-pair calibration as extrinsics.yaml (docs/formats.md): x, y, yaw and z = the
  * scale (the camera height), with their covariance and which were estimated; with metric_sensor
  * non-zero (the pairs' sensor measured metres, e.g. a laser scan matcher) z is 0, not estimated.

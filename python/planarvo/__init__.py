@@ -12,8 +12,8 @@ The library: $PLANARVO_LIBRARY, else the one installed beside this package, else
 (see python/README.md). Every failed call raises planarvo.Error; invalid Python input raises
 ValueError before any C call. Units: metres, radians, seconds (docs/conventions.md).
 """
-from ._calibration import (CalibrationMethod, CalibrationOptions, CalibrationResult, RobustLoss, calibrate,
-                           compose_extrinsics)
+from ._calibration import (CalibrationMethod, CalibrationOptions, CalibrationResult, PairResiduals, RobustLoss,
+                           calibrate, calibrate_residuals, compose_extrinsics)
 from ._camera import EXTRINSICS_NAMES, Camera, Extrinsics
 from ._camera_calibration import (CalibrationStatus, CameraCalibrationOptions, CameraCalibrationResult,
                                   CameraCalibrator, ReadoutSource, RollPitch, RollPitchOptions, RollPitchResult,
@@ -39,6 +39,6 @@ __all__ = ["EXTRINSICS_NAMES", "CalibrationMethod", "CalibrationOptions", "Calib
     "Mosaic", "MosaicInfo", "MotionPair", "MotionProfile", "MountingChange", "MountingResponse", "PosegraphInit", "ReadoutSource", "Residuals", "RobustLoss", "RollPitch",
     "RollPitchOptions",
     "RollPitchResult", "SE2", "SimOptions", "SolverSummary", "StatsWriter", "Status", "Tracker",
-    "TrackerOptions", "TrackResult", "TrackStatus", "bag_topics", "calibrate", "calibrate_dataset", "compose_extrinsics",
+    "TrackerOptions", "TrackResult", "TrackStatus", "bag_topics", "calibrate", "calibrate_dataset", "calibrate_residuals", "PairResiduals", "compose_extrinsics",
     "build_mosaic", "default_texture", "evaluate_motions", "list_devices", "load_motion_pairs", "posegraph_optimize", "read_tum",
     "save_motion_pairs", "simulate", "track_motions", "version", "write_tum"]

@@ -11,7 +11,7 @@ import numpy as np
 
 from . import _native as N
 from ._camera import Extrinsics
-from ._errors import _check
+from ._errors import Status, _check
 from ._motion_pairs import MotionPair, _pairs_array
 from ._native import lib
 from ._posegraph import SolverSummary
@@ -129,6 +129,52 @@ def calibrate(pairs: Sequence[MotionPair], options: Optional[CalibrationOptions]
     result = CalibrationResult._from_c(r)
     _check(status, result)
     return result
+
+
+@dataclass
+class PairResiduals:
+    """Each pair's residual at a calibration's estimate, as the library weighs it (the odometry
+    method: the robot's motion eliminated): d (N, 3) the odometry's motion less the sensor's
+    mapped into the robot frame (m, m, rad), cov (N, 3, 3) its covariance, chi2 (N,), outlier (N,)
+    gated out as a gross error, has_odometry (N,); normalised (N, 3) each component of d over its
+    own standard deviation. odometry_noise: (3, 3) the fitted model's variance coefficients per
+    component (constant, per m^2 of travel, per rad^2 of turn), None when the options' model was
+    used."""
+    d: np.ndarray
+    cov: np.ndarray
+    chi2: np.ndarray
+    outlier: np.ndarray
+    has_odometry: np.ndarray
+    odometry_noise: Optional[np.ndarray]
+
+    @property
+    def normalised(self) -> np.ndarray:
+        return self.d / np.sqrt(np.maximum(np.einsum("nii->ni", self.cov), 1e-300))
+
+
+def calibrate_residuals(pairs: Sequence[MotionPair], options: Optional[CalibrationOptions] = None
+                        ) -> Tuple[CalibrationResult, PairResiduals]:
+    """calibrate(), and each pair's residual at the estimate with the odometry's noise model
+    (planarvo_calibrate_residuals): what the calibration plots draw. The result is returned
+    whether or not it is ok (check .ok)."""
+    if not pairs:
+        raise ValueError("calibrate_residuals: no motion pairs")
+    o = _calibration_options(options, None)
+    r = N.sized(N.CalibrationResult)
+    res = (N.PairResidual * len(pairs))()
+    noise = N.OdometryNoise()
+    status = lib.planarvo_calibrate_residuals(_pairs_array(pairs), len(pairs), ctypes.byref(o), ctypes.byref(r), res,
+                                              ctypes.byref(noise))
+    result = CalibrationResult._from_c(r)
+    if status != Status.FAILED:  # a calibration that is not ok still fills the result and the residuals
+        _check(status, result)
+    n = len(pairs)
+    residuals = PairResiduals(np.array([list(p.d) for p in res]).reshape(n, 3),
+                              np.array([list(p.covariance) for p in res]).reshape(n, 3, 3),
+                              np.array([p.chi2 for p in res]), np.array([bool(p.outlier) for p in res]),
+                              np.array([bool(p.has_odometry) for p in res]),
+                              np.array(noise.variance[:]).reshape(3, 3) if noise.fitted else None)
+    return result, residuals
 
 
 def compose_extrinsics(roll: float, pitch: float, roll_pitch_covariance: Optional[np.ndarray],

@@ -168,6 +168,15 @@ class CalibrationResult(ctypes.Structure):
                 ("variance_factor", c_double)]
 
 
+class PairResidual(ctypes.Structure):
+    _fields_ = [("has_odometry", c_int32), ("outlier", c_int32), ("d", c_double * 3), ("covariance", c_double * 9),
+                ("chi2", c_double)]
+
+
+class OdometryNoise(ctypes.Structure):
+    _fields_ = [("fitted", c_int32), ("variance", c_double * 9)]
+
+
 class RollPitchOptions(ctypes.Structure):
     _fields_ = [("struct_size", c_size_t), ("initial_roll", c_double), ("initial_pitch", c_double),
                 ("max_frames", c_int32), ("min_keyframes", c_int32), ("max_keyframes", c_int32),
@@ -284,6 +293,8 @@ _SIGNATURES = {
     "planarvo_motion_pairs_load": (S, [c_char_p, P(MotionPair), c_size_t, P(c_size_t)]),
     "planarvo_calibration_options_init": (None, [P(CalibrationOptions)]),
     "planarvo_calibrate": (S, [P(MotionPair), c_size_t, P(CalibrationOptions), P(CalibrationResult)]),
+    "planarvo_calibrate_residuals": (S, [P(MotionPair), c_size_t, P(CalibrationOptions), P(CalibrationResult),
+                                         P(PairResidual), P(OdometryNoise)]),
     "planarvo_calibration_save": (S, [c_char_p, P(CalibrationResult), c_enum, c_int32, c_char_p]),
     "planarvo_roll_pitch_options_init": (None, [P(RollPitchOptions)]),
     "planarvo_roll_pitch_create": (S, [c_void_p, P(Camera), P(RollPitchOptions), P(c_void_p)]),

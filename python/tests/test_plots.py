@@ -11,7 +11,7 @@ import pytest
 pytest.importorskip("matplotlib")
 
 import planarvo  # noqa: E402
-from planarvo.plot import _io, _motion, _residuals  # noqa: E402
+from planarvo.plot import _io, _motion  # noqa: E402
 
 from conftest import true_motions  # noqa: E402
 
@@ -193,20 +193,13 @@ def synthetic_pairs(z, n, rng, noise):
     return pairs
 
 
-def arrays(pairs):
-    odo = np.array([[p.odometry.x, p.odometry.y, p.odometry.theta] for p in pairs])
-    sen = np.array([[p.sensor.x, p.sensor.y, p.sensor.theta] for p in pairs])
-    return odo, sen
-
-
 def test_residuals_vanish_on_noise_free_pairs_at_the_true_values():
     z = (0.25, -0.02, 0.18, -0.16)
-    odo, sen = arrays(synthetic_pairs(z, 50, np.random.default_rng(1), 0.0))
-    eye = np.tile(np.eye(3) * 1e-6, (50, 1, 1))
-    res = _residuals.pair_residuals(odo, sen, z, eye, eye)
-    assert np.abs(res.d).max() < 1e-12
-    res = _residuals.pair_residuals(odo, sen, (0.26, -0.02, 0.18, -0.16), eye, eye)
-    assert np.abs(res.d).max() > 1e-4             # and do not vanish elsewhere
+    pairs = synthetic_pairs(z, 50, np.random.default_rng(1), 0.0)
+    result, res = planarvo.calibrate_residuals(pairs)
+    np.testing.assert_allclose(result.value, z, atol=1e-9)
+    assert res.has_odometry.all() and not res.outlier.any()
+    assert np.abs(res.d).max() < 1e-9
 
 
 def test_residual_chi2_is_the_solvers_at_its_least_squares_optimum():
@@ -214,16 +207,21 @@ def test_residual_chi2_is_the_solvers_at_its_least_squares_optimum():
     z = (0.25, -0.02, 0.18, -0.16)
     pairs = synthetic_pairs(z, 300, np.random.default_rng(2), np.array([3e-4, 1e-4, 1e-3]))
     options = planarvo.CalibrationOptions(loss=planarvo.RobustLoss.NONE, gate_sigma=0.0)
-    result = planarvo.calibrate(pairs, options)
-    odo, sen = arrays(pairs)
-    s_cov, o_cov, fit = C.covariances(pairs, options, odo, sen)
-    assert not fit
-    res = _residuals.pair_residuals(odo, sen, result.value, o_cov, s_cov)
+    result, res = planarvo.calibrate_residuals(pairs, options)
+    assert res.odometry_noise is None  # motion pairs given: the options' model, not fitted
     # final_chi2 is the sum of e' Omega e over the factors at the optimum (planarvo.h).
     assert res.chi2.sum() == pytest.approx(result.summary.final_chi2, rel=1e-6)
-    # Moving off the optimum raises it.
-    off = np.array(result.value) + np.array([1e-3, 0, 0, 0])
-    assert _residuals.pair_residuals(odo, sen, off, o_cov, s_cov).chi2.sum() > res.chi2.sum() + 1.0
+    # Each pair's chi2 is its d over its covariance.
+    chi2 = np.einsum("ni,ni->n", res.d, np.linalg.solve(res.cov, res.d[:, :, None])[:, :, 0])
+    np.testing.assert_allclose(res.chi2, chi2, rtol=1e-9)
+    # The plots draw the library's values.
+    data = C.CalibrationData("test", pairs, options, False)
+    C.residuals(data)
+    np.testing.assert_array_equal(data.residuals.chi2, res.chi2)
+    # With the odometry's noise fitted, the model comes back.
+    fitted, res_fit = planarvo.calibrate_residuals(pairs, planarvo.CalibrationOptions(estimate_odometry_noise=True))
+    assert res_fit.odometry_noise is not None and res_fit.odometry_noise.shape == (3, 3)
+    assert (res_fit.odometry_noise >= 0).all()
 
 
 def test_mosaic_figure_reads_the_map_yaml_and_draws_each_mosaic(tmp_path):

@@ -114,6 +114,39 @@ size_t motion_pair_stride(const planarvo_motion_pair* pairs) {
 }
 
 // Pair i of the caller's array as a sample: fields beyond its struct_size take their defaults.
+// Each pair's residual at the estimate and whether it was gated out (planarvo_pair_residual).
+void residuals_to_c(const planarvo::graph::CalibrationResult& r, size_t count, planarvo_pair_residual* out) {
+  std::vector<char> outlier(count, 0);
+  for (int k : r.outlier_samples) outlier.at(static_cast<size_t>(k)) = 1;
+  for (size_t i = 0; i < count; ++i) {
+    planarvo_pair_residual o;
+    std::memset(&o, 0, sizeof o);
+    o.outlier = outlier[i];
+    if (i < r.residuals.size() && r.residuals[i]) {
+      const planarvo::graph::PairResidual& p = *r.residuals[i];
+      o.has_odometry = 1;
+      for (int k = 0; k < 3; ++k) o.d[k] = p.d[k];
+      planarvo::capi::matrix_to_c<3>(p.covariance, o.covariance);
+      o.chi2 = p.chi2;
+    }
+    out[i] = o;
+  }
+}
+
+void odometry_noise_to_c(const planarvo::graph::CalibrationResult& r, planarvo_odometry_noise* out) {
+  planarvo_odometry_noise o;
+  std::memset(&o, 0, sizeof o);
+  if (r.odometry_noise) {
+    o.fitted = 1;
+    for (int c = 0; c < 3; ++c) {
+      o.variance[c * 3 + 0] = r.odometry_noise->constant[c];
+      o.variance[c * 3 + 1] = r.odometry_noise->per_translation[c];
+      o.variance[c * 3 + 2] = r.odometry_noise->per_rotation[c];
+    }
+  }
+  *out = o;
+}
+
 planarvo::graph::MotionSample read_pair(const planarvo_motion_pair* pairs, size_t stride, size_t i) {
   planarvo_motion_pair p;
   planarvo_motion_pair_init(&p);
@@ -344,6 +377,14 @@ PLANARVO_API void planarvo_calibration_options_init(planarvo_calibration_options
 PLANARVO_API planarvo_status planarvo_calibrate(const planarvo_motion_pair* pairs, size_t count,
                                                 const planarvo_calibration_options* options,
                                                 planarvo_calibration_result* result) {
+  return planarvo_calibrate_residuals(pairs, count, options, result, nullptr, nullptr);
+}
+
+PLANARVO_API planarvo_status planarvo_calibrate_residuals(const planarvo_motion_pair* pairs, size_t count,
+                                                          const planarvo_calibration_options* options,
+                                                          planarvo_calibration_result* result,
+                                                          planarvo_pair_residual* residuals,
+                                                          planarvo_odometry_noise* noise) {
   bool ok = true;
   std::string reason;
   const planarvo_status st = guard([&] {
@@ -360,6 +401,8 @@ PLANARVO_API planarvo_status planarvo_calibrate(const planarvo_motion_pair* pair
     send_lines(o.log, o.log_user_data, r.summary.full_report());
     const planarvo_calibration_result out = planarvo::capi::calibration_result_to_c(r);
     planarvo::capi::write_versioned(out, result);
+    if (residuals) residuals_to_c(r, count, residuals);
+    if (noise) odometry_noise_to_c(r, noise);
     ok = r.ok();
     reason = r.ambiguous ? std::string("ambiguous: (x, yaw) and (-x, yaw + 180 deg) fit equally; give direction "
                                        "labels or odometry")

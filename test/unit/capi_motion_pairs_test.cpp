@@ -340,6 +340,57 @@ TEST(CApiCalibrateKnownAnswer, NoisyMotionsGiveTheTruthWithinTheReportedSigma) {
   }
 }
 
+// What plots draw, from the library: each pair's residual at the estimate, whose chi2 over the
+// pairs the final solve kept is the solver's own chi2 (the robot's motion eliminated exactly,
+// pair_residuals.h), the gated pairs flagged as the result counts them, and the odometry's noise
+// model, fitted only when asked.
+TEST(CApiCalibrateKnownAnswer, ResidualsAreThePairsShareOfTheFinalChi2) {
+  CalibrationSim sim;
+  sim.seed = 21;
+  sim.sensor_sigma_t = 0.002 / kTruth[2];
+  sim.sensor_sigma_theta = 0.002;
+  sim.odometry_sigma_t = 0.002;
+  sim.odometry_sigma_theta = 0.002;
+  sim.outlier_fraction = 0.02;
+  const auto pairs = simulated_pairs(sim);
+  planarvo_calibration_result r{};
+  r.struct_size = sizeof r;
+  std::vector<planarvo_pair_residual> res(pairs.size());
+  planarvo_odometry_noise noise{};
+  ASSERT_EQ(planarvo_calibrate_residuals(pairs.data(), pairs.size(), nullptr, &r, res.data(), &noise), PLANARVO_OK)
+      << planarvo_last_error();
+  const planarvo_calibration_result plain = calibrate(pairs, nullptr);
+  EXPECT_EQ(std::memcmp(plain.value, r.value, sizeof r.value), 0);  // the same calibration
+  double chi2 = 0.0;
+  int outliers = 0;
+  for (const planarvo_pair_residual& p : res) {
+    ASSERT_EQ(p.has_odometry, 1);
+    outliers += p.outlier;
+    if (!p.outlier) chi2 += p.chi2;
+  }
+  EXPECT_EQ(outliers, r.outliers);
+  EXPECT_GT(outliers, 0);
+  EXPECT_NEAR(chi2, r.summary.final_chi2, 1e-6 * r.summary.final_chi2);
+  EXPECT_EQ(noise.fitted, 0);  // the pairs carry their covariances
+
+  // Odometry without covariances, its model fitted to the residuals when asked.
+  CalibrationSim bare = sim;
+  bare.odometry_sigma_t = bare.odometry_sigma_theta = 0.0;
+  bare.outlier_fraction = 0.0;
+  const auto bare_pairs = simulated_pairs(bare);
+  planarvo_calibration_options o;
+  planarvo_calibration_options_init(&o);
+  for (int fit = 0; fit < 2; ++fit) {
+    o.estimate_odometry_noise = fit;
+    planarvo_calibration_result rb{};
+    rb.struct_size = sizeof rb;
+    planarvo_odometry_noise nb{};
+    ASSERT_EQ(planarvo_calibrate_residuals(bare_pairs.data(), bare_pairs.size(), &o, &rb, nullptr, &nb), PLANARVO_OK)
+        << planarvo_last_error();
+    EXPECT_EQ(nb.fitted, fit);
+  }
+}
+
 // Drives that do not determine the answer: PLANARVO_ERROR_FAILED, the reason as the message and
 // in the result, the result filled in.
 TEST(CApiCalibrateKnownAnswer, UnobservableDrivesAreFailedWithTheReason) {

@@ -11,6 +11,7 @@
 
 #include "graph/solver/covariance.h"
 #include "graph/calibration/factors.h"
+#include "graph/calibration/pair_residuals.h"
 #include "graph/posegraph/factors.h"
 #include "graph/solver/solver.h"
 
@@ -119,6 +120,55 @@ TEST(GraphCalibration, TurningInPlaceMakesYObservable) {
   ASSERT_TRUE(solve(g).converged());
   EXPECT_NEAR(g.vector(z)[CI::kY], truth[CI::kY], 3e-3);
   EXPECT_NEAR(g.vector(z)[CI::kX], truth[CI::kX], 3e-3);
+}
+
+}  // namespace
+}  // namespace planarvo::graph
+
+namespace planarvo::graph {
+namespace {
+
+// A pair's residual (pair_residuals.h) is the minimum over the robot's free motion of the two
+// factors' χ² (the odometry factor, eq. 25, and the sensor factor, eq. 26), which the solver finds
+// on a two-pose graph with z held: the same χ², whatever the motions, noise models and z.
+TEST(GraphPairResidual, IsTheTwoFactorGraphsMinimumWithTheMotionFree) {
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  auto rot3 = [](double t) {
+    Eigen::Matrix3d A = Eigen::Matrix3d::Identity();
+    A.topLeftCorner<2, 2>() << std::cos(t), -std::sin(t), std::sin(t), std::cos(t);
+    return A;
+  };
+  auto spd = [&](double scale) {
+    Eigen::Matrix3d B;
+    for (int i = 0; i < 9; ++i) B(i / 3, i % 3) = u(rng);
+    return Eigen::Matrix3d(scale * scale * (B * B.transpose() + 0.2 * Eigen::Matrix3d::Identity()));
+  };
+  for (int trial = 0; trial < 20; ++trial) {
+    const Eigen::Vector4d z(0.3 * u(rng), 0.2 * u(rng), 0.15 + 0.1 * std::abs(u(rng)), 3.0 * u(rng));
+    const SE2 sensor(0.5 * u(rng), 0.2 * u(rng), 0.6 * u(rng));
+    const SE2 truth = sensor_to_robot_motion(sensor, z.data());
+    const SE2 odometry = truth * SE2(0.01 * u(rng), 0.01 * u(rng), 0.02 * u(rng));
+    const Eigen::Matrix3d C_o = spd(0.01), C_s = spd(0.005);  // of the right perturbations
+
+    FactorGraph g;
+    const VariableId zv = g.add_vector(z, "z", calibration_parameter_names());
+    g.set_fixed(zv);
+    const VariableId a = g.add_pose(SE2());
+    g.set_fixed(a);
+    const VariableId b = g.add_pose(odometry);
+    g.emplace_factor<OdometryFactor>(a, b, odometry, Eigen::Matrix3d(C_o.inverse()));
+    g.emplace_factor<SensorMotionFactor>(a, b, zv, sensor, Eigen::Matrix3d(C_s.inverse()));
+    const SolverSummary s = solve(g);
+    ASSERT_TRUE(s.converged()) << s.full_report();
+
+    // The covariances of the motions' own (x, y, theta), as the calibration holds them.
+    const Eigen::Matrix3d A_o = rot3(odometry.theta), A_s = rot3(sensor.theta);
+    const PairResidual r =
+        pair_residual(odometry, sensor, A_o * C_o * A_o.transpose(), A_s * C_s * A_s.transpose(), z);
+    EXPECT_NEAR(r.chi2, g.chi2(), 1e-7 * (1.0 + g.chi2())) << trial;
+    EXPECT_NEAR(r.d[2], std::remainder(odometry.theta - truth.theta, 2 * M_PI), 1e-12);
+  }
 }
 
 }  // namespace

@@ -7,5 +7,5 @@ output files (matplotlib, Agg backend).
 The `planarvo plot` command runs the same. Modules: _cli (the command line), _style (sizes, fonts,
 colours, saving), _io (reading the files), _motion (matching, velocities, fits, status spans),
 _trajectory, _velocity, _tracking (the track figures), _track (the track subcommand),
-_calibration_data (motion pairs, windows, calibrations), _residuals (the graph's residuals),
+_calibration_data (motion pairs, windows, calibrations; the residuals are the library's),
 _calibration_figures, _calibration_command, _report (HTML)."""

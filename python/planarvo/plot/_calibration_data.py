@@ -4,15 +4,15 @@ consecutive windows, and the residuals at the final estimate."""
 from __future__ import annotations
 
 import math
+import os
 import sys
 from dataclasses import dataclass, field
-from typing import List, Optional, Tuple
+from typing import List, Optional
 
 import numpy as np
 
 from ._errors import InputError
-from ._io import ExtrinsicsFile
-from . import _residuals as R
+from ._io import ExtrinsicsFile, read_extrinsics
 
 GRAPH_NAMES = ("x", "y", "z", "yaw")  # the graph's (x, y, scale, yaw); the scale is the camera height
 
@@ -36,7 +36,7 @@ class CalibrationData:
     metric: bool                    # scale held at 1 (a metric sensor)
     whole: Run = None
     windows: List[Run] = field(default_factory=list)
-    residuals: Optional[R.PairResiduals] = None
+    residuals: Optional[object] = None  # planarvo.PairResiduals: the library's, at the whole drive's estimate
     outlier: Optional[np.ndarray] = None
     odometry_noise: str = ""        # how the odometry's sigmas were taken
 
@@ -107,60 +107,39 @@ def windows(pairs: list, options, n: int) -> List[Run]:
     return [calibrate(pairs, options, "%d" % (k + 1), int(edges[k]), int(edges[k + 1])) for k in range(n)]
 
 
-def _arrays(pairs: list) -> Tuple[np.ndarray, np.ndarray]:
-    odo = np.array([[p.odometry.x, p.odometry.y, p.odometry.theta] for p in pairs])
-    sen = np.array([[p.sensor.x, p.sensor.y, p.sensor.theta] for p in pairs])
-    return odo, sen
-
-
-def covariances(pairs: list, options, odo: np.ndarray, sen: np.ndarray):
-    """The (N, 3, 3) covariances of the sensor's and the odometry's (x, y, theta) as the calibration
-    takes them: a pair's own, else the options' default model (None for the odometry when its
-    model is to be fitted to the residuals)."""
-    lib = _library_defaults()
-
-    def opt(name):
-        v = getattr(options, name)
-        return lib[name] if v is None else v
-    s_model = R.model_covariance(sen, opt("sensor_sigma_relative"), opt("sensor_sigma_floor"), opt("sensor_sigma_theta"))
-    o_model = R.model_covariance(odo, opt("odometry_sigma_relative"), opt("odometry_sigma_floor"),
-                                 opt("odometry_sigma_theta"))
-    s_cov = np.array([R.component_covariance(sen[i:i + 1], p.sensor_covariance[None])[0]
-                      if p.sensor_covariance is not None else s_model[i] for i, p in enumerate(pairs)])
-    given = [p.odometry_covariance is not None for p in pairs]
-    o_cov = np.array([R.component_covariance(odo[i:i + 1], p.odometry_covariance[None])[0]
-                      if p.odometry_covariance is not None else o_model[i] for i, p in enumerate(pairs)])
-    fit = bool(options.estimate_odometry_noise) and not any(given)
-    return s_cov, o_cov, fit
-
-
-def _library_defaults() -> dict:
-    """planarvo_calibration_options_init's values of the noise model and the gate."""
-    import ctypes
-    from .. import _native as N
-    c = N.sized(N.CalibrationOptions)
-    N.lib.planarvo_calibration_options_init(ctypes.byref(c))
-    names = ("sensor_sigma_relative", "sensor_sigma_floor", "sensor_sigma_theta", "odometry_sigma_relative",
-             "odometry_sigma_floor", "odometry_sigma_theta", "gate_sigma")
-    return {n: getattr(c, n) for n in names}
-
-
 def residuals(data: CalibrationData) -> None:
-    """Fills data.residuals, data.outlier and data.odometry_noise at the whole drive's estimate."""
-    z = data.whole.result.value
-    odo, sen = _arrays(data.pairs)
-    s_cov, o_cov, fit = covariances(data.pairs, data.options, odo, sen)
-    gate = data.options.gate_sigma if data.options.gate_sigma is not None else _library_defaults()["gate_sigma"]
-    res = R.pair_residuals(odo, sen, z, o_cov, s_cov)
-    outlier = R.gated(res.chi2, gate)
-    data.odometry_noise = "the calibration options' default model"
-    if fit:  # refitted as the calibration does: to the residuals of the inliers, twice
-        e = R.right_residual(odo, R.sensor_to_robot(sen, z))
-        for _ in range(2):
-            coefs = R.fit_odometry_noise(odo[~outlier], e[~outlier])
-            o_cov = R.component_covariance(odo, R.noise_covariance(coefs, odo))
-            res = R.pair_residuals(odo, sen, z, o_cov, s_cov)
-            outlier = R.gated(res.chi2, gate)
-        data.odometry_noise = ("a model fitted to these residuals, as the calibration fits it (variance per "
-                               "component: constant + per travel² + per turn²)")
-    data.residuals, data.outlier = res, outlier
+    """Fills data.residuals, data.outlier and data.odometry_noise: the whole drive's calibration's
+    own, from the library (planarvo_calibrate_residuals)."""
+    from planarvo import calibrate_residuals
+    usable = [p for p in data.pairs if p.odometry is not None]
+    if not usable:
+        return
+    _, res = calibrate_residuals(usable, data.options)
+    data.residuals, data.outlier = res, res.outlier
+    data.odometry_noise = ("the calibration options' default model" if res.odometry_noise is None else
+                           "a model fitted to these residuals by the calibration (variance per component: "
+                           "constant + per travel² + per turn²)")
+
+
+def prepare(dataset, motions, extrinsics, truth_path, n_windows, fix_scale):
+    """Reads the inputs and runs the calibrations: (data, extrinsics, truth or None)."""
+    extr = read_extrinsics(extrinsics)
+    if truth_path is None and dataset is not None:
+        default = os.path.join(dataset, "extrinsics_gt.yaml")
+        truth_path = default if os.path.isfile(default) else None
+    truth = read_extrinsics(truth_path) if truth_path else None
+    if dataset is not None:
+        pairs, source = pairs_from_dataset(dataset, extr), "tracked from %s" % dataset
+    else:
+        pairs, source = load_pairs(motions), motions
+    if len(pairs) < 3:
+        raise InputError("%d motion pairs with odometry: too few to calibrate" % len(pairs))
+    options = options_for(extr, dataset is not None, fix_scale)
+    data = CalibrationData(source, pairs, options, bool(options.fix_scale) and options.fixed_scale == 1.0
+                             and float(extr.values[2]) == 0.0)
+    data.whole = calibrate(pairs, options, "all", 0, len(pairs))
+    if data.whole.result is None:
+        raise InputError("the calibration of the whole drive failed: %s" % data.whole.problem)
+    data.windows = windows(pairs, options, n_windows)
+    residuals(data)
+    return data, extr, truth, truth_path

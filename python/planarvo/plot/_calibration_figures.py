@@ -105,7 +105,7 @@ def residuals_figure(data: CalibrationData, out_dir: str, formats: Sequence[str]
         ax.plot(idx[~out], shown[~out], ".", ms=2.5, color=S.COLORS["estimate"], label="pair")
         if out.any():
             ax.plot(idx[out], shown[out], "x", ms=4, color=S.COLORS["outlier"],
-                    label="beyond the gate (%d; clipped to the axes)" % out.sum())
+                    label="gated out (%d; clipped to the axes)" % out.sum())
         ax.axhline(0, color="black", lw=0.6)
         ax.set_ylabel("%s / σ" % names[c])
         ax.set_ylim(-lim, lim)

@@ -91,7 +91,7 @@ def calibration_section(data: CalibrationData, extr: ExtrinsicsFile, truth: Opti
                         ("method (YAML)", extr.method or "–"), ("notes (YAML)", extr.notes or "–"),
                         ("motion pairs (count)", len(data.pairs)),
                         ("outliers (the calibration's gate)", res.outliers),
-                        ("pairs beyond the gate at the final estimate (recomputed here)", int(data.outlier.sum())),
+                        ("pairs gated out by the calibration", int(data.outlier.sum())),
                         ("variance factor (in the sigmas)", "%.3g" % res.variance_factor),
                         ("odometry noise for the residuals", data.odometry_noise),
                         ("solver", "%d iterations over all solves, %.3f s; final: %s" % (
@@ -132,7 +132,7 @@ def full_report(args) -> List[str]:
                                                           "\n".join(_img(f) for f in figs)))
         if args.extrinsics:
             from . import _calibration_figures as F
-            from ._calibration_command import prepare
+            from ._calibration_data import prepare
             data, extr, truth, truth_path = prepare(args.dataset, None, args.extrinsics, args.truth, args.windows, None)
             figs = F.estimates_figure(data, extr, truth, tmp, ["png"]) + F.residuals_figure(data, tmp, ["png"])
             inputs = {"extrinsics": args.extrinsics, "motion pairs": data.source, "truth": truth_path or "none"}

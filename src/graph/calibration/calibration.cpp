@@ -15,6 +15,7 @@
 #include "core/error.h"
 #include "graph/calibration/calibration_init.h"
 #include "graph/calibration/calibration_internal.h"
+#include "graph/calibration/pair_residuals.h"
 #include "graph/solver/covariance.h"
 
 namespace planarvo::graph {
@@ -312,6 +313,12 @@ void finish_result(Context& ctx, const Vector4& z, const std::vector<std::string
   r.outliers = static_cast<int>(r.outlier_samples.size());
   for (int k = 0; k < 4; ++k) r.value[static_cast<size_t>(k)] = z[k];
   r.value[CI::kYaw] = wrap_angle(z[CI::kYaw]);
+  // Each pair's residual at the estimate, with the covariances the final solve weighed it by.
+  r.residuals.assign(ctx.samples.size(), std::nullopt);
+  for (size_t i = 0; i < ctx.samples.size(); ++i)
+    if (ctx.samples[i].odometry)
+      r.residuals[i] = pair_residual(ctx.samples[i].odometry->value, ctx.samples[i].sensor.value, ctx.odo_cov[i],
+                                     ctx.sensor_cov[i], z);
   for (size_t k = 0; k < reasons.size(); ++k)
     r.unobservable_reason += (k ? "; " : "") + reasons[k];
 }

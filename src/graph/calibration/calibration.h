@@ -21,6 +21,7 @@
 #include "core/motion.h"
 #include "core/se2.h"
 #include "graph/calibration/odometry_noise.h"
+#include "graph/calibration/pair_residuals.h"
 #include "graph/solver/solver.h"
 
 namespace planarvo::graph {
@@ -112,6 +113,9 @@ struct CalibrationResult {
   bool ambiguous = false;
   int outliers = 0;                  // samples gated out as gross errors
   std::vector<int> outlier_samples;  // their indices in the input
+  // Per sample, its residual at the estimate as the odometry method weighs it (pair_residuals.h,
+  // with the covariances of the final solve); none for a sample without odometry.
+  std::vector<std::optional<PairResidual>> residuals;
   // The a-posteriori variance factor max(1, χ²/dof) of the final least-squares fit (inliers):
   // the covariance is scaled by it, so sigmas that were too optimistic do not make it so.
   double variance_factor = 1.0;
