@@ -82,6 +82,10 @@ typedef enum planarvo_status {
  * next failing call. Printable: control bytes from the input (NUL, escapes) are written \xNN,
  * and a message over 4096 bytes keeps its start and its end. */
 PLANARVO_API const char* planarvo_last_error(void);
+/* The C API's functions, one per line "name|return type|parameter types, comma-separated", in the
+ * headers' order, generated from them at build time: what language bindings declare their
+ * foreign functions from (the Python package's ctypes prototypes come from it). */
+PLANARVO_API const char* planarvo_api_signatures(void);
 /* A fixed name for a status code, e.g. "PLANARVO_ERROR_INVALID_INPUT". */
 PLANARVO_API const char* planarvo_status_name(planarvo_status status);
 

@@ -230,91 +230,61 @@ def sized(struct_type):
     return s
 
 
-S = c_enum  # planarvo_status
-_SIGNATURES = {
-    "planarvo_version_number": (ctypes.c_int, []),
-    "planarvo_version_string": (c_char_p, []),
-    "planarvo_last_error": (c_char_p, []),
-    "planarvo_status_name": (c_char_p, [c_enum]),
-    "planarvo_camera_load": (S, [c_char_p, P(Camera)]),
-    "planarvo_camera_save": (S, [c_char_p, P(Camera)]),
-    "planarvo_extrinsics_load": (S, [c_char_p, P(Extrinsics)]),
-    "planarvo_extrinsics_save": (S, [c_char_p, P(Extrinsics), P(c_double), c_char_p, c_char_p, c_char_p]),
-    "planarvo_extrinsics_matrix": (S, [P(Extrinsics), P(c_double)]),
-    "planarvo_extrinsics_name": (c_char_p, [c_int32]),
-    "planarvo_list_devices": (S, [P(DeviceInfo), c_size_t, P(c_size_t)]),
-    "planarvo_context_options_init": (None, [P(ContextOptions)]),
-    "planarvo_context_create": (S, [P(ContextOptions), P(c_void_p)]),
-    "planarvo_context_destroy": (None, [c_void_p]),
-    "planarvo_context_device": (S, [c_void_p, P(DeviceInfo)]),
-    "planarvo_context_cache_dir": (c_char_p, [c_void_p]),
-    "planarvo_context_export_kernels_for": (S, [c_void_p, c_char_p, c_char_p, P(c_size_t)]),
-    "planarvo_context_prepare_kernels": (S, [c_void_p]),
-    "planarvo_dataset_options_init": (None, [P(DatasetOptions)]),
-    "planarvo_dataset_open": (S, [c_char_p, P(DatasetOptions), P(c_void_p)]),
-    "planarvo_dataset_destroy": (None, [c_void_p]),
-    "planarvo_bag_topics": (S, [c_char_p, c_char_p, c_size_t, P(c_size_t)]),
-    "planarvo_dataset_info_get": (S, [c_void_p, P(DatasetInfo)]),
-    "planarvo_dataset_set_roi": (S, [c_void_p, P(Region)]),
-    "planarvo_dataset_set_readout": (S, [c_void_p, ctypes.c_double, ctypes.c_char_p]),
-    "planarvo_dataset_frame_data": (S, [c_void_p, c_int64, P(FrameData)]),
-    "planarvo_dataset_frame": (S, [c_void_p, c_int64, P(Image)]),
-    "planarvo_write_tum": (S, [c_char_p, P(c_double), P(SE2), c_size_t]),
-    "planarvo_read_tum": (S, [c_char_p, P(c_double), P(SE2), c_size_t, P(c_size_t)]),
-    "planarvo_mosaic_options_init": (None, [P(MosaicOptions)]),
-    "planarvo_mosaic_build": (S, [c_void_p, c_void_p, P(Extrinsics), P(c_double), P(SE2), c_size_t,
-                                  P(MosaicOptions), P(c_void_p)]),
-    "planarvo_mosaic_destroy": (None, [c_void_p]),
-    "planarvo_mosaic_info_get": (S, [c_void_p, P(MosaicInfo)]),
-    "planarvo_mosaic_image": (S, [c_void_p, P(Image)]),
-    "planarvo_mosaic_save": (S, [c_void_p, c_char_p]),
-    "planarvo_stats_writer_open": (S, [c_char_p, P(c_void_p)]),
-    "planarvo_stats_writer_add": (S, [c_void_p, P(FrameStats)]),
-    "planarvo_stats_writer_close": (S, [c_void_p]),
-    "planarvo_stats_writer_discard": (None, [c_void_p]),
-    "planarvo_sim_options_init": (None, [P(SimOptions)]),
-    "planarvo_sim_default_camera": (S, [c_int32, c_int32, c_double, P(Camera)]),
-    "planarvo_simulate": (S, [c_void_p, P(SimOptions), c_char_p]),
-    "planarvo_tracker_options_init": (None, [P(TrackerOptions)]),
-    "planarvo_tracker_create": (S, [c_void_p, P(Camera), P(Extrinsics), P(TrackerOptions), P(c_void_p)]),
-    "planarvo_tracker_destroy": (None, [c_void_p]),
-    "planarvo_tracker_track": (S, [c_void_p, P(Image), c_double, P(TrackResult)]),
-    "planarvo_tracker_reset": (S, [c_void_p]),
-    "planarvo_tracker_odometry": (S, [c_void_p, P(SE2)]),
-    "planarvo_tracker_save_flat_field": (S, [c_void_p, c_char_p]),
-    "planarvo_tracker_residuals": (S, [c_void_p, c_int32, P(ctypes.c_float), P(ctypes.c_float), P(ctypes.c_float),
-                                       c_size_t, P(c_int32), P(c_int32), P(c_double)]),
-    "planarvo_evaluate_motions": (S, [P(SE2), P(SE2), P(c_double), P(c_int32), c_size_t, c_double,
-                                      P(MotionAccuracy)]),
-    "planarvo_posegraph_options_init": (None, [P(PosegraphOptions)]),
-    "planarvo_posegraph_optimize": (S, [c_char_p, c_char_p, P(PosegraphOptions), P(SolverSummary)]),
-    "planarvo_motion_pair_init": (None, [P(MotionPair)]),
-    "planarvo_motion_pairs_save": (S, [c_char_p, P(MotionPair), c_size_t]),
-    "planarvo_motion_pairs_load": (S, [c_char_p, P(MotionPair), c_size_t, P(c_size_t)]),
-    "planarvo_calibration_options_init": (None, [P(CalibrationOptions)]),
-    "planarvo_calibrate": (S, [P(MotionPair), c_size_t, P(CalibrationOptions), P(CalibrationResult)]),
-    "planarvo_calibrate_residuals": (S, [P(MotionPair), c_size_t, P(CalibrationOptions), P(CalibrationResult),
-                                         P(PairResidual), P(OdometryNoise)]),
-    "planarvo_calibration_save": (S, [c_char_p, P(CalibrationResult), c_enum, c_int32, c_char_p]),
-    "planarvo_roll_pitch_options_init": (None, [P(RollPitchOptions)]),
-    "planarvo_roll_pitch_create": (S, [c_void_p, P(Camera), P(RollPitchOptions), P(c_void_p)]),
-    "planarvo_roll_pitch_destroy": (None, [c_void_p]),
-    "planarvo_roll_pitch_add_frame": (S, [c_void_p, P(Image), c_double, P(c_int32)]),
-    "planarvo_roll_pitch_estimate": (S, [c_void_p, P(RollPitchResult)]),
-    "planarvo_camera_calibration_options_init": (None, [P(CameraCalibrationOptions)]),
-    "planarvo_calibrate_dataset": (S, [c_void_p, c_void_p, P(CameraCalibrationOptions),
-                                       P(CameraCalibrationResult)]),
-    "planarvo_camera_calibrator_create": (S, [c_void_p, P(Camera), P(CameraCalibrationOptions), P(c_void_p)]),
-    "planarvo_camera_calibrator_destroy": (None, [c_void_p]),
-    "planarvo_camera_calibrator_add_frame": (S, [c_void_p, P(Image), c_double, P(SE2), P(c_int32)]),
-    "planarvo_camera_calibrator_add_odometry": (S, [c_void_p, c_double, P(SE2)]),
-    "planarvo_camera_calibration_save": (S, [c_char_p, P(CameraCalibrationResult), c_char_p]),
-    "planarvo_camera_calibrator_finish": (S, [c_void_p, P(CameraCalibrationResult)]),
-    "planarvo_track_motions": (S, [c_void_p, c_void_p, P(Extrinsics), P(TrackerOptions), P(MotionPair), c_size_t,
-                                   P(c_size_t)]),
-    "planarvo_compose_extrinsics": (S, [c_double, c_double, P(c_double), P(CalibrationResult), P(Extrinsics),
-                                        P(c_double), P(c_int32)]),
-}
+# The C types of the library's signature table (planarvo_api_signatures) as ctypes types.
+_SCALARS = {"int": ctypes.c_int, "int32_t": c_int32, "int64_t": c_int64, "size_t": c_size_t, "double": c_double,
+            "float": ctypes.c_float, "uint8_t": ctypes.c_uint8, "void": None}
+_CALLBACKS = {"planarvo_progress_fn": PROGRESS_FN, "planarvo_log_fn": LOG_FN}
+
+
+def _struct_class(c_name: str):
+    """The mirror of struct planarvo_<name> in this module (planarvo_motion_pair -> MotionPair), or None."""
+    name = "".join(w.capitalize() for w in c_name[len("planarvo_"):].split("_")).replace("Se2", "SE2")
+    cls = globals().get(name)
+    return cls if isinstance(cls, type) and issubclass(cls, ctypes.Structure) else None
+
+
+def _ctype(c_type: str):
+    """The ctypes type of a C type of the signature table; KeyError when this module cannot
+    express it (a struct without a mirror)."""
+    t = c_type.replace("const ", "").strip()
+    if t.endswith("]"):  # an array parameter is a pointer
+        t = t[:t.index("[")] + "*"
+    stars = len(t) - len(t.rstrip("*"))
+    base = t.rstrip("*")
+    if stars == 0:
+        if base in _SCALARS:
+            return _SCALARS[base]
+        if base in _CALLBACKS:
+            return _CALLBACKS[base]
+        if base.startswith("planarvo_") and _struct_class(base) is None:
+            return c_enum  # planarvo_status and the other enums
+        raise KeyError(c_type)
+    if base == "char" and stars == 1:
+        return c_char_p
+    if base == "void" and stars == 1:
+        return c_void_p
+    if base in _SCALARS and stars == 1:
+        return P(_SCALARS[base])
+    cls = _struct_class(base)
+    if cls is not None and stars == 1:
+        return P(cls)
+    if base.startswith("planarvo_") and cls is None:  # an opaque handle
+        return c_void_p if stars == 1 else P(c_void_p)
+    raise KeyError(c_type)
+
+
+def _signatures(table: str) -> dict:
+    """name -> (restype, argtypes) for each function of the table that this module can declare."""
+    out = {}
+    for line in table.splitlines():
+        if not line:
+            continue
+        name, ret, params = line.split("|")
+        try:
+            out[name] = (_ctype(ret), [_ctype(p) for p in params.split(",") if p])
+        except KeyError:
+            pass  # a struct this module does not mirror: the function is not declared
+    return out
 
 
 def _candidates() -> List[str]:
@@ -357,7 +327,9 @@ def load_library() -> ctypes.CDLL:
         raise ImportError("planarvo: cannot load libplanarvo; set PLANARVO_LIBRARY to the path of libplanarvo.so. "
                           "Tried: " + "; ".join(tried))
     try:
-        for name, (restype, argtypes) in _SIGNATURES.items():
+        lib.planarvo_api_signatures.restype = c_char_p
+        lib.planarvo_api_signatures.argtypes = []
+        for name, (restype, argtypes) in _signatures(lib.planarvo_api_signatures().decode()).items():
             function = getattr(lib, name)
             function.restype, function.argtypes = restype, argtypes
     except AttributeError as e:

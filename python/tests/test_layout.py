@@ -62,3 +62,20 @@ def test_every_structure_matches_the_c_layout(tmp_path):
             if offset != c_layout[(cls.__name__, field[0])]:
                 mismatches.append(f"{cls.__name__}.{field[0]}: offset {offset} != C {c_layout[(cls.__name__, field[0])]}")
     assert not mismatches, "\n".join(mismatches)
+
+
+def test_every_function_of_the_header_has_a_prototype_from_the_library():
+    """The prototypes come from the library's signature table, which the build generates from the
+    headers: every PLANARVO_API function the header declares (read here from the header's text, an
+    independent list) is declared with ctypes, with as many argument types as it has parameters."""
+    header = open(os.path.join(HEADER_DIR, "planarvo", "planarvo.h")).read()
+    for extra in ("dataset.h", "mosaic.h"):
+        header += open(os.path.join(HEADER_DIR, "planarvo", extra)).read()
+    header = re.sub(r"/\*.*?\*/", " ", header, flags=re.S)
+    declared = dict(re.findall(r"PLANARVO_API\s+[^;{]*?\b(planarvo_\w+)\s*\(([^;{]*?)\)\s*;", header, flags=re.S))
+    table = _native._signatures(_native.lib.planarvo_api_signatures().decode())
+    assert set(table) == set(declared)
+    for name, params in declared.items():
+        n = 0 if params.strip() in ("", "void") else params.count(",") + 1
+        assert len(table[name][1]) == n, name
+        assert getattr(_native.lib, name).argtypes == table[name][1], name
