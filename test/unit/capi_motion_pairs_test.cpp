@@ -313,9 +313,8 @@ TEST(CApiCalibrateKnownAnswer, SavedExtrinsicsAreTheGraphsFourParameters) {
   EXPECT_EQ(planarvo_extrinsics_name(6), nullptr);
 }
 
-// Noisy motions with gross errors: the truth within 4 reported standard deviations, the gross
-// errors rejected.
-TEST(CApiCalibrateKnownAnswer, NoisyMotionsGiveTheTruthWithinTheReportedSigma) {
+// 2 mm / 2 mrad of noise on both motions, which carry their covariances, and 2 % gross errors.
+CalibrationSim noisy_with_gross_errors() {
   CalibrationSim sim;
   sim.seed = 21;
   sim.sensor_sigma_t = 0.002 / kTruth[2];
@@ -323,6 +322,13 @@ TEST(CApiCalibrateKnownAnswer, NoisyMotionsGiveTheTruthWithinTheReportedSigma) {
   sim.odometry_sigma_t = 0.002;
   sim.odometry_sigma_theta = 0.002;
   sim.outlier_fraction = 0.02;
+  return sim;
+}
+
+// Noisy motions with gross errors: the truth within 4 reported standard deviations, the gross
+// errors rejected.
+TEST(CApiCalibrateKnownAnswer, NoisyMotionsGiveTheTruthWithinTheReportedSigma) {
+  const CalibrationSim sim = noisy_with_gross_errors();
   const auto pairs = simulated_pairs(sim);
   planarvo_calibration_options o;
   planarvo_calibration_options_init(&o);
@@ -345,13 +351,7 @@ TEST(CApiCalibrateKnownAnswer, NoisyMotionsGiveTheTruthWithinTheReportedSigma) {
 // pair_residuals.h), the gated pairs flagged as the result counts them, and the odometry's noise
 // model, fitted only when asked.
 TEST(CApiCalibrateKnownAnswer, ResidualsAreThePairsShareOfTheFinalChi2) {
-  CalibrationSim sim;
-  sim.seed = 21;
-  sim.sensor_sigma_t = 0.002 / kTruth[2];
-  sim.sensor_sigma_theta = 0.002;
-  sim.odometry_sigma_t = 0.002;
-  sim.odometry_sigma_theta = 0.002;
-  sim.outlier_fraction = 0.02;
+  const CalibrationSim sim = noisy_with_gross_errors();
   const auto pairs = simulated_pairs(sim);
   planarvo_calibration_result r{};
   r.struct_size = sizeof r;
