@@ -1,6 +1,6 @@
 // The camera's 6-DoF extrinsics from the two stages of the paper's calibration: roll and pitch
 // from images (section 5.1, track/roll_pitch.h) and x, y, height and yaw from the graph
-// (section 5.2, graph/calibration.h), with a 6x6 covariance and, per parameter, whether it was
+// (section 5.2, graph/calibration/calibration.h), with a 6x6 covariance and, per parameter, whether it was
 // estimated and whether the data determine it.
 //
 // Why they compose: the tracker run at x = y = 0, z = 1, yaw = 0 with the estimated tilt measures

@@ -5,7 +5,7 @@
 //      camera's planar motions in units of its height, with covariances (calib/motion_samples.h);
 //   3. the graph calibration of x, y, height and yaw, against wheel odometry or from the
 //      nonholonomic constraint with direction labels and a height given by hand
-//      (graph/calibration.h);
+//      (graph/calibration/calibration.h);
 //   4. the 6-DoF extrinsics with a 6x6 covariance (calib/extrinsics_estimate.h).
 // Frames arrive one at a time (a data set, a camera stream): the frames of stage 1 are held on
 // the host until the tilt is known and then tracked, so every frame of the drive is used once.

@@ -1,4 +1,4 @@
-// The odometry noise model fitted to residuals (graph/odometry_noise.h) against the model the
+// The odometry noise model fitted to residuals (graph/calibration/odometry_noise.h) against the model the
 // residuals were drawn from.
 #include <cmath>
 #include <random>
