@@ -44,18 +44,20 @@ struct Estimate {
 
 inline Eigen::Matrix3d lost_covariance() { return Eigen::Matrix3d::Identity(); }
 
-// Reasons (compared by address).
-inline constexpr const char* kNoTexture = "no texture";
-inline constexpr const char* kMismatch = "images do not match";
-inline constexpr const char* kAfterLost = "the frame before was lost: the motion is from its predicted pose";
-inline constexpr const char* kMisaligned = "misaligned: the images match only where something fixed to the camera is";
-inline constexpr const char* kBrightness = "brightness changed too much";
-inline constexpr const char* kWrongSize = "frame size differs from the camera's";
-inline constexpr const char* kTimeGap = "time gap";
-inline constexpr const char* kWeak = "motion poorly constrained";
-inline constexpr const char* kBadTime = "timestamp not increasing";
-inline constexpr const char* kNotAligned = "not aligned";
-inline constexpr const char* kShutterUnknown =
+// Reasons, compared by address: each an inline array, one object whichever of the tracker's files
+// uses it (a pointer constant to a literal would be one literal per file, and sanitizers do not
+// merge them).
+inline constexpr char kNoTexture[] = "no texture";
+inline constexpr char kMismatch[] = "images do not match";
+inline constexpr char kAfterLost[] = "the frame before was lost: the motion is from its predicted pose";
+inline constexpr char kMisaligned[] = "misaligned: the images match only where something fixed to the camera is";
+inline constexpr char kBrightness[] = "brightness changed too much";
+inline constexpr char kWrongSize[] = "frame size differs from the camera's";
+inline constexpr char kTimeGap[] = "time gap";
+inline constexpr char kWeak[] = "motion poorly constrained";
+inline constexpr char kBadTime[] = "timestamp not increasing";
+inline constexpr char kNotAligned[] = "not aligned";
+inline constexpr char kShutterUnknown[] =
     "rolling shutter at speed with no twist measured before: the keyframe's shear is taken as the mean velocity's";
 
 // The motions against a keyframe whose rolling-shutter twist was not measured (the first frame,
