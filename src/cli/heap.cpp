@@ -1,7 +1,7 @@
 // Why: a `planarvo posegraph` process lives for milliseconds to seconds and touches each page of
 // its heap once. On a virtual machine (this project's build and CI machines among them) the first
 // touch of a 4 KiB page costs about 11 µs (the fault, zeroing, the hypervisor's mapping), and of
-// a 2 MiB transparent huge page about 0.35 µs per 4 KiB (src/graph/README.md, "Whole-process
+// a 2 MiB transparent huge page about 0.35 µs per 4 KiB (test/bench/results/graph.md, "Whole-process
 // time"). `planarvo posegraph intel.g2o` took 1,100 page faults, a third of its run.
 //
 // What: glibc's malloc (mallopt) keeps blocks up to 64 MiB in the brk heap instead of a fresh
