@@ -1,5 +1,6 @@
-// The OpenCV FileStorage YAML formats of formats.h: the camera calibration (as OpenCV's
-// calibration sample writes it) and the extrinsics (docs/formats.md, "Extrinsics YAML").
+// Reading the OpenCV FileStorage YAML formats of formats.h, the camera calibration and the
+// extrinsics (docs/formats.md), with cv::FileStorage, so that a file reads as OpenCV reads it.
+// Their writers, which need no OpenCV, are in formats_yaml_write.cpp.
 #include <algorithm>
 #include <array>
 #include <cctype>
@@ -386,20 +387,6 @@ std::string size_text(const cv::Mat& m) {
   return std::to_string(m.rows) + "x" + std::to_string(m.cols);
 }
 
-// Writes the FileStorage text through TextWriter, so that a failed write is Error(Io) naming
-// the file (cv::FileStorage writing a file itself reports nothing).
-void write_storage_text(const std::string& path, cv::FileStorage& fs) {
-  const std::string text = fs.releaseAndGetString();
-  detail::TextWriter w(path);
-  w.write(text);
-  w.close();
-}
-
-cv::FileStorage memory_writer() {
-  return cv::FileStorage(".yaml", cv::FileStorage::WRITE | cv::FileStorage::MEMORY |
-                                      cv::FileStorage::FORMAT_YAML);
-}
-
 }  // namespace
 
 CameraModel read_camera_yaml(const std::string& path, bool* readout_given) {
@@ -465,27 +452,6 @@ CameraModel read_camera_yaml(const std::string& path, bool* readout_given) {
   });
 }
 
-void write_camera_yaml(const std::string& path, const CameraModel& camera) {
-  try {
-    camera.validate(path.c_str());
-  } catch (const Error& e) {
-    throw_invalid_argument(e.what());
-  }
-  cv::FileStorage fs = memory_writer();
-  fs << "image_width" << camera.width;
-  fs << "image_height" << camera.height;
-  cv::Mat K = (cv::Mat_<double>(3, 3) << camera.fx, 0, camera.cx, 0, camera.fy, camera.cy, 0, 0, 1);
-  fs << "camera_matrix" << K;
-  // 5x1, as calibrateCamera returns it and OpenCV's calibration sample writes it.
-  cv::Mat D = (cv::Mat_<double>(5, 1) << camera.k1, camera.k2, camera.p1, camera.p2, camera.k3);
-  fs << "distortion_coefficients" << D;
-  if (!camera.roi.empty())
-    fs << "region_of_interest" << "[:" << camera.roi.x << camera.roi.y << camera.roi.width << camera.roi.height << "]";
-  if (camera.rolling_shutter_readout != 0) fs << "rolling_shutter_readout" << camera.rolling_shutter_readout;
-  if (camera.exposure_time != 0) fs << "exposure_time" << camera.exposure_time;
-  write_storage_text(path, fs);
-}
-
 ExtrinsicsEstimate read_extrinsics_yaml(const std::string& path) {
   return with_parse_errors(path, [&] {
     cv::FileStorage fs;
@@ -539,32 +505,6 @@ ExtrinsicsEstimate read_extrinsics_yaml(const std::string& path) {
     if (!nn.empty() && !nn.isNone()) out.notes = read_string(nn, path, "notes");
     return out;
   });
-}
-
-void write_extrinsics_yaml(const std::string& path, const ExtrinsicsEstimate& e) {
-  const std::array<double, 6> values = extrinsics_values(e.value);
-  for (double v : values)
-    if (!std::isfinite(v)) throw_invalid_argument(path + ": extrinsics are not finite");
-  if (!e.covariance.allFinite()) throw_invalid_argument(path + ": covariance is not finite");
-
-  cv::FileStorage fs = memory_writer();
-  for (size_t i = 0; i < 6; ++i) fs << kExtrinsicsNames[i] << values[i];
-  const Eigen::Matrix4d T = e.value.T_vc();
-  cv::Mat Tm(4, 4, CV_64F), Cm(6, 6, CV_64F);
-  for (int r = 0; r < 4; ++r)
-    for (int c = 0; c < 4; ++c) Tm.at<double>(r, c) = T(r, c);
-  for (int r = 0; r < 6; ++r)
-    for (int c = 0; c < 6; ++c) Cm.at<double>(r, c) = e.covariance(r, c);
-  fs << "T_robot_camera" << Tm;
-  fs << "covariance" << Cm;
-  fs << "estimated" << "[";
-  for (size_t i = 0; i < 6; ++i)
-    if (e.estimated[i]) fs << kExtrinsicsNames[i];
-  fs << "]";
-  // cv::write, not <<: operator<< reads a leading '[' or '{' of a string as structure.
-  cv::write(fs, "method", e.method);
-  cv::write(fs, "notes", e.notes);
-  write_storage_text(path, fs);
 }
 
 }  // namespace planarvo::io
