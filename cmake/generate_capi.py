@@ -8,8 +8,9 @@ API. From them this writes:
     binaries");
   - planarvo_api_signatures(): each function's return and parameter types as text, which the
     Python package reads to declare its ctypes prototypes (python/planarvo/_native.py).
-It fails (and so does the build) when a declared function is defined in no source under src/capi,
-or one is defined twice, or a source defines a PLANARVO_API function that no header declares.
+It fails (and so does the build) when a declared function is defined in no source under
+src/capi/base or src/capi/vision, or one is defined twice, or a source defines a PLANARVO_API
+function that no header declares.
 
 usage: generate_capi.py OUT_FORWARD.cpp OUT_SIGNATURES.cpp --headers H... --base B... --module M...
 """
@@ -126,7 +127,7 @@ def main():
     for name, _, _, _ in funcs:
         where = base.get(name, []) + module.get(name, [])
         if not where:
-            problems.append("%s is declared but defined in no source under src/capi" % name)
+            problems.append("%s is declared but defined in no source under src/capi/base or src/capi/vision" % name)
         elif len(where) > 1:
             problems.append("%s is defined more than once: %s" % (name, ", ".join(where)))
     for name, where in list(base.items()) + list(module.items()):

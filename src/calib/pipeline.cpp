@@ -9,7 +9,7 @@
 #include "calib/motion_samples.h"
 #include "calib/tilt_propagation.h"
 #include "core/error.h"
-#include "io/dataset.h"
+#include "io/dataset/dataset.h"
 
 namespace planarvo::calib {
 

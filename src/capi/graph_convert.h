@@ -1,5 +1,5 @@
 // The graph calibration's options and result across the C API, shared by planarvo_calibrate and
-// the camera calibration (capi/calibration.cpp).
+// the camera calibration (capi/vision/calibration.cpp).
 #pragma once
 #include "graph/calibration/calibration.h"
 #include "planarvo/planarvo.h"

@@ -5,7 +5,7 @@
 
 #include <opencv2/core.hpp>
 
-#include "io/dataset.h"
+#include "io/dataset/dataset.h"
 #include "ocl/runtime.h"
 #include "planarvo/planarvo.h"
 

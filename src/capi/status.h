@@ -19,7 +19,7 @@ planarvo_status fail(planarvo_status status, const std::string& message);
 // Runs the current exception through the translation table (call inside a catch block).
 planarvo_status translate_current_exception() noexcept;
 // The status and message for an exception of a dependency (OpenCL, OpenCV): defined once per
-// binary, by capi/status_foreign.cpp in the engine and capi/host/status_foreign.cpp in the
+// binary, by capi/vision/status_foreign.cpp in the engine and capi/host/status_foreign.cpp in the
 // C API library, which has neither dependency (see README.md, "Two binaries").
 planarvo_status translate_foreign_exception(const std::exception& e) noexcept;
 
@@ -40,6 +40,8 @@ planarvo_status guard(F&& body) noexcept {
 
 // Argument checks that throw Error(InvalidArgument) naming the argument.
 void require(bool condition, const char* message);
+// "fn: path is NULL or empty" unless path is a non-empty string.
+void require_path(const char* path, const char* fn);
 template <class T>
 void require_not_null(const T* p, const char* name) {
   require(p != nullptr, name);

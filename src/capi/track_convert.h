@@ -1,5 +1,5 @@
 // The tracker's options and frames across the C API, shared by the tracker's calls and the
-// calibration's (capi/calibration.cpp).
+// calibration's (capi/vision/calibration.cpp).
 #pragma once
 #include <cstddef>
 #include <cstdint>

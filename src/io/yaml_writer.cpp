@@ -7,8 +7,9 @@
 #include <limits>
 
 #include "core/error.h"
+#include "io/text.h"
 
-namespace planarvo::io::detail {
+namespace planarvo::io {
 
 namespace {
 
@@ -155,6 +156,12 @@ void YamlWriter::write_flow(const char* key, const std::vector<int>& values) {
   end();
 }
 
+void YamlWriter::write_flow(const char* key, const std::vector<double>& values) {
+  begin(key, false, true, nullptr);
+  for (const double v : values) scalar(nullptr, format_real(v).c_str());
+  end();
+}
+
 void YamlWriter::write_block(const char* key, const std::vector<std::string>& values, const std::string& what) {
   begin(key, false, false, nullptr);
   for (const std::string& v : values) {
@@ -169,4 +176,10 @@ std::string YamlWriter::finish() {
   return std::move(text_);
 }
 
-}  // namespace planarvo::io::detail
+void YamlWriter::save(const std::string& path) {
+  detail::TextWriter w(path);
+  w.write(finish());
+  w.close();
+}
+
+}  // namespace planarvo::io

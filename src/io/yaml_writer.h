@@ -1,6 +1,7 @@
 // YAML written the way cv::FileStorage writes it (OpenCV 4's YAML emitter), without OpenCV, so
 // that the base library writes camera.yaml and extrinsics.yaml byte for byte as before without
-// loading the vision module. Internal to src/io (formats_yaml.cpp writes the two formats with it).
+// loading the vision module. formats_yaml.cpp writes the two formats with it, the simulator its
+// simulation.yaml.
 //
 // The layout it reproduces, which test/unit/yaml_writer_test.cpp checks against cv::FileStorage:
 // "%YAML:1.0" and "---" lines, then one "key: value" line per top-level entry; a block
@@ -14,7 +15,7 @@
 #include <string>
 #include <vector>
 
-namespace planarvo::io::detail {
+namespace planarvo::io {
 
 class YamlWriter {
  public:
@@ -27,12 +28,16 @@ class YamlWriter {
   void write(const char* key, const std::string& value, const std::string& what);
   // A rows x cols matrix of doubles, row-major, as cv::write of a CV_64F cv::Mat.
   void write_matrix(const char* key, int rows, int cols, const double* data);
-  // fs << key << "[:" << v... << "]": a flow sequence of integers.
+  // fs << key << "[:" << v... << "]": a flow sequence of integers; of reals as cv::write of a
+  // std::vector<double>.
   void write_flow(const char* key, const std::vector<int>& values);
+  void write_flow(const char* key, const std::vector<double>& values);
   // fs << key << "[" << s... << "]": a block sequence of strings (written "[]" when empty).
   void write_block(const char* key, const std::vector<std::string>& values, const std::string& what);
   // The document, every line ended by '\n'. The writer is spent afterwards.
   std::string finish();
+  // finish() written to path, complete or not at all; Error(Io) naming the file on failure.
+  void save(const std::string& path);
 
  private:
   struct Level {
@@ -56,4 +61,4 @@ class YamlWriter {
 std::string format_real(double v);
 std::string quote_string(const std::string& s);
 
-}  // namespace planarvo::io::detail
+}  // namespace planarvo::io

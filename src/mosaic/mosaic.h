@@ -14,7 +14,7 @@
 
 #include "core/extrinsics.h"
 #include "core/se2.h"
-#include "io/dataset.h"
+#include "io/dataset/dataset.h"
 #include "mosaic/mosaic_warp.h"
 #include "ocl/runtime.h"
 

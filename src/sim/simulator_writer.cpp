@@ -6,11 +6,11 @@
 #include <filesystem>
 #include <string>
 
-#include <opencv2/core/persistence.hpp>
 #include <opencv2/imgcodecs.hpp>
 
 #include "core/error.h"
 #include "io/formats.h"
+#include "io/yaml_writer.h"
 #include "ocl/runtime.h"
 #include "sim/simulator.h"
 
@@ -31,34 +31,40 @@ void report(const Options& o, double fraction, const char* stage) {
 
 // The options a data set was made with, for reproducing it (not read by planarvo).
 void write_simulation_yaml(const std::string& path, const Options& o, const Eigen::Vector2d& texel) {
-  try {
-    cv::FileStorage fs(path, cv::FileStorage::WRITE);
-    if (!fs.isOpened()) throw Error(ErrorCode::Io, path + ": cannot be written");
-    fs << "generator" << "planarvo simulator";
-    fs << "texture" << o.texture;
-    fs << "texel_size" << o.texel_size;
-    fs << "texel_size_u" << texel.x();
-    fs << "texel_size_v" << texel.y();
-    fs << "seed" << std::to_string(o.seed);
-    fs << "motion" << motion_profile_name(o.motion);
-    fs << "seconds" << o.seconds << "fps" << o.fps;
-    fs << "max_speed" << o.max_speed << "max_turn_rate" << o.max_turn_rate;
-    fs << "max_acceleration" << o.max_acceleration;
-    fs << "max_angular_acceleration" << o.max_angular_acceleration;
-    fs << "start_pose" << std::vector<double>{o.start_pose.x, o.start_pose.y, o.start_pose.theta};
-    fs << "pixel_noise" << o.pixel_noise << "gain_variation" << o.gain_variation;
-    fs << "odometry_noise" << o.odometry_noise << "odometry_noise_floor" << o.odometry_noise_floor;
-    fs << "wheel_base" << o.wheel_base;
-    fs << "readout_time" << o.readout_time << "exposure_time" << o.exposure_time;
-    fs << "supersampling" << o.supersampling << "mipmap" << static_cast<int>(o.mipmap);
-    fs << "lamp_falloff" << o.lamp_falloff << "reflection" << o.reflection << "shadow" << o.shadow;
-    fs << "lean" << o.lean << "bumps" << o.bumps << "bump_spacing" << o.bump_spacing << "bump_length" << o.bump_length;
-    if (std::isfinite(o.knock_time))
-      fs << "knock" << std::vector<double>{o.knock_time, o.knock_roll, o.knock_pitch, o.knock_z};
-    fs.release();
-  } catch (const cv::Exception& e) {
-    throw Error(ErrorCode::Io, path + ": cannot be written (" + e.err + ")");
-  }
+  io::YamlWriter y;
+  y.write("generator", std::string("planarvo simulator"), "generator");
+  y.write("texture", o.texture, path + ": texture");
+  y.write("texel_size", o.texel_size);
+  y.write("texel_size_u", texel.x());
+  y.write("texel_size_v", texel.y());
+  y.write("seed", std::to_string(o.seed), "seed");
+  y.write("motion", std::string(motion_profile_name(o.motion)), "motion");
+  y.write("seconds", o.seconds);
+  y.write("fps", o.fps);
+  y.write("max_speed", o.max_speed);
+  y.write("max_turn_rate", o.max_turn_rate);
+  y.write("max_acceleration", o.max_acceleration);
+  y.write("max_angular_acceleration", o.max_angular_acceleration);
+  y.write_flow("start_pose", std::vector<double>{o.start_pose.x, o.start_pose.y, o.start_pose.theta});
+  y.write("pixel_noise", o.pixel_noise);
+  y.write("gain_variation", o.gain_variation);
+  y.write("odometry_noise", o.odometry_noise);
+  y.write("odometry_noise_floor", o.odometry_noise_floor);
+  y.write("wheel_base", o.wheel_base);
+  y.write("readout_time", o.readout_time);
+  y.write("exposure_time", o.exposure_time);
+  y.write("supersampling", o.supersampling);
+  y.write("mipmap", static_cast<int>(o.mipmap));
+  y.write("lamp_falloff", o.lamp_falloff);
+  y.write("reflection", o.reflection);
+  y.write("shadow", o.shadow);
+  y.write("lean", o.lean);
+  y.write("bumps", o.bumps);
+  y.write("bump_spacing", o.bump_spacing);
+  y.write("bump_length", o.bump_length);
+  if (std::isfinite(o.knock_time))
+    y.write_flow("knock", std::vector<double>{o.knock_time, o.knock_roll, o.knock_pitch, o.knock_z});
+  y.save(path);
 }
 
 }  // namespace

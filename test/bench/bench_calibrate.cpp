@@ -32,7 +32,7 @@
 #include <unistd.h>
 
 #include "calib/pipeline.h"
-#include "io/dataset.h"
+#include "io/dataset/dataset.h"
 #include "sim/simulator.h"
 #include "bench_args.h"
 #include "ocl/runtime.h"

@@ -16,7 +16,7 @@
 #include "calib/pipeline.h"
 #include "common/printed_values.h"
 #include "common/test_util.h"
-#include "io/dataset.h"
+#include "io/dataset/dataset.h"
 #include "io/formats.h"
 #include "ocl/runtime.h"
 #include "planarvo/planarvo.h"

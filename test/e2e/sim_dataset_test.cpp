@@ -9,7 +9,7 @@
 
 #include "common/test_util.h"
 #include "core/error.h"
-#include "io/dataset.h"
+#include "io/dataset/dataset.h"
 #include "ocl/runtime.h"
 #include "sim/simulator.h"
 

@@ -11,7 +11,7 @@
 
 #include "common/test_util.h"
 #include "core/extrinsics.h"
-#include "io/dataset.h"
+#include "io/dataset/dataset.h"
 #include "ocl/runtime.h"
 #include "sim/simulator.h"
 #include "track/evaluation.h"

@@ -1,4 +1,4 @@
-// Data sets (src/io/dataset.h) on small synthetic directories: frames, interpolation of
+// Data sets (src/io/dataset/dataset.h) on small synthetic directories: frames, interpolation of
 // odometry and ground truth to frame times against hand-computed values, direction labels by
 // interval midpoint, every bad input as InvalidInput naming the file (and line), progress and
 // cancelling, and a video standing in for images/ + frames.txt.
@@ -16,8 +16,8 @@
 #include <opencv2/videoio.hpp>
 
 #include "common/test_util.h"
-#include "io/dataset.h"
-#include "io/frame_image.h"
+#include "io/dataset/dataset.h"
+#include "io/dataset/frame_image.h"
 #include "unit/io_test_helpers.h"
 
 namespace planarvo {

@@ -7,7 +7,7 @@
 #include <opencv2/core.hpp>
 
 #include "common/test_util.h"
-#include "io/dataset.h"
+#include "io/dataset/dataset.h"
 #include "io/formats.h"
 #include "unit/io_test_helpers.h"
 

@@ -21,7 +21,7 @@
 namespace planarvo {
 namespace {
 
-using io::detail::YamlWriter;
+using io::YamlWriter;
 
 cv::FileStorage opencv_writer() {
   return cv::FileStorage(".yaml", cv::FileStorage::WRITE | cv::FileStorage::MEMORY | cv::FileStorage::FORMAT_YAML);
@@ -120,6 +120,13 @@ TEST(YamlWriter, RandomDocumentsAreWhatFileStorageWrites) {
           break;
         }
         case 4: {
+          if (rng() % 2) {
+            std::vector<double> v(rng() % 12);
+            for (double& x : v) x = random_real(rng);
+            theirs << key << v;
+            ours.write_flow(key.c_str(), v);
+            break;
+          }
           std::vector<int> v(rng() % 30);
           theirs << key << "[:";
           for (int& x : v) {

@@ -14,7 +14,7 @@
 
 #include "core/se2.h"
 #include "core/camera.h"
-#include "io/dataset_bag.h"
+#include "io/dataset/dataset_bag.h"
 #include "io/formats.h"
 
 namespace planarvo::io {

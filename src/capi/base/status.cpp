@@ -66,6 +66,10 @@ void require(bool condition, const char* message) {
   if (!condition) throw Error(ErrorCode::InvalidArgument, message);
 }
 
+void require_path(const char* path, const char* fn) {
+  if (path == nullptr || *path == '\0') throw Error(ErrorCode::InvalidArgument, std::string(fn) + ": path is NULL or empty");
+}
+
 void require_struct_size(size_t struct_size, size_t offset_end, const char* name) {
   if (struct_size < offset_end)
     throw Error(ErrorCode::InvalidArgument,

@@ -8,7 +8,7 @@
 // an earlier frame that is no longer cached reopens the file and grabs forward to it: O(i)
 // decodes. Seeking (CAP_PROP_POS_FRAMES) is not used, because it is inexact for codecs with
 // inter frames in some backends.
-#include "io/dataset.h"
+#include "io/dataset/dataset.h"
 
 #include <algorithm>
 #include <cmath>
@@ -28,7 +28,7 @@
 
 #include "core/error.h"
 #include "io/bag/bag.h"
-#include "io/frame_image.h"
+#include "io/dataset/frame_image.h"
 #include "io/text.h"
 
 namespace planarvo::io {

@@ -1,4 +1,6 @@
-// C API: camera and extrinsics YAML, TUM trajectories.
+// C API: the files the base library writes and reads without OpenCV: camera.yaml and
+// extrinsics.yaml written (io/yaml_writer.h), TUM trajectories, plane.txt, the statistics CSV.
+// Reading the YAML files needs cv::FileStorage: vision/files_yaml.cpp.
 #include <cmath>
 #include <cstddef>
 #include <cstdio>
@@ -18,21 +20,9 @@
 using planarvo::capi::guard;
 using planarvo::capi::require;
 
-namespace {
-void require_path(const char* path, const char* fn) {
-  require(path != nullptr && *path != '\0', (std::string(fn) + ": path is NULL or empty").c_str());
-}
-}  // namespace
+using planarvo::capi::require_path;
 
 extern "C" {
-
-PLANARVO_API planarvo_status planarvo_camera_load(const char* path, planarvo_camera* camera) {
-  return guard([&] {
-    require_path(path, "planarvo_camera_load");
-    require(camera != nullptr, "planarvo_camera_load: camera is NULL");
-    *camera = planarvo::capi::to_c(planarvo::io::read_camera_yaml(path));
-  });
-}
 
 PLANARVO_API planarvo_status planarvo_camera_save(const char* path, const planarvo_camera* camera) {
   return guard([&] {
@@ -45,14 +35,6 @@ PLANARVO_API planarvo_status planarvo_camera_save(const char* path, const planar
       throw planarvo::Error(planarvo::ErrorCode::InvalidArgument, e.what());
     }
     planarvo::io::write_camera_yaml(path, m);
-  });
-}
-
-PLANARVO_API planarvo_status planarvo_extrinsics_load(const char* path, planarvo_extrinsics* e) {
-  return guard([&] {
-    require_path(path, "planarvo_extrinsics_load");
-    require(e != nullptr, "planarvo_extrinsics_load: extrinsics is NULL");
-    *e = planarvo::capi::to_c(planarvo::io::read_extrinsics_yaml(path).value);
   });
 }
 

@@ -1,4 +1,4 @@
-#include "io/frame_image.h"
+#include "io/dataset/frame_image.h"
 
 #include <algorithm>
 #include <cstdint>

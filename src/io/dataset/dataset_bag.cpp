@@ -1,4 +1,4 @@
-#include "io/dataset_bag.h"
+#include "io/dataset/dataset_bag.h"
 
 #include <algorithm>
 #include <cmath>
@@ -12,7 +12,7 @@
 #include "core/error.h"
 #include "io/bag/bag.h"
 #include "io/bag/messages.h"
-#include "io/frame_image.h"
+#include "io/dataset/frame_image.h"
 
 namespace planarvo::io::detail {
 

@@ -1,4 +1,4 @@
-// C API: data sets (src/io/dataset.h).
+// C API: data sets (src/io/dataset/dataset.h).
 #include <cstring>
 #include <memory>
 #include <optional>
@@ -10,7 +10,7 @@
 #include "capi/status.h"
 #include "core/error.h"
 #include "io/bag/bag.h"
-#include "io/dataset.h"
+#include "io/dataset/dataset.h"
 
 using planarvo::capi::guard;
 using planarvo::capi::require;
