@@ -136,6 +136,12 @@ typedef struct planarvo_plane_attitude {
  * negative sigma; PLANARVO_ERROR_IO when it cannot be written. */
 PLANARVO_API planarvo_status planarvo_write_plane(const char* path, const planarvo_plane_attitude* rows, size_t count);
 
+/* Reads plane.txt (t roll pitch sigma_roll sigma_pitch per line, '#' comments; times increasing,
+ * |roll| and |pitch| at most pi/2, sigmas not negative, else PLANARVO_ERROR_INVALID_INPUT naming
+ * the line). capacity and count as planarvo_read_tum. */
+PLANARVO_API planarvo_status planarvo_read_plane(const char* path, planarvo_plane_attitude* rows, size_t capacity,
+                                                 size_t* count);
+
 /* Writes a TUM trajectory (t x y z qx qy qz qw, z = 0, rotation about z). */
 PLANARVO_API planarvo_status planarvo_write_tum(const char* path, const double* timestamps,
                                                 const planarvo_se2* poses, size_t count);
@@ -168,5 +174,20 @@ PLANARVO_API planarvo_status planarvo_stats_writer_add(planarvo_stats_writer* wr
 PLANARVO_API planarvo_status planarvo_stats_writer_close(planarvo_stats_writer* writer);
 /* Removes the partial file, leaves PATH as it was, and releases the writer; NULL is allowed. */
 PLANARVO_API void planarvo_stats_writer_discard(planarvo_stats_writer* writer);
+
+/* A statistics CSV read back, row by row. planarvo_stats_read takes the writer's header or its
+ * first nine columns (files written before the local plane) and a row per frame, numbers as the
+ * writer writes them (nan and inf included, but for the timestamp), status as written (RFC 4180
+ * quoting); anything else, or no row, is PLANARVO_ERROR_INVALID_INPUT naming the file and line. */
+typedef struct planarvo_stats_table planarvo_stats_table;
+PLANARVO_API planarvo_status planarvo_stats_read(const char* path, planarvo_stats_table** table);
+/* The number of rows; 0 for NULL. */
+PLANARVO_API size_t planarvo_stats_table_size(const planarvo_stats_table* table);
+/* Row `index` into *row; row->status points into the table, valid until it is freed.
+ * PLANARVO_ERROR_INVALID_ARGUMENT for an index past the end. */
+PLANARVO_API planarvo_status planarvo_stats_table_row(const planarvo_stats_table* table, size_t index,
+                                                     planarvo_frame_stats* row);
+/* Releases the table; NULL is allowed. */
+PLANARVO_API void planarvo_stats_table_free(planarvo_stats_table* table);
 
 #endif /* PLANARVO_DATASET_H */

@@ -169,6 +169,20 @@ PLANARVO_API planarvo_status planarvo_extrinsics_save(const char* path,
                                                       const double* covariance,
                                                       const char* estimated, const char* method,
                                                       const char* notes);
+/* Everything an extrinsics YAML holds (docs/formats.md), as planarvo_extrinsics_file_load reads it. */
+#define PLANARVO_EXTRINSICS_TEXT_MAX 4096
+typedef struct planarvo_extrinsics_file {
+  planarvo_extrinsics value;
+  double covariance[36];  /* row-major, in x y z roll pitch yaw order; zeros when the file has none */
+  int32_t estimated[6];   /* 1 for each parameter the file lists under estimated */
+  char method[PLANARVO_EXTRINSICS_TEXT_MAX + 1]; /* "" when the file has none */
+  char notes[PLANARVO_EXTRINSICS_TEXT_MAX + 1];
+} planarvo_extrinsics_file;
+/* Reads the whole extrinsics YAML: the values as planarvo_extrinsics_load does, and the
+ * covariance, the estimated parameters, method and notes. PLANARVO_ERROR_INVALID_INPUT naming the
+ * file for a malformed file, and for a method or notes longer than PLANARVO_EXTRINSICS_TEXT_MAX
+ * bytes (planarvo's writers write none longer). */
+PLANARVO_API planarvo_status planarvo_extrinsics_file_load(const char* path, planarvo_extrinsics_file* file);
 /* T_robot_camera as a 4x4 row-major matrix. */
 PLANARVO_API planarvo_status planarvo_extrinsics_matrix(const planarvo_extrinsics* e,
                                                         double matrix[16]);

@@ -4,6 +4,7 @@
 // temporary.
 #pragma once
 #include <string>
+#include <vector>
 
 #include "io/text.h"
 
@@ -45,5 +46,13 @@ class StatsWriter {
  private:
   detail::TextWriter out_;
 };
+
+// Reads a statistics CSV back: the header StatsWriter writes, or the first nine columns of it
+// (files written before the local plane); every row with as many fields as the header; the
+// timestamp finite, iterations an integer, the other numbers any double (nan and inf are written
+// for a lost frame's figures); the five attitude fields all empty (has_attitude false) or all
+// given, mounting_changed 0 or 1; status as written (RFC 4180 quoting). Empty lines are skipped.
+// InvalidInput "path:line: ..." otherwise, and for a file with no row.
+std::vector<FrameStats> read_stats(const std::string& path);
 
 }  // namespace planarvo::io

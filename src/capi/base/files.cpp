@@ -156,6 +156,22 @@ PLANARVO_API planarvo_status planarvo_write_tum(const char* path, const double* 
   });
 }
 
+PLANARVO_API planarvo_status planarvo_read_plane(const char* path, planarvo_plane_attitude* rows, size_t capacity,
+                                                 size_t* count) {
+  return guard([&] {
+    require_path(path, "planarvo_read_plane");
+    require(capacity == 0 || rows != nullptr, "planarvo_read_plane: rows is NULL");
+    const std::vector<planarvo::io::PlaneAttitude> v = planarvo::io::read_plane(path);
+    if (count) *count = v.size();
+    if (capacity == 0) return;
+    if (capacity < v.size())
+      planarvo::throw_invalid_argument("planarvo_read_plane: " + std::string(path) + " has " +
+                                       std::to_string(v.size()) + " rows, the array holds " + std::to_string(capacity));
+    for (size_t i = 0; i < v.size(); ++i)
+      rows[i] = {v[i].t, v[i].roll, v[i].pitch, v[i].sigma_roll, v[i].sigma_pitch};
+  });
+}
+
 PLANARVO_API planarvo_status planarvo_write_plane(const char* path, const planarvo_plane_attitude* rows, size_t count) {
   return guard([&] {
     require_path(path, "planarvo_write_plane");
@@ -215,5 +231,40 @@ PLANARVO_API planarvo_status planarvo_stats_writer_close(planarvo_stats_writer* 
 PLANARVO_API void planarvo_stats_writer_discard(planarvo_stats_writer* writer) {
   delete writer;  // the writer's destructor removes the partial file
 }
+
+struct planarvo_stats_table {
+  std::vector<planarvo::io::FrameStats> rows;
+};
+
+PLANARVO_API planarvo_status planarvo_stats_read(const char* path, planarvo_stats_table** table) {
+  return guard([&] {
+    require(table != nullptr, "planarvo_stats_read: table is NULL");
+    *table = nullptr;
+    require_path(path, "planarvo_stats_read");
+    auto t = std::make_unique<planarvo_stats_table>();
+    t->rows = planarvo::io::read_stats(path);
+    *table = t.release();
+  });
+}
+
+PLANARVO_API size_t planarvo_stats_table_size(const planarvo_stats_table* table) {
+  return table ? table->rows.size() : 0;
+}
+
+PLANARVO_API planarvo_status planarvo_stats_table_row(const planarvo_stats_table* table, size_t index,
+                                                     planarvo_frame_stats* row) {
+  return guard([&] {
+    require(table != nullptr && row != nullptr, "planarvo_stats_table_row: NULL argument");
+    require(index < table->rows.size(), ("planarvo_stats_table_row: index " + std::to_string(index) +
+                                         " is past the table's " + std::to_string(table->rows.size()) + " rows")
+                                            .c_str());
+    const planarvo::io::FrameStats& r = table->rows[index];
+    *row = {r.timestamp, r.vx, r.vy, r.omega, r.iterations, r.final_cost, r.inlier_fraction, r.ms,
+            r.status.c_str(), r.has_attitude ? 1 : 0, r.roll, r.pitch, r.sigma_roll, r.sigma_pitch,
+            r.mounting_changed ? 1 : 0};
+  });
+}
+
+PLANARVO_API void planarvo_stats_table_free(planarvo_stats_table* table) { delete table; }
 
 }  // extern "C"
