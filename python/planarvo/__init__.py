@@ -14,7 +14,7 @@ ValueError before any C call. Units: metres, radians, seconds (docs/conventions.
 """
 from ._calibration import (CalibrationMethod, CalibrationOptions, CalibrationResult, PairResiduals, RobustLoss,
                            calibrate, calibrate_residuals, compose_extrinsics)
-from ._camera import EXTRINSICS_NAMES, Camera, Extrinsics
+from ._camera import EXTRINSICS_NAMES, Camera, Extrinsics, ExtrinsicsFile
 from ._camera_calibration import (CalibrationStatus, CameraCalibrationOptions, CameraCalibrationResult,
                                   CameraCalibrator, ReadoutSource, RollPitch, RollPitchOptions, RollPitchResult,
                                   calibrate_dataset)
@@ -22,9 +22,9 @@ from ._context import Context, DeviceInfo, list_devices, version
 from ._dataset import Dataset, DatasetInfo, FrameData, bag_topics
 from ._errors import Error, Status
 from ._evaluation import MotionAccuracy, evaluate_motions
-from ._mosaic import Mosaic, MosaicInfo, build_mosaic, read_tum
+from ._mosaic import Mosaic, MosaicInfo, build_mosaic
 from ._motion_pairs import MotionPair, load_motion_pairs, save_motion_pairs, track_motions
-from ._output import StatsWriter, write_tum
+from ._output import STATS_COLUMNS, StatsWriter, read_plane, read_stats, read_tum, write_tum
 from ._posegraph import PosegraphInit, SolverSummary, posegraph_optimize
 from ._se2 import SE2
 from ._simulate import MotionProfile, SimOptions, default_texture, simulate
@@ -35,10 +35,10 @@ __version__ = _lib.planarvo_version_string().decode()
 
 __all__ = ["EXTRINSICS_NAMES", "CalibrationMethod", "CalibrationOptions", "CalibrationResult",
     "CalibrationStatus", "Camera", "CameraCalibrationOptions", "CameraCalibrationResult", "CameraCalibrator",
-    "Context", "Dataset", "DatasetInfo", "DeviceInfo", "Error", "Extrinsics", "FrameData", "MotionAccuracy",
+    "Context", "Dataset", "DatasetInfo", "DeviceInfo", "Error", "Extrinsics", "ExtrinsicsFile", "FrameData", "MotionAccuracy",
     "Mosaic", "MosaicInfo", "MotionPair", "MotionProfile", "MountingChange", "MountingResponse", "PosegraphInit", "ReadoutSource", "Residuals", "RobustLoss", "RollPitch",
     "RollPitchOptions",
     "RollPitchResult", "SE2", "SimOptions", "SolverSummary", "StatsWriter", "Status", "Tracker",
     "TrackerOptions", "TrackResult", "TrackStatus", "bag_topics", "calibrate", "calibrate_dataset", "calibrate_residuals", "PairResiduals", "compose_extrinsics",
-    "build_mosaic", "default_texture", "evaluate_motions", "list_devices", "load_motion_pairs", "posegraph_optimize", "read_tum",
+    "build_mosaic", "default_texture", "evaluate_motions", "list_devices", "load_motion_pairs", "posegraph_optimize", "read_plane", "read_stats", "read_tum", "STATS_COLUMNS",
     "save_motion_pairs", "simulate", "track_motions", "version", "write_tum"]

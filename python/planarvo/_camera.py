@@ -119,3 +119,33 @@ class Extrinsics:
 
     def _to_c(self) -> N.Extrinsics:
         return N.Extrinsics(*(getattr(self, n) for n in EXTRINSICS_NAMES))
+
+
+@dataclass
+class ExtrinsicsFile:
+    """Everything an extrinsics YAML holds (docs/formats.md): the extrinsics, their (6, 6)
+    covariance in EXTRINSICS_NAMES order (zeros when the file has none), the names of the
+    estimated parameters, and the method and notes ('' when absent)."""
+    extrinsics: Extrinsics
+    covariance: np.ndarray
+    estimated: Tuple[str, ...]
+    method: str
+    notes: str
+
+    @classmethod
+    def load(cls, path: PathLike) -> "ExtrinsicsFile":
+        f = N.ExtrinsicsFile()
+        _check(lib.planarvo_extrinsics_file_load(_path(path), ctypes.byref(f)))
+        return cls(Extrinsics._from_c(f.value), _matrix(f.covariance, 6),
+                   tuple(n for n, flag in zip(EXTRINSICS_NAMES, f.estimated) if flag),
+                   f.method.decode("utf-8", "replace"), f.notes.decode("utf-8", "replace"))
+
+    @property
+    def values(self) -> np.ndarray:
+        """(x, y, z, roll, pitch, yaw), shape (6,)."""
+        return self.extrinsics.as_array()
+
+    @property
+    def sigmas(self) -> np.ndarray:
+        """The standard deviations of the six, from the covariance's diagonal."""
+        return np.sqrt(np.maximum(np.diag(self.covariance), 0.0))

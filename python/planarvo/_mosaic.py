@@ -1,5 +1,5 @@
 """The floor mosaic (planarvo/mosaic.h): the ground under a trajectory as one 8-bit image,
-placed as ROS map_server places a map, and TUM trajectories read back."""
+placed as ROS map_server places a map."""
 from __future__ import annotations
 
 import ctypes
@@ -17,19 +17,6 @@ from ._handle import _Handle
 from ._native import lib
 from ._se2 import _se2_array
 from ._util import PathLike, ProgressFn, _Callback, _path
-
-
-def read_tum(path: PathLike) -> Tuple[np.ndarray, np.ndarray]:
-    """A TUM trajectory (planar poses only): timestamps (N,) and poses (N, 3) of (x, y, theta)."""
-    n = ctypes.c_size_t()
-    _check(lib.planarvo_read_tum(_path(path), None, None, 0, ctypes.byref(n)))
-    t = np.zeros(n.value, dtype=np.float64)
-    p = (N.SE2 * max(n.value, 1))()
-    if n.value:
-        _check(lib.planarvo_read_tum(_path(path), t.ctypes.data_as(N.P(ctypes.c_double)), p, n.value,
-                                     ctypes.byref(n)))
-    poses = np.array([(s.x, s.y, s.theta) for s in p[:n.value]], dtype=np.float64).reshape(-1, 3)
-    return t, poses
 
 
 @dataclass(frozen=True)

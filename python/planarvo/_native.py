@@ -38,6 +38,11 @@ class Extrinsics(ctypes.Structure):
     _fields_ = [(n, c_double) for n in ("x", "y", "z", "roll", "pitch", "yaw")]
 
 
+class ExtrinsicsFile(ctypes.Structure):
+    _fields_ = [("value", Extrinsics), ("covariance", c_double * 36), ("estimated", c_int32 * 6),
+                ("method", ctypes.c_char * 4097), ("notes", ctypes.c_char * 4097)]
+
+
 class SE2(ctypes.Structure):
     _fields_ = [("x", c_double), ("y", c_double), ("theta", c_double)]
 
@@ -84,6 +89,10 @@ class FrameData(ctypes.Structure):
     _fields_ = [("timestamp", c_double), ("has_odometry", c_int32), ("odometry", SE2),
                 ("has_groundtruth", c_int32), ("groundtruth", SE2), ("has_direction", c_int32),
                 ("direction", c_int32)]
+
+
+class PlaneAttitude(ctypes.Structure):
+    _fields_ = [(n, c_double) for n in ("timestamp", "roll", "pitch", "sigma_roll", "sigma_pitch")]
 
 
 class FrameStats(ctypes.Structure):

@@ -1,8 +1,9 @@
-"""Result files (docs/formats.md): TUM trajectories and the per-frame statistics CSV."""
+"""Result files (docs/formats.md), written and read back by the library: TUM trajectories,
+plane.txt and the per-frame statistics CSV."""
 from __future__ import annotations
 
 import ctypes
-from typing import Any, Optional, Sequence
+from typing import Any, Dict, Optional, Sequence, Tuple
 
 import numpy as np
 
@@ -12,6 +13,60 @@ from ._handle import _Handle
 from ._native import lib
 from ._se2 import _se2_array
 from ._util import PathLike, _path
+
+
+def read_tum(path: PathLike) -> Tuple[np.ndarray, np.ndarray]:
+    """A TUM trajectory (planar poses only): timestamps (N,) and poses (N, 3) of (x, y, theta)."""
+    n = ctypes.c_size_t()
+    _check(lib.planarvo_read_tum(_path(path), None, None, 0, ctypes.byref(n)))
+    t = np.zeros(n.value, dtype=np.float64)
+    p = (N.SE2 * max(n.value, 1))()
+    if n.value:
+        _check(lib.planarvo_read_tum(_path(path), t.ctypes.data_as(N.P(ctypes.c_double)), p, n.value,
+                                     ctypes.byref(n)))
+    poses = np.array([(s.x, s.y, s.theta) for s in p[:n.value]], dtype=np.float64).reshape(-1, 3)
+    return t, poses
+
+
+def read_plane(path: PathLike) -> np.ndarray:
+    """plane.txt (`planarvo track --plane-out`, the simulator's truth): (N, 5) of timestamp, roll,
+    pitch, sigma_roll, sigma_pitch (radians)."""
+    n = ctypes.c_size_t()
+    _check(lib.planarvo_read_plane(_path(path), None, 0, ctypes.byref(n)))
+    rows = (N.PlaneAttitude * max(n.value, 1))()
+    if n.value:
+        _check(lib.planarvo_read_plane(_path(path), rows, n.value, ctypes.byref(n)))
+    return np.array([(r.timestamp, r.roll, r.pitch, r.sigma_roll, r.sigma_pitch) for r in rows[:n.value]],
+                    dtype=np.float64).reshape(-1, 5)
+
+
+STATS_COLUMNS = ("timestamp", "vx", "vy", "omega", "iterations", "final_cost", "inlier_fraction", "ms", "status",
+                 "roll", "pitch", "sigma_roll", "sigma_pitch", "mounting_changed")
+
+
+def read_stats(path: PathLike) -> Dict[str, np.ndarray]:
+    """The per-frame statistics CSV (`planarvo track --stats`, StatsWriter) as one array per
+    column, named as in the file's header (STATS_COLUMNS): float64, but iterations (int64),
+    status (str) and mounting_changed (bool); roll, pitch and their sigmas NaN where a row has no
+    attitude (files from before the local plane have none)."""
+    table = ctypes.c_void_p()
+    _check(lib.planarvo_stats_read(_path(path), ctypes.byref(table)))
+    try:
+        n = lib.planarvo_stats_table_size(table)
+        cols: Dict[str, list] = {name: [] for name in STATS_COLUMNS}
+        row = N.FrameStats()
+        for i in range(n):
+            _check(lib.planarvo_stats_table_row(table, i, ctypes.byref(row)))
+            for name in ("timestamp", "vx", "vy", "omega", "iterations", "final_cost", "inlier_fraction", "ms"):
+                cols[name].append(getattr(row, name))
+            cols["status"].append(row.status.decode("utf-8", "replace"))
+            for name in ("roll", "pitch", "sigma_roll", "sigma_pitch"):
+                cols[name].append(getattr(row, name) if row.has_attitude else np.nan)
+            cols["mounting_changed"].append(bool(row.has_attitude and row.mounting_changed))
+    finally:
+        lib.planarvo_stats_table_free(table)
+    types = {"iterations": np.int64, "status": str, "mounting_changed": bool}
+    return {name: np.array(v, dtype=types.get(name, np.float64)) for name, v in cols.items()}
 
 
 def write_tum(path: PathLike, timestamps: Sequence[float], poses: Any) -> None:

@@ -61,8 +61,15 @@ def test_extrinsics_round_trip_and_matrix(tmp_path):
            notes="round trip")
     loaded = planarvo.Extrinsics.load(tmp_path / "e.yaml")
     np.testing.assert_allclose(loaded.as_array(), e.as_array(), rtol=0, atol=1e-15)
-    text = (tmp_path / "e.yaml").read_text()
-    assert "round trip" in text
+    f = planarvo.ExtrinsicsFile.load(tmp_path / "e.yaml")
+    assert f.extrinsics == e  # every value exactly
+    np.testing.assert_array_equal(f.covariance, cov)
+    np.testing.assert_array_equal(f.sigmas, np.sqrt(np.diag(cov)))
+    assert f.estimated == planarvo.EXTRINSICS_NAMES
+    assert (f.method, f.notes) == ("test", "round trip")
+    e.save(tmp_path / "bare.yaml")
+    bare = planarvo.ExtrinsicsFile.load(tmp_path / "bare.yaml")
+    assert bare.estimated == () and bare.method == "" and not bare.covariance.any()
 
     def rx(a):
         return np.array([[1, 0, 0], [0, math.cos(a), -math.sin(a)], [0, math.sin(a), math.cos(a)]])
@@ -133,3 +140,26 @@ def test_stats_writer(tmp_path):
             raise RuntimeError("stop")
     assert path.read_text().splitlines() == lines
     assert not (tmp_path / "stats.csv.partial").exists()
+    # Read back by the library: each column as written; no attitude is NaN.
+    st = planarvo.read_stats(path)
+    assert set(st) == set(planarvo.STATS_COLUMNS)
+    np.testing.assert_array_equal(st["timestamp"], [0.0, 0.1, 0.2])
+    np.testing.assert_array_equal(st["vx"], [0.0, 0.5, 0.5])
+    np.testing.assert_array_equal(st["iterations"], [0, 7, 7])
+    assert list(st["status"]) == ["first", "ok", "ok"]
+    assert np.isnan(st["roll"][:2]).all() and st["roll"][2] == 0.015625 and st["sigma_pitch"][2] == 0.002
+    assert list(st["mounting_changed"]) == [False, False, True]
+    path.write_text("timestamp,vx\n0,1\n")
+    with pytest.raises(planarvo.Error) as err:
+        planarvo.read_stats(path)
+    assert err.value.status == planarvo.Status.INVALID_INPUT and str(path) + ":1:" in err.value.message
+
+
+def test_plane_reads_back(tmp_path):
+    path = tmp_path / "plane.txt"
+    path.write_text("# t roll pitch sigma_roll sigma_pitch\n0.0 0.01 -0.02 0.001 0.002\n0.1 0.015 -0.025 0 0\n")
+    np.testing.assert_array_equal(planarvo.read_plane(path),
+                                  [[0.0, 0.01, -0.02, 0.001, 0.002], [0.1, 0.015, -0.025, 0, 0]])
+    path.write_text("0.0 12.4 0 0 0\n")  # degrees by mistake
+    with pytest.raises(planarvo.Error):
+        planarvo.read_plane(path)

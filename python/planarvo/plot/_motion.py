@@ -18,9 +18,9 @@ def wrap(a):
 
 
 def match_frames(traj: Trajectory, series: Series) -> np.ndarray:
-    """The data-set frame index of every trajectory line (by time, within TIME_TOLERANCE; a
+    """The data-set frame index of every trajectory pose (by time, within TIME_TOLERANCE; a
     trajectory may skip frames). Stamps are the data set's times plus its time origin (a bag's
-    first stamp; 0 for a folder). Raises InputError naming the first line that matches no frame."""
+    first stamp; 0 for a folder). Raises InputError naming the first pose that matches no frame."""
     t = traj.stamps - series.time_origin_s
     times = series.times
     j = np.clip(np.searchsorted(times, t), 1, len(times) - 1) if len(times) > 1 else np.zeros(len(t), int)
@@ -30,8 +30,8 @@ def match_frames(traj: Trajectory, series: Series) -> np.ndarray:
     bad = np.nonzero(np.abs(times[j] - t) > TIME_TOLERANCE)[0]
     if len(bad):
         k = int(bad[0])
-        raise InputError("%s line %d: time %.9f matches no frame of %s (nearest frame %.9f, %.3g s away; "
-                         "tolerance %g s)" % (traj.path, traj.lines[k], traj.stamps[k], series.path,
+        raise InputError("%s pose %d: time %.9f matches no frame of %s (nearest frame %.9f, %.3g s away; "
+                         "tolerance %g s)" % (traj.path, k + 1, traj.stamps[k], series.path,
                                               times[j[k]] + series.time_origin_s, abs(times[j[k]] - t[k]),
                                               TIME_TOLERANCE))
     return j

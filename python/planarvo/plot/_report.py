@@ -11,8 +11,10 @@ from typing import Dict, List, Optional
 
 import numpy as np
 
+from planarvo import EXTRINSICS_NAMES
+
 from ._calibration_data import CalibrationData
-from ._io import EXTRINSICS_NAMES, ExtrinsicsFile
+from ._io import ExtrinsicsFile
 
 CSS = """body{font-family:sans-serif;max-width:1150px;margin:2em auto;color:#222}
 table{border-collapse:collapse;margin:0.5em 0 1.5em}td,th{border:1px solid #bbb;padding:3px 9px;text-align:right}

@@ -25,10 +25,10 @@ def plot_track(dataset: str, trajectory: str, stats: Optional[str], out_dir: str
     series = read_dataset(dataset)
     frames = match_frames(traj, series)
     times = series.times[frames]
-    if np.any(np.diff(times) <= 0):
+    if np.any(np.diff(times) <= 0):  # two poses matched to one frame
         k = int(np.nonzero(np.diff(times) <= 0)[0][0]) + 1
-        raise InputError("%s line %d: time %.9f is not after the line before it" % (trajectory, traj.lines[k],
-                                                                                    traj.stamps[k]))
+        raise InputError("%s pose %d: time %.9f matches the same frame as the pose before it"
+                         % (trajectory, k + 1, traj.stamps[k]))
     first, last = int(frames[0]), int(frames[-1])
     span = slice(first, last + 1)
     written = _trajectory.trajectory_figure(
