@@ -346,12 +346,13 @@ class Random {
 uint64_t derive_seed(uint64_t seed, uint64_t stream);
 
 // ---------------------------------------------------------------------------------------------
-// Where simulate() spent its time, seconds of wall-clock time.
+// Where simulate() spent its time, seconds. setup and render are the calling thread's wall-clock
+// time; camera and write (PNG) run on worker threads beside the render and are their time summed.
 struct SimulationStats {
   double setup = 0;    // trajectory, texture, mip pyramid, ray tables, kernel build
   double render = 0;   // the render kernel, including the read-back
-  double camera = 0;   // gain, offset, noise, quantisation
-  double write = 0;    // PNG encoding and writing, text files
+  double camera = 0;   // lighting, gain, offset, noise, quantisation (worker threads)
+  double write = 0;    // PNG encoding and writing (worker threads), text files
   int64_t frames = 0;
 };
 

@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <string>
+#include <utility>
 
 #include <opencv2/imgcodecs.hpp>
 
@@ -12,6 +13,7 @@
 #include "io/formats.h"
 #include "io/yaml_writer.h"
 #include "ocl/runtime.h"
+#include "sim/frame_finisher.h"
 #include "sim/simulator.h"
 
 namespace planarvo::sim {
@@ -111,18 +113,6 @@ void write_truth(const Options& options, const Trajectory& tr, const std::filesy
   }
 }
 
-// One frame's PNG (compression 1: fast, lossless); Io naming the file when it cannot be written.
-void write_png(const std::string& path, const cv::Mat& image) {
-  static const std::vector<int> png = {cv::IMWRITE_PNG_COMPRESSION, 1};
-  bool ok = false;
-  try {
-    ok = cv::imwrite(path, image, png);
-  } catch (const cv::Exception& e) {
-    throw Error(ErrorCode::Io, path + ": cannot be written (" + e.err + ")");
-  }
-  if (!ok) throw Error(ErrorCode::Io, path + ": cannot be written");
-}
-
 }  // namespace
 
 void simulate(ocl::Runtime& runtime, const Options& options, const std::string& out_dir,
@@ -159,26 +149,26 @@ void simulate(ocl::Runtime& runtime, const Options& options, const std::string& 
   write_simulation_yaml((dir / "simulation.yaml").string(), options, renderer.texel());
   st.write += seconds_since(t0);
 
+  // The device renders frame k + 1 while worker threads finish frame k (frame_finisher.h): one
+  // thread of the two cores' is enough to keep up with the render, a second overlaps the render's
+  // host side.
   std::vector<io::FrameEntry> frames;
   const size_t n = tr.t.size();
-  for (size_t k = 0; k < n; ++k) {
-    report(options, static_cast<double>(k) / static_cast<double>(n), "rendering");
-    t0 = Clock::now();
-    cv::Mat clean = render_frame(renderer, options, tr, k);
-    st.render += seconds_since(t0);
-
-    t0 = Clock::now();
-    apply_lighting(lighting, clean);
-    const cv::Mat image = apply_camera(clean, exposure[k], options.pixel_noise,
-                                       derive_seed(options.seed, 1000 + k));
-    st.camera += seconds_since(t0);
-
-    t0 = Clock::now();
-    char name[32];
-    std::snprintf(name, sizeof name, "images/%06zu.png", k);
-    write_png((dir / name).string(), image);
-    frames.push_back({tr.t[k], name, 0});
-    st.write += seconds_since(t0);
+  {
+    FrameFinisher finisher(options, lighting, exposure, 2, 4);
+    for (size_t k = 0; k < n; ++k) {
+      report(options, static_cast<double>(k) / static_cast<double>(n), "rendering");
+      t0 = Clock::now();
+      cv::Mat clean = render_frame(renderer, options, tr, k);
+      st.render += seconds_since(t0);
+      char name[32];
+      std::snprintf(name, sizeof name, "images/%06zu.png", k);
+      finisher.submit(k, std::move(clean), (dir / name).string());
+      frames.push_back({tr.t[k], name, 0});
+    }
+    finisher.finish();
+    st.camera = finisher.camera_seconds();
+    st.write += finisher.write_seconds();
   }
   t0 = Clock::now();
   io::write_frames((dir / "frames.txt").string(), frames);
