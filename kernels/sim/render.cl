@@ -78,7 +78,10 @@ void render_ground(__global const float* tex, __constant int* levels, __global c
     const float b00 = (a00 * j00 + a01 * j10) * inv_s, b01 = (a00 * j01 + a01 * j11) * inv_s;
     const float b10 = (a10 * j00 + a11 * j10) * inv_s, b11 = (a10 * j01 + a11 * j11) * inv_s;
     const float len2 = fmax(b00 * b00 + b10 * b10, b01 * b01 + b11 * b11);
-    if (g2 < 0.0f && len2 < 1e30f) lod = clamp(0.5f * log2(fmax(len2, 1e-30f)), 0.0f, lod_max);
+    // A footprint of at most one texel is level 0 whatever log2 says (it is <= 0 there): the
+    // common case, and log2 is a good part of the kernel's time on a CPU.
+    if (g2 < 0.0f && len2 < 1e30f)
+      lod = len2 <= 1.0f ? 0.0f : clamp(0.5f * log2(fmax(len2, 1e-30f)), 0.0f, lod_max);
   }
   const int l0 = (int)lod;
   const int l1 = min(l0 + 1, (int)lod_max);

@@ -252,7 +252,7 @@ cv::Mat render_reference(const MipPyramid& pyramid, const RayTable& rays, const 
         const float b10 = (a10 * j00 + a11 * j10) * inv_s, b11 = (a10 * j01 + a11 * j11) * inv_s;
         const float len2 = std::max(b00 * b00 + b10 * b10, b01 * b01 + b11 * b11);
         if (g2 < 0.0f && len2 < 1e30f)
-          lod = std::min(std::max(0.5f * std::log2(std::max(len2, 1e-30f)), 0.0f), lod_max);
+          lod = len2 <= 1.0f ? 0.0f : std::min(std::max(0.5f * std::log2(std::max(len2, 1e-30f)), 0.0f), lod_max);
       }
       const int l0 = static_cast<int>(lod);
       const int l1 = std::min(l0 + 1, static_cast<int>(lod_max));
