@@ -320,7 +320,7 @@ typedef struct planarvo_sim_options {
   double gain_variation;      /* amplitude of the slow camera gain change, relative; def. 0.05 */
   double odometry_noise;      /* wheel odometry error, relative standard deviation per wheel
                                  travel; default 0.01 */
-  int32_t supersampling;      /* samples per pixel along each axis; default 3 */
+  int32_t supersampling;      /* samples per pixel along each axis; default 2 (3 in 0.2.0 and before) */
   planarvo_progress_fn progress;
   void* progress_user_data;
   double min_turn_radius;     /* PLANARVO_MOTION_CAR: the tightest turn, metres; default 0 (only

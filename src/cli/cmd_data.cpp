@@ -67,7 +67,7 @@ std::vector<OptionSpec> simulate_options() {
       {"height", "PX", "image height", "480"},
       {"fov", "DEG", "horizontal field of view", "80"},
       {"distortion", "k1,k2,p1,p2,k3", "lens distortion (OpenCV model)", "-0.12,0.03,0,0,0"},
-      {"supersampling", "N", "N x N samples per pixel (plus mip-mapping)", "3"},
+      {"supersampling", "N", "N x N samples per pixel (plus mip-mapping)", "2"},
       roi_option("the whole image; written to camera.yaml. A camera that sees the horizon needs one that leaves "
                  "it out"),
       {"quiet", "", "no progress bar", ""},

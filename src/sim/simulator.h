@@ -94,8 +94,8 @@ struct Options {
   double exposure_time = 0.0;       // seconds each row integrates the moving scene before it is
                                     // read, at most 1 / fps (0: instantaneous, no motion blur);
                                     // written into camera.yaml as exposure_time (likewise)
-  int supersampling = 3;            // samples per pixel along each axis (ray tables take
-                                    // 8 S^2 + 24 bytes per pixel: 29 MB at 640x480, S = 3)
+  int supersampling = 2;            // samples per pixel along each axis (ray tables take
+                                    // 8 S^2 + 24 bytes per pixel: 17 MB at 640x480, S = 2)
   bool mipmap = true;               // prefilter the texture (off only for tests/references)
   // Real-camera light (fixed to the camera, not to the ground; see Lighting below).
   double lamp_falloff = 0.0;   // a lamp beside the lens: the darkest corner's brightness is
