@@ -283,6 +283,10 @@ PLANARVO_API planarvo_status planarvo_context_export_kernels_for(planarvo_contex
                                                                  size_t* exported);
 /* Builds (or loads) every kernel program now, so that the first frame does not pay for it. */
 PLANARVO_API planarvo_status planarvo_context_prepare_kernels(planarvo_context* context);
+/* As planarvo_context_prepare_kernels, but only the programs the named uses need (the names of
+ * planarvo_context_export_kernels_for; NULL or "": every program). Built programs go to the
+ * context's program cache, so another context, or a later run, on the same device loads them. */
+PLANARVO_API planarvo_status planarvo_context_prepare_kernels_for(planarvo_context* context, const char* uses);
 
 /* Data sets, bags and the files a run writes: planarvo/dataset.h (part of this header). */
 #define PLANARVO_INSIDE_PLANARVO_H

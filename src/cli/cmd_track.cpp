@@ -317,10 +317,14 @@ TrackRun track_dataset(planarvo_context* ctx, planarvo_dataset* ds, const planar
   return run;
 }
 
-void print_track_run(const TrackRun& run) {
+double median_ms(const TrackRun& run) {
   std::vector<double> ms = run.ms;
   std::sort(ms.begin(), ms.end());
-  const double median = ms.empty() ? 0 : ms[ms.size() / 2];
+  return ms.empty() ? 0 : ms[ms.size() / 2];
+}
+
+void print_track_run(const TrackRun& run) {
+  const double median = median_ms(run);
   std::printf("frames %lld: %lld ok, %lld degraded, %lld lost; %lld keyframes\n", static_cast<long long>(run.frames),
               static_cast<long long>(run.ok), static_cast<long long>(run.degraded), static_cast<long long>(run.lost),
               static_cast<long long>(run.keyframes));

@@ -127,6 +127,8 @@ struct TrackOutputs {
   // of it the local plane found), "" for none.
   std::string mounting;
 };
+// The median of the per-frame engine times, ms (0 without frames).
+double median_ms(const TrackRun& run);
 TrackRun track_dataset(planarvo_context* ctx, planarvo_dataset* ds, const planarvo_extrinsics& extrinsics,
                        const planarvo_tracker_options& options, const TrackOutputs& outputs, Progress* progress);
 void print_track_run(const TrackRun& run);

@@ -351,13 +351,36 @@ cl::Program Runtime::build_with_cache(const std::string& name, const std::string
   return p;
 }
 
-void Runtime::prepare_all() {
+void Runtime::prepare(const std::vector<std::string>& uses) {
+  check_uses(uses);
   for (const EmbeddedSource* s = embedded_sources(); s->name; ++s) {
     if (std::string(s->name) == kPreludeName) continue;
-    std::vector<std::string> option_sets = registered_build_options(s->name);
-    if (option_sets.empty()) option_sets.push_back("");
-    for (const std::string& options : option_sets) program(s->name, options);
+    for (const std::string& options : variants_for(s->name, uses)) program(s->name, options);
   }
+}
+
+void Runtime::check_uses(const std::vector<std::string>& uses) {
+  const std::vector<std::string> known = known_uses();
+  for (const std::string& u : uses)
+    if (std::find(known.begin(), known.end(), u) == known.end())
+      throw Error(ErrorCode::InvalidArgument,
+                  "no kernels are registered for " + quote(u) + "; the uses are " + join(known, ", "));
+}
+
+std::vector<std::string> Runtime::variants_for(const std::string& program, const std::vector<std::string>& uses) {
+  std::vector<std::string> sets = registered_build_options(program);
+  if (uses.empty()) {
+    if (sets.empty()) sets.push_back("");
+    return sets;
+  }
+  std::vector<std::string> out;
+  for (const std::string& options : sets) {
+    const std::vector<std::string> has = registered_uses(program, options);
+    if (std::any_of(uses.begin(), uses.end(),
+                    [&](const std::string& u) { return std::find(has.begin(), has.end(), u) != has.end(); }))
+      out.push_back(options);
+  }
+  return out;
 }
 
 void Runtime::register_build_options(const std::string& program, const std::string& options,

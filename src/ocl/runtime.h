@@ -108,9 +108,17 @@ class Runtime {
   // when a build fails.
   size_t export_binaries(const std::string& dir, const std::vector<std::string>& uses = {});
 
-  // Builds (or loads) every embedded program with each registered option set, as
-  // export_binaries() would, so that the first frame does not pay for compilation.
-  void prepare_all();
+  // Builds (or loads) the programs export_binaries() would write for the same uses (empty:
+  // every embedded program with each registered option set), so that the first frame does not
+  // pay for compilation. An unknown use is Error(InvalidArgument).
+  void prepare(const std::vector<std::string>& uses = {});
+  void prepare_all() { prepare(); }
+
+  // Error(InvalidArgument) naming the first of uses that no variant is registered for.
+  static void check_uses(const std::vector<std::string>& uses);
+  // The option sets of program that serve one of uses (every registered one, or "" when none
+  // is, for no uses).
+  static std::vector<std::string> variants_for(const std::string& program, const std::vector<std::string>& uses);
 
   // Layers declare the build options they will use for a program, so that export_binaries()
   // can build exactly those variants. uses names what needs the variant in the user's words,

@@ -186,29 +186,8 @@ cl::Program Runtime::load_from_binaries(const std::string& name, const std::stri
 }
 
 size_t Runtime::export_binaries(const std::string& dir, const std::vector<std::string>& uses) {
-  const std::vector<std::string> known = known_uses();
-  for (const std::string& u : uses)
-    if (std::find(known.begin(), known.end(), u) == known.end())
-      throw Error(ErrorCode::InvalidArgument,
-                  "no kernels are registered for " + quote(u) + "; the uses are " + join(known, ", "));
-  // The option sets to export for a program: every registered one (or "" when none is) when
-  // no use is asked for; otherwise those registered for one of the uses.
-  const auto wanted = [&](const std::string& program) {
-    std::vector<std::string> sets = registered_build_options(program);
-    if (uses.empty()) {
-      if (sets.empty()) sets.push_back("");
-      return sets;
-    }
-    std::vector<std::string> out;
-    for (const std::string& options : sets) {
-      const std::vector<std::string> has = registered_uses(program, options);
-      if (std::any_of(uses.begin(), uses.end(), [&](const std::string& u) {
-            return std::find(has.begin(), has.end(), u) != has.end();
-          }))
-        out.push_back(options);
-    }
-    return out;
-  };
+  check_uses(uses);
+  const auto wanted = [&](const std::string& program) { return variants_for(program, uses); };
 
   std::lock_guard<std::mutex> lock(mutex_);
   std::error_code ec;

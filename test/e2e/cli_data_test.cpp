@@ -290,7 +290,7 @@ TEST(CliData, DemoPrintsWhatTheCApiComputesOnItsDataSet) {
     degraded += f.result.status == PLANARVO_TRACK_DEGRADED;
     lost += f.result.status == PLANARVO_TRACK_LOST;
   }
-  const std::vector<double> counts = numbers_after(r.output, "tracked every frame with the true extrinsics in");
+  const std::vector<double> counts = numbers_after(r.output, "tracked every frame in");
   ASSERT_GE(counts.size(), 4u) << r.output;
   EXPECT_EQ(counts[1], ok);
   EXPECT_EQ(counts[2], degraded);

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <set>
 #include <string>
@@ -118,6 +119,38 @@ TEST(CApi, ExportKernelsForAUse) {
             PLANARVO_ERROR_INVALID_ARGUMENT);
   EXPECT_EQ(planarvo_context_export_kernels_for(nullptr, dir.c_str(), nullptr, &n), PLANARVO_ERROR_INVALID_ARGUMENT);
   EXPECT_EQ(planarvo_context_export_kernels_for(c, nullptr, nullptr, &n), PLANARVO_ERROR_INVALID_ARGUMENT);
+  planarvo_context_destroy(c);
+}
+
+// Preparing by use builds what the export for the same use writes, into the context's cache.
+TEST(CApi, PrepareKernelsForAUseBuildsWhatItsExportWrites) {
+  planarvo::test::ScratchDir d;
+  const std::string cache = (d / "cache").string();
+  planarvo_context_options o;
+  planarvo_context_options_init(&o);
+  o.cache_dir = cache.c_str();
+  planarvo_context* c = nullptr;
+  ASSERT_EQ(planarvo_context_create(&o, &c), PLANARVO_OK) << planarvo_last_error();
+  const auto entries = [&] {
+    size_t n = 0;
+    if (std::filesystem::exists(cache))
+      for (const auto& e : std::filesystem::recursive_directory_iterator(cache)) n += e.is_regular_file();
+    return n;
+  };
+  size_t simulate = 0, track = 0;
+  ASSERT_EQ(planarvo_context_export_kernels_for(c, (d / "sim").string().c_str(), "simulate", &simulate), PLANARVO_OK);
+  ASSERT_EQ(planarvo_context_export_kernels_for(c, (d / "track").string().c_str(), "track", &track), PLANARVO_OK);
+  ASSERT_GT(track, 1u);
+  planarvo_context_destroy(c);  // the exports built into the cache too: start again from an empty one
+  std::filesystem::remove_all(cache);
+  ASSERT_EQ(planarvo_context_create(&o, &c), PLANARVO_OK) << planarvo_last_error();
+  ASSERT_EQ(planarvo_context_prepare_kernels_for(c, "simulate"), PLANARVO_OK) << planarvo_last_error();
+  EXPECT_EQ(entries(), simulate);
+  ASSERT_EQ(planarvo_context_prepare_kernels_for(c, "track, simulate"), PLANARVO_OK) << planarvo_last_error();
+  EXPECT_EQ(entries(), simulate + track);
+  EXPECT_EQ(planarvo_context_prepare_kernels_for(c, "tracking"), PLANARVO_ERROR_INVALID_ARGUMENT);
+  EXPECT_NE(std::string(planarvo_last_error()).find("tracking"), std::string::npos);
+  EXPECT_EQ(planarvo_context_prepare_kernels_for(nullptr, "track"), PLANARVO_ERROR_INVALID_ARGUMENT);
   planarvo_context_destroy(c);
 }
 

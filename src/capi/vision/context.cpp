@@ -37,6 +37,22 @@ void fill_info(const planarvo::ocl::DeviceInfo& d, planarvo_device_info* out) {
   std::memcpy(out, &info, std::min(struct_size, sizeof info));
 }
 
+// "track,calibrate" as names; "" or NULL: none (every kernel). An empty name is InvalidArgument.
+std::vector<std::string> use_names(const char* uses, const char* fn) {
+  std::vector<std::string> names;
+  for (const char* p = uses ? uses : ""; *p;) {
+    const char* end = std::strchr(p, ',');
+    if (!end) end = p + std::strlen(p);
+    std::string name(p, end);
+    name.erase(0, name.find_first_not_of(' '));
+    name.erase(name.find_last_not_of(' ') + 1);
+    if (name.empty()) planarvo::throw_invalid_argument(std::string(fn) + ": an empty name in uses \"" + uses + "\"");
+    names.push_back(name);
+    p = *end ? end + 1 : end;
+  }
+  return names;
+}
+
 }  // namespace
 
 extern "C" {
@@ -120,19 +136,7 @@ PLANARVO_API planarvo_status planarvo_context_export_kernels_for(planarvo_contex
   return guard([&] {
     require(context != nullptr, "planarvo_context_export_kernels_for: context is NULL");
     require(dir != nullptr && *dir, "planarvo_context_export_kernels_for: dir is NULL or empty");
-    std::vector<std::string> names;
-    for (const char* p = uses ? uses : ""; *p;) {
-      const char* end = std::strchr(p, ',');
-      if (!end) end = p + std::strlen(p);
-      std::string name(p, end);
-      name.erase(0, name.find_first_not_of(' '));
-      name.erase(name.find_last_not_of(' ') + 1);
-      if (name.empty())
-        planarvo::throw_invalid_argument("planarvo_context_export_kernels_for: an empty name in uses \"" +
-                                         std::string(uses) + "\"");
-      names.push_back(name);
-      p = *end ? end + 1 : end;
-    }
+    const std::vector<std::string> names = use_names(uses, "planarvo_context_export_kernels_for");
     const size_t n = context->runtime->export_binaries(dir, names);
     if (exported) *exported = n;
   });
@@ -142,6 +146,13 @@ PLANARVO_API planarvo_status planarvo_context_prepare_kernels(planarvo_context* 
   return guard([&] {
     require(context != nullptr, "planarvo_context_prepare_kernels: context is NULL");
     context->runtime->prepare_all();
+  });
+}
+
+PLANARVO_API planarvo_status planarvo_context_prepare_kernels_for(planarvo_context* context, const char* uses) {
+  return guard([&] {
+    require(context != nullptr, "planarvo_context_prepare_kernels_for: context is NULL");
+    context->runtime->prepare(use_names(uses, "planarvo_context_prepare_kernels_for"));
   });
 }
 
