@@ -660,6 +660,16 @@ typedef struct planarvo_motion_pair {
   double odometry_covariance[9];
 } planarvo_motion_pair;
 
+/* The camera's own motion (the sensor motion of the graph calibration, docs/conventions.md "Sensor
+ * motions and the calibration model") from a robot motion tracked with extrinsics e: the motion of
+ * the ground point below the camera, turned by its yaw, in units of its height, as tracking with
+ * x = y = 0, z = 1, yaw = 0 and e's roll and pitch measures it. robot_covariance and
+ * sensor_covariance (3x3 row-major, right perturbations) may be NULL. PLANARVO_ERROR_INVALID_ARGUMENT
+ * unless e->z > 0. */
+PLANARVO_API planarvo_status planarvo_sensor_motion(const planarvo_extrinsics* e, const planarvo_se2* robot_motion,
+                                                   const double* robot_covariance, planarvo_se2* sensor_motion,
+                                                   double* sensor_covariance);
+
 /* Zeroes *pair (no odometry, direction or covariances) and sets its struct_size. */
 PLANARVO_API void planarvo_motion_pair_init(planarvo_motion_pair* pair);
 /* Writes count motion pairs (elements pairs[0].struct_size bytes apart) as the CSV that

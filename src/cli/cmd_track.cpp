@@ -44,17 +44,19 @@ struct Tracked {
 
 // The motion pair of a tracked interval, with the data set's odometry and direction label when
 // it has them; none for an interval the odometry or the labels do not cover, so that every row
-// has the same columns.
-bool motion_pair(const planarvo_dataset_info& info, const planarvo_frame_data& previous,
-                 const planarvo_frame_data& fd, const planarvo_track_result& r, planarvo_motion_pair* p) {
+// has the same columns. The sensor's motion is the camera's own (planarvo_sensor_motion: its
+// ground point and yaw, in units of its height), whatever extrinsics the robot's was tracked with,
+// which is what calibrate --motions calibrates.
+bool motion_pair(const planarvo_dataset_info& info, const planarvo_extrinsics& extrinsics,
+                 const planarvo_frame_data& previous, const planarvo_frame_data& fd, const planarvo_track_result& r,
+                 planarvo_motion_pair* p) {
   if (r.status != PLANARVO_TRACK_OK && r.status != PLANARVO_TRACK_DEGRADED) return false;
   if (info.has_odometry && !(fd.has_odometry && previous.has_odometry)) return false;
   if (info.has_direction && !fd.has_direction) return false;
   planarvo_motion_pair_init(p);
   p->interval = fd.timestamp - previous.timestamp;
-  p->sensor = r.motion;
+  check(planarvo_sensor_motion(&extrinsics, &r.motion, r.covariance, &p->sensor, p->sensor_covariance));
   p->has_sensor_covariance = 1;
-  for (int k = 0; k < 9; ++k) p->sensor_covariance[k] = r.covariance[k];
   p->has_odometry = info.has_odometry;
   if (p->has_odometry) p->odometry = relative(previous.odometry, fd.odometry);
   p->has_direction = info.has_direction;
@@ -297,7 +299,8 @@ TrackRun track_dataset(planarvo_context* ctx, planarvo_dataset* ds, const planar
       check(planarvo_stats_writer_add(stats.get(), &row));
     }
     planarvo_motion_pair p;
-    if (!outputs.motions.empty() && !first && motion_pair(info, previous, fd, r, &p)) pairs.push_back(p);
+    if (!outputs.motions.empty() && !first && motion_pair(info, extrinsics, previous, fd, r, &p))
+      pairs.push_back(p);
     k.t.push_back(fd.timestamp);
     k.pose.push_back(r.pose);
     k.motion.push_back(r.motion);

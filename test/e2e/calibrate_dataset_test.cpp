@@ -165,6 +165,20 @@ TEST(CalibrateDataset, OdometryMethodThroughTheCApiAndTheTool) {
   EXPECT_LT(std::abs(g.value.z - t.z), 2e-3);
   EXPECT_LT(std::abs(std::remainder(g.value.yaw - t.yaw, 2 * M_PI)), 0.3 * kDeg);
 
+  // The README's route: track with the true extrinsics themselves. --motions-out writes the
+  // camera's own motions whatever extrinsics it tracked with, so the calibration is the same
+  // (before, it came out x = y = 0, yaw = 0 and a "scale" of 1 m).
+  const std::string pairs_gt = (dir / "pairs_gt.csv").string(), from_gt = (dir / "from_gt.yaml").string();
+  ASSERT_EQ(test::run_cli("track \"" + dir.path().string() + "\" --quiet --extrinsics \"" +
+                          (dir / "extrinsics_gt.yaml").string() + "\" --motions-out \"" + pairs_gt + "\"").exit_code, 0);
+  const test::CommandResult cg = test::run_cli("calibrate --motions \"" + pairs_gt + "\" -o \"" + from_gt + "\"");
+  ASSERT_EQ(cg.exit_code, 0) << cg.output;
+  const ExtrinsicsEstimate h = io::read_extrinsics_yaml(from_gt);
+  EXPECT_LT(std::abs(h.value.x - t.x), 3e-3);
+  EXPECT_LT(std::abs(h.value.y - t.y), 3e-3);
+  EXPECT_LT(std::abs(h.value.z - t.z), 2e-3);
+  EXPECT_LT(std::abs(std::remainder(h.value.yaw - t.yaw, 2 * M_PI)), 0.3 * kDeg);
+
   // Bad usage: exit 2 and nothing written.
   std::filesystem::remove(out);
   EXPECT_EQ(test::run_cli("calibrate \"" + dir.path().string() + "\" --method nonholonomic -o \"" + out + "\"").exit_code, 2);

@@ -9,6 +9,7 @@
 #include "capi/convert.h"
 #include "capi/graph_convert.h"
 #include "capi/status.h"
+#include "core/sensor_motion.h"
 #include "core/error.h"
 #include "graph/calibration/calibration.h"
 #include "graph/posegraph/optimize.h"
@@ -254,6 +255,21 @@ planarvo_calibration_result calibration_result_to_c(const planarvo::graph::Calib
 }  // namespace planarvo::capi
 
 extern "C" {
+
+PLANARVO_API planarvo_status planarvo_sensor_motion(const planarvo_extrinsics* e, const planarvo_se2* robot_motion,
+                                                   const double* robot_covariance, planarvo_se2* sensor_motion,
+                                                   double* sensor_covariance) {
+  return guard([&] {
+    require(e != nullptr && robot_motion != nullptr && sensor_motion != nullptr,
+            "planarvo_sensor_motion: NULL argument");
+    planarvo::Motion m;
+    m.value = planarvo::capi::to_cpp(*robot_motion);
+    if (robot_covariance) m.covariance = planarvo::capi::matrix_from_c<3>(robot_covariance);
+    const planarvo::Motion s = planarvo::sensor_motion(planarvo::capi::to_cpp(*e), m);
+    *sensor_motion = planarvo::capi::to_c(s.value);
+    if (sensor_covariance) planarvo::capi::matrix_to_c<3>(s.covariance, sensor_covariance);
+  });
+}
 
 PLANARVO_API void planarvo_posegraph_options_init(planarvo_posegraph_options* o) {
   if (!o) return;
