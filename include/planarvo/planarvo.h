@@ -356,6 +356,8 @@ typedef struct planarvo_sim_options {
                                  is off by: */
   double knock_roll, knock_pitch; /* radians */
   double knock_z;             /* metres; the data set gets extrinsics_knocked.yaml */
+  int32_t accept_unusual_extrinsics; /* as planarvo_tracker_options': non-zero lets extrinsics
+                                        outside the plausible ranges through; default 0 */
 } planarvo_sim_options;
 
 PLANARVO_API void planarvo_sim_options_init(planarvo_sim_options* options);
@@ -422,6 +424,11 @@ typedef struct planarvo_tracker_options {
    * degree); positive and finite. Unread (so RECALIBRATE, 1 degree) for older struct_size. */
   int32_t on_mounting_change;
   double mounting_min_step;
+  /* Extrinsics outside what a camera on a vehicle can be are refused with
+   * PLANARVO_ERROR_INVALID_ARGUMENT naming the value and its likely unit mistake: x or y over 20 m,
+   * a height over 5 m, an angle over a turn (2 pi; degrees given as radians). Non-zero lets an
+   * unusual rig through. Default 0; unread (so 0) for older struct_size. */
+  int32_t accept_unusual_extrinsics;
 } planarvo_tracker_options;
 
 typedef enum planarvo_mounting_response {
@@ -895,6 +902,10 @@ typedef struct planarvo_camera_calibration_options {
   planarvo_progress_fn progress;
   void* progress_user_data;
   planarvo_readout_source readout; /* default PLANARVO_READOUT_CAMERA */
+  /* As planarvo_tracker_options': non-zero lets an `initial` or a `height` outside the plausible
+   * ranges through (a height of 178.7 is refused: millimetres?). Default 0; unread (so 0) for
+   * older struct_size. */
+  int32_t accept_unusual_extrinsics;
 } planarvo_camera_calibration_options;
 
 typedef struct planarvo_camera_calibration_result {

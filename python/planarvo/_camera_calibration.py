@@ -108,6 +108,8 @@ class CameraCalibrationOptions:
     graph: Optional[CalibrationOptions] = None
     tracker: Optional[TrackerOptions] = None
     readout: Optional["ReadoutSource"] = None
+    # True lets an initial or a height outside the plausible ranges through (see TrackerOptions).
+    accept_unusual_extrinsics: Optional[bool] = None
 
 
 class ReadoutSource(enum.IntEnum):

@@ -111,7 +111,7 @@ class SimOptions(ctypes.Structure):
                 ("min_turn_radius", c_double), ("readout_time", c_double), ("exposure_time", c_double),
                 ("lamp_falloff", c_double), ("reflection", c_double), ("shadow", c_double),
                 ("lean", c_double), ("bumps", c_double), ("knock_time", c_double), ("knock_roll", c_double),
-                ("knock_pitch", c_double), ("knock_z", c_double)]
+                ("knock_pitch", c_double), ("knock_z", c_double), ("accept_unusual_extrinsics", c_int32)]
 
 
 class TrackerOptions(ctypes.Structure):
@@ -119,7 +119,7 @@ class TrackerOptions(ctypes.Structure):
                 ("max_iterations", c_int32), ("keyframe_overlap", c_double), ("estimate_brightness", c_int32),
                 ("level0_subsample", c_int32), ("flat_field", c_char_p), ("local_plane", c_int32),
                 ("local_plane_prior_sigma", c_double), ("on_mounting_change", c_int32),
-                ("mounting_min_step", c_double)]
+                ("mounting_min_step", c_double), ("accept_unusual_extrinsics", c_int32)]
 
 
 class TrackResult(ctypes.Structure):
@@ -202,7 +202,8 @@ class CameraCalibrationOptions(ctypes.Structure):
     _fields_ = [("struct_size", c_size_t), ("method", c_enum), ("height", c_double),
                 ("roll_pitch_frames", c_int32), ("has_initial", c_int32), ("initial", Extrinsics),
                 ("estimate_roll_pitch", c_int32), ("graph", P(CalibrationOptions)), ("tracker", P(TrackerOptions)),
-                ("progress", PROGRESS_FN), ("progress_user_data", c_void_p), ("readout", c_enum)]
+                ("progress", PROGRESS_FN), ("progress_user_data", c_void_p), ("readout", c_enum),
+                ("accept_unusual_extrinsics", c_int32)]
 
 
 class CameraCalibrationResult(ctypes.Structure):

@@ -61,6 +61,8 @@ class SimOptions:
     knock_roll: Optional[float] = None
     knock_pitch: Optional[float] = None
     knock_z: Optional[float] = None
+    # True lets extrinsics outside the plausible ranges through (see TrackerOptions).
+    accept_unusual_extrinsics: Optional[bool] = None
 
 
 def default_texture() -> str:

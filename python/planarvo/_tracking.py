@@ -80,6 +80,9 @@ class TrackerOptions:
     # (radians, default 1 degree).
     on_mounting_change: Optional[MountingResponse] = None
     mounting_min_step: Optional[float] = None
+    # Extrinsics outside what a camera on a vehicle can be (an offset over 20 m, a height over 5 m,
+    # an angle over a turn: millimetres or degrees by mistake) raise Error unless this is True.
+    accept_unusual_extrinsics: Optional[bool] = None
 
 
 def _tracker_options(options: Optional[TrackerOptions]) -> N.TrackerOptions:

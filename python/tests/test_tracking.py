@@ -44,7 +44,19 @@ def test_matches_cli(tracked, drive, tmp_path):
     subprocess.run([cli, "track", str(drive), "--extrinsics", str(drive / "extrinsics_gt.yaml"),
                     "--motions-out", str(out), "--quiet"], check=True, capture_output=True)
     cli_motions = np.loadtxt(out, delimiter=",", comments="#")[:, 4:7]  # sensor_dx, sensor_dy, sensor_dtheta
-    ours = np.array([r.motion.as_array() for r in results[1:]])
+    # The CLI writes the camera's own motion (docs/conventions.md): T^-1 M T with T = (x, y, yaw)
+    # of the extrinsics, in units of the height.
+    e = info.extrinsics_gt
+
+    def hom(x, y, t):
+        return np.array([[np.cos(t), -np.sin(t), x], [np.sin(t), np.cos(t), y], [0.0, 0.0, 1.0]])
+
+    T = hom(e.x, e.y, e.yaw)
+    ours = []
+    for r in results[1:]:
+        m = np.linalg.inv(T) @ hom(*r.motion.as_array()) @ T
+        ours.append((m[0, 2] / e.z, m[1, 2] / e.z, np.arctan2(m[1, 0], m[0, 0])))
+    ours = np.array(ours)
     assert cli_motions.shape == ours.shape
     np.testing.assert_allclose(ours, cli_motions, rtol=0, atol=1e-9)
     # ... and the same through planarvo.track_motions and load_motion_pairs.
@@ -261,3 +273,20 @@ def test_a_knocked_camera_is_reported_and_recalibrated(context, tmp_path):
             assert abs(changes[-1].mounting.pitch - knocked.pitch) < math.radians(0.2)
         else:
             assert last.pitch == ext.pitch
+
+
+def test_extrinsics_in_the_wrong_unit_are_refused_unless_accepted(context, tracked):
+    """Angles in degrees (12.4 for 12.4 deg) are refused naming the value and the mistake; the
+    option lets an unusual rig through."""
+    info = tracked[0]
+    e = info.extrinsics_gt
+    degrees = planarvo.Extrinsics(e.x, e.y, e.z, 12.4, 17.6, -9.2)
+    with pytest.raises(planarvo.Error) as err:
+        planarvo.Tracker(context, info.camera, degrees)
+    assert err.value.status == planarvo.Status.INVALID_ARGUMENT
+    assert "roll = 12.4 rad is more than a turn: degrees by mistake?" in err.value.message
+    with planarvo.Tracker(context, info.camera, degrees, planarvo.TrackerOptions(accept_unusual_extrinsics=True)):
+        pass
+    millimetres = planarvo.Extrinsics(e.x, e.y, e.z * 1000.0, e.roll, e.pitch, e.yaw)
+    with pytest.raises(planarvo.Error, match="millimetres by mistake"):
+        planarvo.Tracker(context, info.camera, millimetres)

@@ -70,6 +70,10 @@ struct CameraCalibrator::Impl {
     if (o.graph.method == graph::CalibrationMethod::Nonholonomic && !o.graph.fix_scale)
       throw_invalid_argument("calibration: the nonholonomic method cannot estimate the camera height: give the height");
     if (o.max_buffered_frames < 2) throw_invalid_argument("calibration: max_buffered_frames must be at least 2");
+    if (!o.accept_unusual_extrinsics) {
+      if (o.initial) check_plausible_extrinsics(*o.initial, "calibration: the initial extrinsics", false);
+      if (o.graph.fix_scale) check_plausible_height(o.graph.fixed_scale, "calibration: the camera height given");
+    }
     return o;
   }
 

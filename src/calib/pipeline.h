@@ -52,6 +52,9 @@ struct PipelineOptions {
   // start stage 3 (otherwise stage 1 starts looking straight down and stage 3 from its closed
   // form).
   std::optional<Extrinsics> initial;
+  // Initial extrinsics and a height given by hand outside core/extrinsics.h's plausible ranges
+  // (most likely millimetres or degrees) are refused unless this is set.
+  bool accept_unusual_extrinsics = false;
   // The rolling shutter's readout time (calib/readout_estimate.h). Off: the camera's
   // rolling_shutter_readout as it is. On: estimated from the first readout_frames frames (held
   // with stage 1's, so at most max_buffered_frames), after a first estimate of roll and pitch,

@@ -57,6 +57,7 @@ int cmd_calibrate_dataset(const Args& args, const planarvo_calibration_options& 
   o.graph = &g;
   if (args.has("fix-scale")) throw UsageError("--fix-scale is for metric sensors' motion pairs; give --height METRES");
   if (args.has("initial")) throw UsageError("--initial is for motion pairs; give --initial-extrinsics FILE");
+  o.accept_unusual_extrinsics = args.has("force") ? 1 : 0;
   if (args.has("height")) {
     o.height = args.get_double("height", 0);
     if (!(o.height > 0)) throw UsageError("--height must be a positive number of metres");

@@ -44,6 +44,7 @@ std::vector<OptionSpec> simulate_options() {
       {"seconds", "S", "duration", "10"},
       {"fps", "F", "frame rate", "30"},
       {"seed", "N", "random seed (same seed, same data set)", "1"},
+      {"force", "", "accept extrinsics outside the plausible ranges (an offset over 20 m, a height over 5 m, an angle over a turn): an unusual rig, not a unit mistake", ""},
       {"motion", "KIND", "mixed | straight | circle | spin | car", "mixed"},
       {"min-turn-radius", "M", "car: the tightest turn, metres (0: limited by --max-turn-rate only)", "0"},
       {"max-speed", "M/S", "peak linear speed", "0.8"},
@@ -86,6 +87,7 @@ void apply_simulate_args(const Args& a, planarvo_sim_options* o, std::string* te
     const auto v = a.get_doubles("extrinsics", 6);
     o->extrinsics = {v[0], v[1], v[2], v[3] * kDeg, v[4] * kDeg, v[5] * kDeg};
   }
+  o->accept_unusual_extrinsics = a.has("force") ? 1 : 0;
   o->seconds = a.get_double("seconds", o->seconds);
   o->fps = a.get_double("fps", o->fps);
   const long long seed = a.get_int("seed", static_cast<long long>(o->seed));

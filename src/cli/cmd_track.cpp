@@ -410,6 +410,7 @@ std::vector<OptionSpec> track_options() {
                              "of the camera's size (as DSO's vignette.png; --save-flat-field writes one)", ""},
       {"save-flat-field", "FILE", "after tracking, write the photometric model in use (learnt, or --flat-field's) as "
                                   "a 16-bit flat-field PNG for --flat-field (a warning when none was learnt)", ""},
+      {"force", "", "accept extrinsics outside the plausible ranges (an offset over 20 m, a height over 5 m, an angle over a turn): an unusual rig, not a unit mistake", ""},
       {"local-plane", "", "estimate the body's roll and pitch relative to the local ground plane with every frame's "
                           "motion (a car whose body leans in turns and pitches over bumps; the extrinsics are the "
                           "camera's mounting on the body at rest)", "off: a rigid body"},
@@ -437,6 +438,7 @@ planarvo_tracker_options tracker_options_from(const Args& args, std::string* fla
   planarvo_tracker_options o;
   planarvo_tracker_options_init(&o);
   o.levels = args.get_int_in("levels", o.levels, 1, 8);
+  o.accept_unusual_extrinsics = args.has("force") ? 1 : 0;
   if (args.has("finest-level")) o.finest_level = args.get_int_in("finest-level", 0, 0, o.levels - 1);
   o.max_iterations = args.get_int_in("max-iterations", 0, 1, 1000);
   o.level0_subsample = args.get_int_in("level0-subsample", 0, 1, 8);

@@ -1,6 +1,9 @@
 #include "core/extrinsics.h"
 
 #include <cmath>
+#include <cstdio>
+#include <string>
+
 #include <Eigen/Geometry>
 
 #include "core/error.h"
@@ -72,6 +75,53 @@ Eigen::Matrix3d ground_homography(const Eigen::Matrix3d& K, const Extrinsics& e_
   const Eigen::Vector3d n = e_ref.plane_normal_camera();
   const Eigen::Matrix3d H = K * (R - t * n.transpose() / e_ref.z) * K.inverse();
   return H / H(2, 2);
+}
+
+namespace {
+
+std::string number(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.6g", v);
+  return buf;
+}
+
+std::string length_problem(const char* name, double v, double limit, const char* what) {
+  std::string s = std::string(name) + " = " + number(v) + " m is " + what + " " + number(limit) + " m";
+  if (std::abs(v) / 1000.0 <= limit && v != 0.0)
+    s += ": millimetres by mistake? (" + number(v) + " mm = " + number(v / 1000.0) + " m)";
+  return s;
+}
+
+}  // namespace
+
+std::string implausible_extrinsics(const Extrinsics& e, bool height_given) {
+  if (!e.finite()) return "a value is not a finite number";
+  if (std::abs(e.x) > kMaxOffset) return length_problem("x", e.x, kMaxOffset, "more than");
+  if (std::abs(e.y) > kMaxOffset) return length_problem("y", e.y, kMaxOffset, "more than");
+  if (e.z > kMaxHeight) return length_problem("the height z", e.z, kMaxHeight, "over");
+  if (e.z < 0.0 || (height_given && e.z == 0.0))
+    return "the height z = " + number(e.z) + " m is not above the ground (z is the camera's height, positive)";
+  const struct {
+    const char* name;
+    double value;
+  } angles[] = {{"roll", e.roll}, {"pitch", e.pitch}, {"yaw", e.yaw}};
+  for (const auto& a : angles)
+    if (std::abs(a.value) > 2.0 * M_PI)
+      return std::string(a.name) + " = " + number(a.value) + " rad is more than a turn: degrees by mistake? (" +
+             number(a.value) + " deg = " + number(a.value * M_PI / 180.0) + " rad)";
+  return "";
+}
+
+void check_plausible_extrinsics(const Extrinsics& e, const std::string& what, bool height_given) {
+  const std::string why = implausible_extrinsics(e, height_given);
+  if (!why.empty())
+    throw_invalid_argument(what + ": " + why +
+                           " (angles are radians, lengths metres; for an unusual rig set accept_unusual_extrinsics, "
+                           "--force in the planarvo tool)");
+}
+
+void check_plausible_height(double z, const std::string& what) {
+  check_plausible_extrinsics(Extrinsics{0.0, 0.0, z, 0.0, 0.0, 0.0}, what);
 }
 
 }  // namespace planarvo

@@ -3,6 +3,7 @@
 // straight down, image top towards the robot's front.
 #pragma once
 #include <cmath>
+#include <string>
 
 #include <Eigen/Core>
 
@@ -28,6 +29,23 @@ struct Extrinsics {
   // R0: camera axes in robot coordinates for roll = pitch = yaw = 0.
   static Eigen::Matrix3d R0();
 };
+
+// What a camera on a vehicle can be (docs/conventions.md, "Plausible extrinsics"): its centre at
+// most kMaxOffset from the robot's origin in x and y, its height 0 < z <= kMaxHeight, each angle
+// at most a turn (2 pi) in size. Values outside are most likely in the wrong unit (millimetres,
+// degrees); a caller lets an unusual rig through with its option (accept_unusual_extrinsics in the
+// C API, --force in the tool).
+inline constexpr double kMaxOffset = 20.0;  // metres
+inline constexpr double kMaxHeight = 5.0;   // metres
+// "" when e is plausible, else which value is not and the unit mistake that likely made it, e.g.
+// "z = 178.7 m is over 5 m: millimetres by mistake? (178.7 mm = 0.1787 m)". With height_given
+// false a z of 0 is "not given" and passes.
+std::string implausible_extrinsics(const Extrinsics& e, bool height_given = true);
+// Throws InvalidArgument "<what>: <why> (angles are radians, lengths metres; for an unusual rig set
+// accept_unusual_extrinsics, --force in the planarvo tool)" when e is not plausible.
+void check_plausible_extrinsics(const Extrinsics& e, const std::string& what, bool height_given = true);
+// The same for a camera height alone (a height given by hand).
+void check_plausible_height(double z, const std::string& what);
 
 // The homography mapping undistorted reference pixels to undistorted live pixels on the ground
 // plane, for the robot's relative motion T_k^-1 T_{k+1} = motion (docs/conventions.md, "The

@@ -94,6 +94,7 @@ struct Options {
   double exposure_time = 0.0;       // seconds each row integrates the moving scene before it is
                                     // read, at most 1 / fps (0: instantaneous, no motion blur);
                                     // written into camera.yaml as exposure_time (likewise)
+  bool accept_unusual_extrinsics = false;  // extrinsics outside core/extrinsics.h's plausible ranges
   int supersampling = 2;            // samples per pixel along each axis (ray tables take
                                     // 8 S^2 + 24 bytes per pixel: 17 MB at 640x480, S = 2)
   bool mipmap = true;               // prefilter the texture (off only for tests/references)

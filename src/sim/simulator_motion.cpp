@@ -256,6 +256,7 @@ void validate(const Options& o) {
   for (double a : {o.extrinsics.x, o.extrinsics.y, o.extrinsics.roll, o.extrinsics.pitch,
                    o.extrinsics.yaw})
     require(std::isfinite(a), "extrinsics contain NaN or inf");
+  if (!o.accept_unusual_extrinsics) check_plausible_extrinsics(o.extrinsics, "simulator options: the extrinsics");
   require(std::isfinite(o.fps) && o.fps > 0, "fps must be positive");
   require(std::isfinite(o.seconds) && std::llround(o.seconds * o.fps) >= 2,
           "seconds * fps must give at least 2 frames");

@@ -155,6 +155,10 @@ struct TrackerOptions : AlignerOptions {
   MountingWatchOptions mounting_watch;
 
   static WarpReduceOptions default_kernel_options();
+  // Extrinsics outside what a camera on a vehicle can be (core/extrinsics.h: an offset over 20 m,
+  // a height over 5 m, an angle over a turn; most likely millimetres or degrees) are refused
+  // unless this is set, for an unusual rig.
+  bool accept_unusual_extrinsics = false;
 };
 
 struct FrameResult {

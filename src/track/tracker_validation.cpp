@@ -36,6 +36,7 @@ CameraModel validated_tracker_camera(const CameraModel& c, const Extrinsics& e, 
   if (!(e.z > 0.0)) throw_invalid_argument("Tracker: the camera height z must be positive");
   if (!e.finite())
     throw_invalid_argument("Tracker: the extrinsics must be finite numbers");
+  if (!o.accept_unusual_extrinsics) check_plausible_extrinsics(e, "Tracker: the extrinsics");
   if (!sees_the_ground(c, e))
     throw_invalid_argument("Tracker: with these extrinsics (roll " + std::to_string(e.roll) + ", pitch " +
                            std::to_string(e.pitch) + " rad) no part of the image looks below the horizon: the "

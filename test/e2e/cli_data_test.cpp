@@ -348,3 +348,45 @@ TEST(CliData, DemoPrintsWhatTheCApiComputesOnItsDataSet) {
 
 }  // namespace
 }  // namespace planarvo
+
+namespace planarvo {
+namespace {
+
+// Values in the wrong unit (millimetres for metres, degrees for radians) are exit 2 naming the
+// value and the mistake, and nothing is written; --force lets an unusual rig through.
+TEST(CliPlausibility, UnitMistakesAreExit2AndForceLetsAnUnusualRigThrough) {
+  test::ScratchDir d;
+  const std::string seq = (d / "seq").string();
+  auto r = test::run_cli("simulate --quiet --out " + seq + " --seconds 0.5 --width 160 --height 120 --fov 80" +
+                         " --extrinsics 244.1,-18.5,178.7,12.4,17.6,-9.2");  // millimetres
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("x = 244.1 m is more than 20 m: millimetres by mistake?"), std::string::npos) << r.output;
+  EXPECT_FALSE(std::filesystem::exists(seq));
+  r = test::run_cli("simulate --quiet --out " + seq + " --seconds 0.5 --width 160 --height 120 --fov 80");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+
+  // A height in millimetres for the calibration: refused before anything is read or written.
+  const std::string out = (d / "cal.yaml").string();
+  r = test::run_cli("calibrate " + seq + " --quiet --method nonholonomic --height 178.7 -o " + out);
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("178.7 m is over 5 m: millimetres by mistake?"), std::string::npos) << r.output;
+  EXPECT_FALSE(std::filesystem::exists(out));
+  r = test::run_cli("calibrate " + seq + " --quiet --method nonholonomic --height 178.7 --force -o " + out);
+  EXPECT_NE(r.exit_code, 2) << r.output;  // let through: what the drive says decides (0 or 1)
+
+  // Extrinsics in degrees for the tracker (written as a file by the library's writer, so that it
+  // is consistent): refused; with --force tracked.
+  planarvo_extrinsics degrees{0.2441, -0.0185, 0.1787, 12.4, 17.6, -9.2};
+  const std::string yaml = (d / "degrees.yaml").string(), traj = (d / "traj.txt").string();
+  ASSERT_EQ(planarvo_extrinsics_save(yaml.c_str(), &degrees, nullptr, nullptr, nullptr, nullptr), PLANARVO_OK);
+  r = test::run_cli("track " + seq + " --quiet --extrinsics " + yaml + " -o " + traj);
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("roll = 12.4 rad is more than a turn: degrees by mistake?"), std::string::npos) << r.output;
+  EXPECT_FALSE(std::filesystem::exists(traj));
+  r = test::run_cli("track " + seq + " --quiet --force --extrinsics " + yaml + " -o " + traj);
+  EXPECT_NE(r.exit_code, 2) << r.output;  // let through (and, being wrong, it loses frames: exit 1)
+  EXPECT_TRUE(std::filesystem::exists(traj));
+}
+
+}  // namespace
+}  // namespace planarvo

@@ -137,6 +137,7 @@ planarvo::calib::PipelineOptions pipeline_options_from_c(const planarvo_camera_c
   if (o.tracker) po.tracker = planarvo::capi::tracker_options_from_c(o.tracker);
   po.roll_pitch.max_frames = o.roll_pitch_frames;
   po.estimate_roll_pitch = o.estimate_roll_pitch != 0;
+  po.accept_unusual_extrinsics = o.accept_unusual_extrinsics != 0;
   const int readout = planarvo::capi::enum_value(o.readout);
   require(readout >= PLANARVO_READOUT_IF_UNKNOWN && readout <= PLANARVO_READOUT_ESTIMATE,
           "planarvo_camera_calibration_options.readout is not a planarvo_readout_source");

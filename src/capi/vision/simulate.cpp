@@ -104,6 +104,8 @@ PLANARVO_API planarvo_status planarvo_simulate(planarvo_context* context, const 
       s.knock_pitch = o->knock_pitch;
       s.knock_z = o->knock_z;
     }
+    if (o->struct_size >= offsetof(planarvo_sim_options, accept_unusual_extrinsics) + sizeof(int32_t))
+      s.accept_unusual_extrinsics = o->accept_unusual_extrinsics != 0;
     s.pixel_noise = o->pixel_noise;
     s.gain_variation = o->gain_variation;
     s.odometry_noise = o->odometry_noise;

@@ -123,6 +123,8 @@ planarvo::track::TrackerOptions tracker_options_from_c(const planarvo_tracker_op
               "planarvo_tracker_options.mounting_min_step must be a positive, finite number of radians");
       o.mounting_watch.min_step = options->mounting_min_step;
     }
+    if (options->struct_size >= offsetof(planarvo_tracker_options, accept_unusual_extrinsics) + sizeof(int32_t))
+      o.accept_unusual_extrinsics = options->accept_unusual_extrinsics != 0;
   }
   return o;
 }
