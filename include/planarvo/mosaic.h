@@ -70,7 +70,11 @@ PLANARVO_API planarvo_status planarvo_mosaic_info_get(const planarvo_mosaic* mos
 PLANARVO_API planarvo_status planarvo_mosaic_image(const planarvo_mosaic* mosaic, planarvo_image* image);
 /* Writes the image to image_path (PNG for .png; any format OpenCV writes by extension) and the
  * map_server YAML beside it with the same stem and .yaml (image, resolution, origin [x, y, yaw],
- * negate, occupied_thresh, free_thresh). */
+ * mode trinary, negate 0, occupied_thresh 1.0, free_thresh 0.998: map_server and nav2's load every
+ * seen pixel as free and every unseen one as unknown; docs/formats.md). */
 PLANARVO_API planarvo_status planarvo_mosaic_save(const planarvo_mosaic* mosaic, const char* image_path);
+/* Writes a contrast-stretched copy of the image for an ordinary viewer (the seen pixels' 1st to
+ * 99th percentile of grey over 1..255; unseen stays 0) to path, format by extension. */
+PLANARVO_API planarvo_status planarvo_mosaic_save_preview(const planarvo_mosaic* mosaic, const char* path);
 
 #endif /* PLANARVO_MOSAIC_H */

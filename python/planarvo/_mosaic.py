@@ -63,6 +63,10 @@ class Mosaic(_Handle):
         """Writes the image (PNG for .png) and the map_server YAML beside it (same stem, .yaml)."""
         _check(lib.planarvo_mosaic_save(self._h(), _path(image_path)))
 
+    def save_preview(self, path: PathLike) -> None:
+        """Writes a contrast-stretched copy of the image for an ordinary viewer (format by extension)."""
+        _check(lib.planarvo_mosaic_save_preview(self._h(), _path(path)))
+
 
 def build_mosaic(context: Context, dataset: Dataset, extrinsics: Extrinsics, timestamps: Sequence[float],
                  poses: Any, resolution: float = 0.001, max_range: float = 0.0, frame_spacing: float = 0.0,

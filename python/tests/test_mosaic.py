@@ -36,12 +36,17 @@ def test_mosaic_image_yaml_and_placement(context, drive, tmp_path):
         m = planarvo.build_mosaic(context, ds, e, t, p, resolution=0.002, progress=lambda f, s: seen.append(f))
         info, image = m.info, m.image
         m.save(tmp_path / "floor.png")
+        m.save_preview(tmp_path / "preview.png")
     assert seen and seen[-1] == 1.0
     assert image.shape == (info.height, info.width)
     assert int((image > 0).sum()) == info.covered_pixels > 1000
     assert info.frames_given == len(t) and 1 <= info.frames_used <= len(t)
     Image = pytest.importorskip("PIL.Image")
     assert np.array_equal(np.asarray(Image.open(tmp_path / "floor.png")), image)
+    # The preview: the same pixels seen, their grey levels spread wider (a floor spans a few).
+    preview = np.asarray(Image.open(tmp_path / "preview.png"))
+    assert np.array_equal(preview > 0, image > 0)
+    assert preview[image > 0].std() > 2 * image[image > 0].std()
     y = (tmp_path / "floor.yaml").read_text()
     assert re.search(r"^image: floor.png$", y, re.M)
     assert float(re.search(r"^resolution: (\S+)$", y, re.M).group(1)) == info.resolution == 0.002

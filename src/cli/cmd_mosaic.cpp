@@ -38,6 +38,8 @@ int cmd_mosaic(int argc, char** argv) {
       {"extrinsics", "FILE", "camera extrinsics YAML", "DATASET/extrinsics.yaml"},
       {"output", "FILE", "the mosaic image (PNG) (also -o); FILE with .yaml for its extension gets the "
                          "map_server description", ""},
+      {"preview", "FILE", "also write a contrast-stretched copy for an ordinary viewer (the image itself keeps the "
+                          "floor's grey levels, which span only a few)", ""},
       {"resolution", "M_PER_PX", "metres per mosaic pixel", "0.001"},
       {"max-range", "M", "use no ground farther than this from the camera's foot point", "4 x the camera height"},
       {"frame-spacing", "M", "use a frame once the camera has moved this far (or turned 5 degrees) since the last "
@@ -63,7 +65,7 @@ int cmd_mosaic(int argc, char** argv) {
   const std::string dir = args.positionals()[0];
   if (!args.has("trajectory")) throw UsageError("--trajectory FILE is required (planarvo track -o writes one)");
   if (!args.has("output")) throw UsageError("-o FILE is required: where to write the mosaic image (floor.png)");
-  args.expect_output_files({"output"});
+  args.expect_output_files({"output", "preview"});
   const std::string out = args.get("output");
   {
     std::string ext = std::filesystem::path(out).extension().string();
@@ -101,6 +103,7 @@ int cmd_mosaic(int argc, char** argv) {
   check(planarvo_mosaic_build(ctx.get(), ds.get(), &e, t.data(), poses.data(), t.size(), &o, &raw));
   std::unique_ptr<planarvo_mosaic, MosaicDeleter> mosaic(raw);
   check(planarvo_mosaic_save(mosaic.get(), out.c_str()));
+  if (args.has("preview")) check(planarvo_mosaic_save_preview(mosaic.get(), args.get("preview").c_str()));
   progress.finish();
   planarvo_mosaic_info mi{};
   mi.struct_size = sizeof mi;
@@ -116,7 +119,9 @@ int cmd_mosaic(int argc, char** argv) {
   std::printf("time %.2f s: decoding %.2f s, warping %.2f s, blending %.2f s; tile memory at most %.1f MB\n",
               mi.seconds_total, mi.seconds_decode, mi.seconds_warp, mi.seconds_blend,
               static_cast<double>(mi.peak_tile_bytes) / 1e6);
-  std::printf("wrote %s and %s\n", out.c_str(), yaml.c_str());
+  std::printf("wrote %s and %s", out.c_str(), yaml.c_str());
+  if (args.has("preview")) std::printf(", and the preview %s", args.get("preview").c_str());
+  std::printf("\n");
   return kExitOk;
 }
 

@@ -526,12 +526,67 @@ void save_mosaic(const Mosaic& mosaic, const std::string& image_path) {
   out << "image: " << img.filename().string() << "\n";
   out << "resolution: " << shortest(mosaic.grid.resolution) << "\n";
   out << "origin: [" << shortest(mosaic.grid.origin.x()) << ", " << shortest(mosaic.grid.origin.y()) << ", 0.0]\n";
-  out << "negate: 0\noccupied_thresh: 0.65\nfree_thresh: 0.196\n";
+  // Loaded as a map (map_server, nav2's map_server: occ = (255 - p) / 255 with negate 0, occupied
+  // when occ > occupied_thresh, free when occ < free_thresh, else unknown in trinary mode): a seen
+  // pixel (1..255: occ <= 254/255 = 0.99608) is free, an unseen one (0: occ = 1) unknown, never
+  // occupied (occ is never over 1). The image stays the floor's picture.
+  out << "mode: trinary\nnegate: 0\noccupied_thresh: 1.0\nfree_thresh: 0.998\n";
   const std::string text = out.str();
   OutputFile yaml_file(yaml.string());
   if (std::fwrite(text.data(), 1, text.size(), yaml_file.stream()) != text.size())
     throw Error(ErrorCode::Io, "cannot write " + yaml.string());
   yaml_file.commit();
+}
+
+cv::Mat contrast_preview(const cv::Mat& image) {
+  if (image.type() != CV_8UC1) throw_invalid_argument("mosaic preview: needs an 8-bit grey image");
+  // The seen pixels' grey levels from their 1st to their 99th percentile stretched over 1..255.
+  int histogram[256] = {};
+  int64_t seen = 0;
+  for (int r = 0; r < image.rows; ++r) {
+    const uint8_t* p = image.ptr<uint8_t>(r);
+    for (int c = 0; c < image.cols; ++c) {
+      ++histogram[p[c]];
+      seen += p[c] != 0;
+    }
+  }
+  cv::Mat out = image.clone();
+  if (seen == 0) return out;
+  int lo = 1, hi = 255;
+  int64_t below = 0;
+  for (int v = 1; v < 256; ++v) {
+    below += histogram[v];
+    if (below <= seen / 100) lo = v + 1;
+    if (below < seen - seen / 100) hi = v + 1;
+  }
+  lo = std::min(lo, 255);
+  hi = std::max(std::min(hi, 255), lo + 1);
+  uint8_t lut[256];
+  lut[0] = 0;
+  for (int v = 1; v < 256; ++v) {
+    const double t = (static_cast<double>(v) - lo) / (hi - lo);
+    lut[v] = static_cast<uint8_t>(std::lround(1.0 + 254.0 * std::min(1.0, std::max(0.0, t))));
+  }
+  for (int r = 0; r < out.rows; ++r) {
+    uint8_t* p = out.ptr<uint8_t>(r);
+    for (int c = 0; c < out.cols; ++c) p[c] = lut[p[c]];
+  }
+  return out;
+}
+
+void save_preview(const Mosaic& mosaic, const std::string& path) {
+  const cv::Mat preview = contrast_preview(mosaic.image);
+  std::vector<uint8_t> bytes;
+  try {
+    if (!cv::imencode(std::filesystem::path(path).extension().string(), preview, bytes))
+      throw Error(ErrorCode::Io, "cannot encode " + path);
+  } catch (const cv::Exception& e) {
+    throw_invalid_argument("mosaic preview: cannot write an image as " + path + ": " + e.what());
+  }
+  OutputFile file(path);
+  if (std::fwrite(bytes.data(), 1, bytes.size(), file.stream()) != bytes.size())
+    throw Error(ErrorCode::Io, "cannot write " + path);
+  file.commit();
 }
 
 }  // namespace planarvo::mosaic

@@ -75,7 +75,16 @@ Mosaic build_mosaic(ocl::Runtime& runtime, io::Dataset& dataset, const Extrinsic
 
 // Writes the image (any format cv::imwrite knows by the extension; PNG is lossless) and, beside it
 // with the same stem and .yaml, the map_server description: image, resolution, origin
-// [x, y, yaw], negate, occupied_thresh, free_thresh. Throws Error(Io) naming the file.
+// [x, y, yaw], mode trinary, negate 0, occupied_thresh 1.0 and free_thresh 0.998, so that map_server
+// (and nav2's) loads every seen pixel as free and every unseen one as unknown
+// (docs/formats.md, "Floor mosaic"). Throws Error(Io) naming the file.
 void save_mosaic(const Mosaic& mosaic, const std::string& image_path);
+
+// The image for an ordinary viewer: the seen pixels' grey levels from their 1st to their 99th
+// percentile stretched linearly over 1..255 (a floor's picture spans a few grey levels); unseen
+// stays 0.
+cv::Mat contrast_preview(const cv::Mat& image);
+// Writes contrast_preview(mosaic.image) to path (format by extension), complete or not at all.
+void save_preview(const Mosaic& mosaic, const std::string& path);
 
 }  // namespace planarvo::mosaic

@@ -117,4 +117,12 @@ PLANARVO_API planarvo_status planarvo_mosaic_save(const planarvo_mosaic* mosaic,
   });
 }
 
+PLANARVO_API planarvo_status planarvo_mosaic_save_preview(const planarvo_mosaic* mosaic, const char* path) {
+  return guard([&] {
+    require(mosaic != nullptr, "planarvo_mosaic_save_preview: mosaic is NULL");
+    require(path != nullptr && *path, "planarvo_mosaic_save_preview: path is NULL or empty");
+    planarvo::mosaic::save_preview(mosaic->mosaic, path);
+  });
+}
+
 }  // extern "C"
