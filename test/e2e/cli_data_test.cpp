@@ -373,6 +373,7 @@ TEST(CliPlausibility, UnitMistakesAreExit2AndForceLetsAnUnusualRigThrough) {
   EXPECT_FALSE(std::filesystem::exists(out));
   r = test::run_cli("calibrate " + seq + " --quiet --method nonholonomic --height 178.7 --force -o " + out);
   EXPECT_NE(r.exit_code, 2) << r.output;  // let through: what the drive says decides (0 or 1)
+  EXPECT_EQ(std::filesystem::exists(out), r.exit_code == 0);  // a result is written only when determined
 
   // Extrinsics in degrees for the tracker (written as a file by the library's writer, so that it
   // is consistent): refused; with --force tracked.
