@@ -20,7 +20,8 @@ from ._camera_calibration import (CalibrationStatus, CameraCalibrationOptions, C
                                   calibrate_dataset)
 from ._context import Context, DeviceInfo, list_devices, version
 from ._dataset import Dataset, DatasetInfo, FrameData, bag_topics
-from ._errors import Error, Status
+from ._errors import (Error, InvalidArgumentError, InvalidInputError, MissingFileError, PermissionDeniedError,
+                      Status)
 from ._evaluation import MotionAccuracy, evaluate_motions
 from ._mosaic import Mosaic, MosaicInfo, build_mosaic
 from ._motion_pairs import MotionPair, load_motion_pairs, save_motion_pairs, track_motions
@@ -35,7 +36,7 @@ __version__ = _lib.planarvo_version_string().decode()
 
 __all__ = ["EXTRINSICS_NAMES", "CalibrationMethod", "CalibrationOptions", "CalibrationResult",
     "CalibrationStatus", "Camera", "CameraCalibrationOptions", "CameraCalibrationResult", "CameraCalibrator",
-    "Context", "Dataset", "DatasetInfo", "DeviceInfo", "Error", "Extrinsics", "ExtrinsicsFile", "FrameData", "MotionAccuracy",
+    "Context", "Dataset", "DatasetInfo", "DeviceInfo", "Error", "InvalidArgumentError", "InvalidInputError", "MissingFileError", "PermissionDeniedError", "Extrinsics", "ExtrinsicsFile", "FrameData", "MotionAccuracy",
     "Mosaic", "MosaicInfo", "MotionPair", "MotionProfile", "MountingChange", "MountingResponse", "PosegraphInit", "ReadoutSource", "Residuals", "RobustLoss", "RollPitch",
     "RollPitchOptions",
     "RollPitchResult", "SE2", "SimOptions", "SolverSummary", "StatsWriter", "Status", "Tracker",

@@ -3,7 +3,6 @@ extrinsics composed from it and roll and pitch."""
 from __future__ import annotations
 
 import ctypes
-import enum
 from dataclasses import dataclass
 from typing import Optional, Sequence, Tuple
 
@@ -11,20 +10,20 @@ import numpy as np
 
 from . import _native as N
 from ._camera import Extrinsics
-from ._errors import Status, _check
+from ._errors import IntEnum, Status, _check
 from ._motion_pairs import MotionPair, _pairs_array
 from ._native import lib
 from ._posegraph import SolverSummary
 from ._util import LogFn, PathLike, _c_options, _Callback, _fill_matrix, _matrix, _opt, _path
 
 
-class CalibrationMethod(enum.IntEnum):
+class CalibrationMethod(IntEnum):
     """planarvo_calibration_method."""
     ODOMETRY = 0
     NONHOLONOMIC = 1
 
 
-class RobustLoss(enum.IntEnum):
+class RobustLoss(IntEnum):
     """planarvo_robust_loss."""
     NONE = 0
     HUBER = 1

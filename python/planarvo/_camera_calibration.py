@@ -3,7 +3,6 @@ data set (calibrate_dataset) or a stream of frames (CameraCalibrator)."""
 from __future__ import annotations
 
 import ctypes
-import enum
 from dataclasses import dataclass, field
 from typing import Optional, Tuple
 
@@ -14,7 +13,7 @@ from ._calibration import CalibrationMethod, CalibrationOptions, CalibrationResu
 from ._camera import Camera, Extrinsics
 from ._context import Context
 from ._dataset import Dataset
-from ._errors import _check
+from ._errors import IntEnum, _check
 from ._frame import _image
 from ._handle import _Handle
 from ._native import lib
@@ -23,7 +22,7 @@ from ._tracking import TrackerOptions, _tracker_options
 from ._util import PathLike, ProgressFn, _c_options, _Callback, _matrix, _opt, _path
 
 
-class CalibrationStatus(enum.IntEnum):
+class CalibrationStatus(IntEnum):
     """planarvo_calibration_status."""
     OK = 0
     TOO_LITTLE_TEXTURE = 1
@@ -112,7 +111,7 @@ class CameraCalibrationOptions:
     accept_unusual_extrinsics: Optional[bool] = None
 
 
-class ReadoutSource(enum.IntEnum):
+class ReadoutSource(IntEnum):
     """planarvo_readout_source: where the calibration gets the rolling shutter's readout time."""
     IF_UNKNOWN = 0  # estimated when the data set's camera file does not give it
     CAMERA = 1      # the camera's as it is (0: a global shutter); the default

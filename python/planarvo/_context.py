@@ -94,9 +94,20 @@ class Context(_Handle):
         """The kernel program cache directory; "" when the cache is off."""
         return os.fsdecode(lib.planarvo_context_cache_dir(self._h()))
 
-    def prepare_kernels(self) -> None:
-        """Builds (or loads) every kernel program now, so that the first frame does not pay for it."""
-        _check(lib.planarvo_context_prepare_kernels(self._h()))
+    def prepare_kernels(self, uses: Optional[str] = None) -> None:
+        """Builds (or loads) the kernel programs now, so that the first frame does not pay for it:
+        every one, or those of uses ("track", "calibrate", "simulate", comma-separated)."""
+        if uses is None:
+            _check(lib.planarvo_context_prepare_kernels(self._h()))
+        else:
+            _check(lib.planarvo_context_prepare_kernels_for(self._h(), uses.encode()))
+
+    def __repr__(self) -> str:
+        if self.closed:
+            return "<planarvo.Context (closed)>"
+        d = self.device
+        return "<planarvo.Context on %s (%s), kernel cache %s>" % (d.device_name, d.platform_name,
+                                                                   self.cache_dir or "off")
 
     def export_kernels(self, directory: PathLike, uses: Union[None, str, Sequence[str]] = None) -> int:
         """Writes the kernel binaries for this device into directory (for kernel_binaries_dir):

@@ -2,9 +2,10 @@
 from __future__ import annotations
 
 import ctypes
+import operator
 import os
 from dataclasses import dataclass
-from typing import Iterator, List, Optional, Tuple
+from typing import Iterator, List, Optional, Tuple, Union, overload
 
 import numpy as np
 
@@ -104,6 +105,37 @@ class Dataset(_Handle):
 
     def __len__(self) -> int:
         return self.info.frame_count
+
+    # A sequence of (timestamp, grey frame): ds[i] (negative i from the end), ds[a:b:c] (a list),
+    # iter(ds), len(ds).
+    @overload
+    def __getitem__(self, index: int) -> Tuple[float, np.ndarray]: ...
+
+    @overload
+    def __getitem__(self, index: slice) -> List[Tuple[float, np.ndarray]]: ...
+
+    def __getitem__(self, index: Union[int, slice]) -> Union[Tuple[float, np.ndarray], List[Tuple[float, np.ndarray]]]:
+        n = len(self)
+        if isinstance(index, slice):
+            return [self[i] for i in range(*index.indices(n))]
+        i = operator.index(index)
+        if i < 0:
+            i += n
+        if not 0 <= i < n:
+            raise IndexError("frame index %d out of range for a data set of %d frames" % (index, n))
+        return self.frame_data(i).timestamp, self.frame(i)
+
+    def __iter__(self) -> Iterator[Tuple[float, np.ndarray]]:
+        return self.frames()
+
+    def __repr__(self) -> str:
+        if self.closed:
+            return "<planarvo.Dataset %r (closed)>" % getattr(self, "path", "")
+        i = self.info
+        return "<planarvo.Dataset %r: %s, %d frames, %dx%d, %.3f .. %.3f s%s%s%s>" % (
+            self.path, "bag" if i.is_bag else "folder", i.frame_count, i.camera.width, i.camera.height,
+            i.first_timestamp, i.last_timestamp, ", odometry" if i.has_odometry else "",
+            ", direction labels" if i.has_direction else "", ", ground truth" if i.has_groundtruth else "")
 
     def set_roi(self, roi: Optional[Tuple[int, int, int, int]]) -> None:
         """Replaces the camera's region of interest (x, y, width, height); None: the whole image."""

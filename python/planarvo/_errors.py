@@ -8,7 +8,15 @@ from typing import Any
 from ._native import lib
 
 
-class Status(enum.IntEnum):
+class IntEnum(enum.IntEnum):
+    """The package's enums: integers the C API takes, printed by name (Python 3.11's IntEnum
+    prints its bare value), e.g. str(TrackStatus.OK) == "TrackStatus.OK"."""
+
+    def __str__(self) -> str:
+        return "%s.%s" % (type(self).__name__, self.name)
+
+
+class Status(IntEnum):
     """planarvo_status."""
     OK = 0
     INVALID_ARGUMENT = 1
@@ -37,10 +45,41 @@ class Error(Exception):
 
     def __reduce__(self):
         # Pickled with its own arguments, so that it crosses processes (multiprocessing,
-        # concurrent.futures) as itself.
-        return (Error, (int(self.status), self.message, self.result))
+        # concurrent.futures) as itself, of the same class.
+        return (_error, (int(self.status), self.message, self.result))
+
+
+# Error's subclasses that are also the built-in exceptions they mean, so that `except ValueError`
+# or `except FileNotFoundError` catches them as Python code expects.
+class InvalidArgumentError(Error, ValueError):
+    """Status.INVALID_ARGUMENT: a value the call cannot take (a NaN, a height in millimetres...)."""
+
+
+class InvalidInputError(Error, ValueError):
+    """Status.INVALID_INPUT: a file or data that is malformed."""
+
+
+class MissingFileError(Error, FileNotFoundError):
+    """Status.INVALID_INPUT for an input file that does not exist."""
+
+
+class PermissionDeniedError(Error, PermissionError):
+    """An input that cannot be read, or an output that cannot be written, for want of permission."""
+
+
+def _error(status: int, message: str, result: Any = None) -> Error:
+    """The Error of the right class for a status and the library's message."""
+    if "Permission denied" in message and status in (Status.INVALID_INPUT, Status.IO):
+        return PermissionDeniedError(status, message, result)
+    if status == Status.INVALID_INPUT and "does not exist" in message:
+        return MissingFileError(status, message, result)
+    if status == Status.INVALID_INPUT:
+        return InvalidInputError(status, message, result)
+    if status == Status.INVALID_ARGUMENT:
+        return InvalidArgumentError(status, message, result)
+    return Error(status, message, result)
 
 
 def _check(status: int, result: Any = None) -> None:
     if status != 0:
-        raise Error(status, lib.planarvo_last_error().decode(errors="replace"), result)
+        raise _error(status, lib.planarvo_last_error().decode(errors="replace"), result)

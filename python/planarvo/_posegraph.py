@@ -2,17 +2,16 @@
 from __future__ import annotations
 
 import ctypes
-import enum
 from dataclasses import dataclass
 from typing import Optional
 
 from . import _native as N
-from ._errors import _check
+from ._errors import IntEnum, _check
 from ._native import lib
 from ._util import LogFn, PathLike, _Callback, _path
 
 
-class PosegraphInit(enum.IntEnum):
+class PosegraphInit(IntEnum):
     """planarvo_posegraph_init."""
     NONE = 0
     ROTATION_FIRST = 1

@@ -2,7 +2,6 @@
 from __future__ import annotations
 
 import ctypes
-import enum
 import os
 from dataclasses import dataclass
 from typing import Optional
@@ -10,12 +9,12 @@ from typing import Optional
 from . import _native as N
 from ._camera import Camera, Extrinsics
 from ._context import Context
-from ._errors import _check
+from ._errors import IntEnum, _check
 from ._native import lib
 from ._util import PathLike, ProgressFn, _c_options, _Callback, _path
 
 
-class MotionProfile(enum.IntEnum):
+class MotionProfile(IntEnum):
     """planarvo_motion_profile (the simulator's drive)."""
     MIXED = 0
     STRAIGHT = 1

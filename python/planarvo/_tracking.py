@@ -2,7 +2,6 @@
 from __future__ import annotations
 
 import ctypes
-import enum
 from dataclasses import dataclass, field
 from typing import Optional, Tuple
 
@@ -11,7 +10,7 @@ import numpy as np
 from . import _native as N
 from ._camera import Camera, Extrinsics
 from ._context import Context
-from ._errors import _check
+from ._errors import IntEnum, _check
 from ._frame import _image
 from ._handle import _Handle
 from ._native import lib
@@ -19,7 +18,7 @@ from ._se2 import SE2
 from ._util import PathLike, _c_options, _path, _require
 
 
-class TrackStatus(enum.IntEnum):
+class TrackStatus(IntEnum):
     """planarvo_track_status."""
     FIRST = 0
     OK = 1
@@ -27,7 +26,7 @@ class TrackStatus(enum.IntEnum):
     LOST = 3
 
 
-class MountingResponse(enum.IntEnum):
+class MountingResponse(IntEnum):
     """What the tracker does when the local plane finds the camera's mounting changed
     (planarvo_mounting_response)."""
     IGNORE = 0       # not watched

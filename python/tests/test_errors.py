@@ -146,3 +146,44 @@ def test_an_option_in_range_is_passed_on(context):
     # numpy integers are integers: 3 levels from np.int64(3) (the tracker accepts 1..8).
     with planarvo.Tracker(context, CAM, planarvo.Extrinsics(z=0.2), planarvo.TrackerOptions(levels=np.int64(3))) as t:
         assert t.camera.width == 64
+
+
+def test_errors_are_the_built_in_exceptions_they_mean(tmp_path, context):
+    """A missing file is FileNotFoundError, a malformed one or a bad value ValueError, and each is
+    still planarvo.Error with its status; the class survives pickling."""
+    import pickle
+    missing = tmp_path / "no-such-camera.yaml"
+    with pytest.raises(FileNotFoundError) as e:
+        planarvo.Camera.load(missing)
+    assert isinstance(e.value, planarvo.MissingFileError) and isinstance(e.value, planarvo.Error)
+    assert e.value.status == planarvo.Status.INVALID_INPUT and str(missing) in e.value.message
+    with pytest.raises(FileNotFoundError):
+        planarvo.Dataset(tmp_path / "no-such-drive")
+    bad = tmp_path / "bad.yaml"
+    bad.write_text("%YAML:1.0\n---\nx: [1, 2\n")
+    with pytest.raises(ValueError) as e:
+        planarvo.Extrinsics.load(bad)
+    assert isinstance(e.value, planarvo.InvalidInputError) and e.value.status == planarvo.Status.INVALID_INPUT
+    with pytest.raises(ValueError) as e:
+        planarvo.Tracker(context, CAM, planarvo.Extrinsics(z=178.7))  # millimetres
+    assert isinstance(e.value, planarvo.InvalidArgumentError) and "millimetres" in e.value.message
+    again = pickle.loads(pickle.dumps(e.value))
+    assert type(again) is planarvo.InvalidArgumentError and again.message == e.value.message
+
+
+def test_unreadable_file_is_permission_error(tmp_path):
+    import os
+    if os.geteuid() == 0:
+        pytest.skip("root reads every file")
+    f = tmp_path / "camera.yaml"
+    planarvo.Camera(64, 48, 50.0, 50.0, 32.0, 24.0).save(f)
+    f.chmod(0)
+    with pytest.raises(PermissionError):
+        planarvo.Camera.load(f)
+
+
+def test_enums_print_their_names():
+    assert str(planarvo.Status.OK) == "Status.OK"
+    assert str(planarvo.TrackStatus.LOST) == "TrackStatus.LOST"
+    assert "%s" % planarvo.CalibrationMethod.NONHOLONOMIC == "CalibrationMethod.NONHOLONOMIC"
+    assert planarvo.TrackStatus.LOST == int(planarvo.TrackStatus.LOST)  # still the C API's integers

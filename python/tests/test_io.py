@@ -163,3 +163,23 @@ def test_plane_reads_back(tmp_path):
     path.write_text("0.0 12.4 0 0 0\n")  # degrees by mistake
     with pytest.raises(planarvo.Error):
         planarvo.read_plane(path)
+
+
+def test_dataset_is_a_sequence_of_timestamped_frames(drive):
+    with planarvo.Dataset(drive) as ds:
+        n = len(ds)
+        assert n == ds.info.frame_count > 3
+        t0, f0 = ds[0]
+        assert t0 == ds.frame_data(0).timestamp and np.array_equal(f0, ds.frame(0))
+        t_last, f_last = ds[-1]
+        assert t_last == ds.frame_data(n - 1).timestamp and np.array_equal(f_last, ds.frame(n - 1))
+        part = ds[1:4]
+        assert [t for t, _ in part] == [ds.frame_data(i).timestamp for i in (1, 2, 3)]
+        assert [t for t, _ in ds[::-2]][:2] == [ds.frame_data(n - 1).timestamp, ds.frame_data(n - 3).timestamp]
+        assert [t for t, _ in ds] == [t for t, _ in ds.frames()]
+        for bad in (n, -n - 1):
+            with pytest.raises(IndexError):
+                ds[bad]
+        text = repr(ds)
+        assert str(drive) in text and "%d frames" % n in text
+    assert "closed" in repr(ds)
