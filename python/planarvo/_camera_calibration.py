@@ -203,7 +203,8 @@ def calibrate_dataset(context: Context, dataset: Dataset, options: Optional[Came
     (.result the CameraCalibrationResult) when it does not give an answer."""
     o = _CameraCalibrationC(options, progress)
     r = N.sized(N.CameraCalibrationResult)
-    status = lib.planarvo_calibrate_dataset(context._h(), dataset._h(), ctypes.byref(o.c), ctypes.byref(r))
+    with o.callback.interruptible():
+        status = lib.planarvo_calibrate_dataset(context._h(), dataset._h(), ctypes.byref(o.c), ctypes.byref(r))
     o.callback.reraise()
     result = CameraCalibrationResult._from_c(r)
     _check(status, result)

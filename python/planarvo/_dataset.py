@@ -87,7 +87,8 @@ class Dataset(_Handle):
         cb = _Callback(progress, N.PROGRESS_FN)
         o.progress = cb.c
         h = ctypes.c_void_p()
-        status = lib.planarvo_dataset_open(_path(directory), ctypes.byref(o), ctypes.byref(h))
+        with cb.interruptible():
+            status = lib.planarvo_dataset_open(_path(directory), ctypes.byref(o), ctypes.byref(h))
         cb.reraise()
         _check(status)
         self._own(h)

@@ -96,9 +96,10 @@ def build_mosaic(context: Context, dataset: Dataset, extrinsics: Extrinsics, tim
     o.progress = cb.c
     e = extrinsics._to_c()
     h = ctypes.c_void_p()
-    status = lib.planarvo_mosaic_build(context._h(), dataset._h(), ctypes.byref(e),
-                                       t.ctypes.data_as(N.P(ctypes.c_double)), p.ctypes.data_as(N.P(N.SE2)),
-                                       p.shape[0], ctypes.byref(o), ctypes.byref(h))
+    with cb.interruptible():
+        status = lib.planarvo_mosaic_build(context._h(), dataset._h(), ctypes.byref(e),
+                                           t.ctypes.data_as(N.P(ctypes.c_double)), p.ctypes.data_as(N.P(N.SE2)),
+                                           p.shape[0], ctypes.byref(o), ctypes.byref(h))
     cb.reraise()
     _check(status)
     m = Mosaic.__new__(Mosaic)

@@ -92,6 +92,7 @@ def simulate(context: Context, out_directory: PathLike, options: Optional[SimOpt
         c.camera = options.camera._to_c()
     cb = _Callback(progress, N.PROGRESS_FN)
     c.progress = cb.c
-    status = lib.planarvo_simulate(context._h(), ctypes.byref(c), _path(out_directory))
+    with cb.interruptible():
+        status = lib.planarvo_simulate(context._h(), ctypes.byref(c), _path(out_directory))
     cb.reraise()
     _check(status)

@@ -2,11 +2,14 @@
 callbacks, matrices to and from C arrays, and option structs from dataclasses."""
 from __future__ import annotations
 
+import contextlib
 import ctypes
 import enum
 import os
+import signal
+import threading
 from dataclasses import fields
-from typing import Any, Callable, Optional, Sequence, Union
+from typing import Any, Callable, Iterator, Optional, Sequence, Union
 
 import numpy as np
 
@@ -47,18 +50,26 @@ def _opt(s: Optional[str]) -> Optional[bytes]:
 
 class _Callback:
     """A Python progress or log function as a C callback, kept alive for the call; an exception
-    raised in it cancels the call (progress) and is re-raised after it."""
+    raised in it cancels the call (progress) and is re-raised after it. A progress callback is
+    always given to the library, with or without fn, so that Ctrl-C (interruptible()) can cancel
+    the call at its next progress report."""
 
     def __init__(self, fn: Optional[Callable], kind):
-        self.fn, self.error = fn, None
-        if fn is None:
-            self.c = kind()  # NULL
-        elif kind is N.PROGRESS_FN:
+        self.fn, self.error, self.interrupted = fn, None, False
+        if kind is N.PROGRESS_FN:
             self.c = kind(self._progress)
+        elif fn is None:
+            self.c = kind()  # NULL
         else:
             self.c = kind(self._log)
 
     def _progress(self, _user, fraction, stage):
+        if self.interrupted:
+            if self.error is None:
+                self.error = KeyboardInterrupt()
+            return 1
+        if self.fn is None:
+            return 0
         try:
             return 1 if self.fn(fraction, stage.decode(errors="replace") if stage else "") else 0
         except BaseException as e:  # noqa: B902 - never let an exception unwind through C
@@ -71,6 +82,29 @@ class _Callback:
                 self.fn(line.decode(errors="replace") if line else "")
             except BaseException as e:  # noqa: B902
                 self.error = e
+
+    @contextlib.contextmanager
+    def interruptible(self) -> Iterator[None]:
+        """Around a long C call in the main thread: Ctrl-C only marks the call interrupted (no
+        exception can cross the C frames), the progress callback cancels it at its next report,
+        and reraise() raises KeyboardInterrupt after it returns. A SIGINT handler of the user's
+        own is left alone."""
+        if (threading.current_thread() is not threading.main_thread()
+                or signal.getsignal(signal.SIGINT) is not signal.default_int_handler):
+            yield
+            return
+
+        def mark(_signum, _frame):
+            self.interrupted = True
+
+        signal.signal(signal.SIGINT, mark)
+        try:
+            yield
+        finally:
+            signal.signal(signal.SIGINT, signal.default_int_handler)
+            if self.interrupted and self.error is None:
+                self.error = KeyboardInterrupt()
+            self.interrupted = False
 
     def reraise(self) -> None:
         # Raised once: a callback reused by later calls (CameraCalibrator) starts clean again.

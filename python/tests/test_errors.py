@@ -187,3 +187,37 @@ def test_enums_print_their_names():
     assert str(planarvo.TrackStatus.LOST) == "TrackStatus.LOST"
     assert "%s" % planarvo.CalibrationMethod.NONHOLONOMIC == "CalibrationMethod.NONHOLONOMIC"
     assert planarvo.TrackStatus.LOST == int(planarvo.TrackStatus.LOST)  # still the C API's integers
+
+
+@pytest.mark.parametrize("with_progress", [False, True])
+def test_ctrl_c_is_a_prompt_keyboard_interrupt(context, tmp_path, capfd, with_progress):
+    """SIGINT during a long call cancels it at its next progress report and raises
+    KeyboardInterrupt (not Error(CANCELLED), nothing printed about an ignored exception), within
+    0.2 s, with or without a progress callback; the context is usable afterwards."""
+    import os
+    import signal
+    import threading
+    import time
+    if threading.current_thread() is not threading.main_thread():
+        pytest.skip("signals reach the main thread only")
+    sent = []
+
+    def interrupt():
+        sent.append(time.monotonic())
+        os.kill(os.getpid(), signal.SIGINT)
+
+    opts = planarvo.SimOptions(seconds=120.0, camera=planarvo.Camera(160, 120, 100.0, 100.0, 79.5, 59.5),
+                               supersampling=1)
+    timer = threading.Timer(1.0, interrupt)
+    timer.start()
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            planarvo.simulate(context, tmp_path / "long", opts, progress=(lambda f, s: False) if with_progress else None)
+        caught = time.monotonic()
+    finally:
+        timer.cancel()
+    assert sent and caught - sent[0] < 0.2
+    assert "Exception ignored" not in capfd.readouterr().err
+    assert signal.getsignal(signal.SIGINT) is signal.default_int_handler
+    planarvo.simulate(context, tmp_path / "after", planarvo.SimOptions(seconds=0.2, camera=opts.camera, supersampling=1))
+    assert (tmp_path / "after" / "frames.txt").exists()
