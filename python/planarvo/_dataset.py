@@ -11,7 +11,7 @@ import numpy as np
 
 from . import _native as N
 from ._camera import Camera, Extrinsics
-from ._errors import Error, Status, _check
+from ._errors import Error, Status, _check, _error
 from ._handle import _Handle
 from ._native import lib
 from ._se2 import SE2
@@ -59,6 +59,13 @@ def bag_topics(path: PathLike) -> List[Tuple[str, str, int]]:
     return out
 
 
+# The tool's options that the library's data-set messages name, as this package's keywords.
+_KEYWORDS = (("--image-topic", "image_topic="), ("--camera-info-topic", "camera_info_topic="),
+             ("--camera FILE", "camera_yaml=FILE"), ("--odom-topic", "odometry_topic="),
+             ("--odometry-topic", "odometry_topic="), ("--groundtruth-topic", "groundtruth_topic="),
+             ("--video", "video="))
+
+
 class Dataset(_Handle):
     """A data set directory (docs/formats.md), or a ROS 1 bag or MCAP file, read and validated on
     open; frames are decoded on demand. video: a video file standing in for frames.txt + images/.
@@ -90,7 +97,14 @@ class Dataset(_Handle):
         with cb.interruptible():
             status = lib.planarvo_dataset_open(_path(directory), ctypes.byref(o), ctypes.byref(h))
         cb.reraise()
-        _check(status)
+        try:
+            _check(status)
+        except Error as e:
+            # The library's messages name the planarvo tool's options; name this call's arguments.
+            message = e.message
+            for flag, keyword in _KEYWORDS:
+                message = message.replace(flag, keyword)
+            raise _error(int(e.status), message) from None
         self._own(h)
         self.path = os.fspath(directory)
 

@@ -66,5 +66,7 @@ def test_a_missing_topic_names_the_topics_there_are(drive, tmp_path):
     assert e.value.status == planarvo.Status.INVALID_INPUT
     for topic in ("/camera/image_raw", "/camera/camera_info", "/odom", "/ground_truth"):
         assert topic in str(e.value)
+    # The message names this call's keyword, not the planarvo tool's option.
+    assert "image_topic=" in e.value.message and "--image-topic" not in e.value.message
     with pytest.raises(ValueError):
         planarvo.Dataset(path, image_topic=3)
