@@ -29,7 +29,8 @@ from ._output import STATS_COLUMNS, StatsWriter, read_plane, read_stats, read_tu
 from ._posegraph import PosegraphInit, SolverSummary, posegraph_optimize
 from ._se2 import SE2
 from ._simulate import MotionProfile, SimOptions, default_texture, simulate
-from ._tracking import MountingChange, MountingResponse, Residuals, Tracker, TrackerOptions, TrackResult, TrackStatus
+from ._tracking import (MountingChange, MountingResponse, Residuals, TrackedDrive, Tracker, TrackerOptions, TrackResult,
+                        TrackStatus, track_dataset)
 from ._native import lib as _lib
 
 __version__ = _lib.planarvo_version_string().decode()
@@ -40,6 +41,6 @@ __all__ = ["EXTRINSICS_NAMES", "CalibrationMethod", "CalibrationOptions", "Calib
     "Mosaic", "MosaicInfo", "MotionPair", "MotionProfile", "MountingChange", "MountingResponse", "PosegraphInit", "ReadoutSource", "Residuals", "RobustLoss", "RollPitch",
     "RollPitchOptions",
     "RollPitchResult", "SE2", "SimOptions", "SolverSummary", "StatsWriter", "Status", "Tracker",
-    "TrackerOptions", "TrackResult", "TrackStatus", "bag_topics", "calibrate", "calibrate_dataset", "calibrate_residuals", "PairResiduals", "compose_extrinsics",
+    "TrackedDrive", "TrackerOptions", "TrackResult", "TrackStatus", "track_dataset", "bag_topics", "calibrate", "calibrate_dataset", "calibrate_residuals", "PairResiduals", "compose_extrinsics",
     "build_mosaic", "default_texture", "evaluate_motions", "list_devices", "load_motion_pairs", "posegraph_optimize", "read_plane", "read_stats", "read_tum", "STATS_COLUMNS",
     "save_motion_pairs", "simulate", "track_motions", "version", "write_tum"]

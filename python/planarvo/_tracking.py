@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import ctypes
 from dataclasses import dataclass, field
-from typing import Optional, Tuple
+from typing import TYPE_CHECKING, Optional, Tuple
 
 import numpy as np
 
@@ -16,6 +16,9 @@ from ._handle import _Handle
 from ._native import lib
 from ._se2 import SE2
 from ._util import PathLike, _c_options, _path, _require
+
+if TYPE_CHECKING:
+    from ._dataset import Dataset
 
 
 class TrackStatus(IntEnum):
@@ -220,3 +223,44 @@ class Tracker(_Handle):
     def reset(self) -> None:
         """Forgets the keyframe and the pose: the next frame is FIRST again."""
         _check(lib.planarvo_tracker_reset(self._h()))
+
+
+@dataclass
+class TrackedDrive:
+    """A whole data set tracked (track_dataset), one row per frame: times (N,) seconds; poses
+    (N, 3) x, y, theta relative to the first frame; motions (N, 3) each frame's motion from the
+    previous (zeros for the first); covariances (N, 3, 3) of the motions; statuses (N,) TrackStatus
+    values (int8; TrackStatus(s) names one); ms (N,) the engine's time per frame."""
+    times: np.ndarray
+    poses: np.ndarray
+    motions: np.ndarray
+    covariances: np.ndarray
+    statuses: np.ndarray
+    ms: np.ndarray
+
+    def __len__(self) -> int:
+        return len(self.times)
+
+    def __repr__(self) -> str:
+        counts = {s.name.lower(): int((self.statuses == s).sum()) for s in TrackStatus if (self.statuses == s).any()}
+        return "<planarvo.TrackedDrive: %d frames, %s>" % (len(self), ", ".join("%d %s" % (n, k) for k, n in counts.items()))
+
+
+def track_dataset(context: Context, dataset: "Dataset", extrinsics: Extrinsics,
+                  options: Optional[TrackerOptions] = None, use_odometry: bool = False) -> TrackedDrive:
+    """Tracks every frame of a data set with a new Tracker and returns the results as arrays
+    (TrackedDrive). use_odometry passes the data set's odometry to the tracker (the local plane
+    watches the camera height with it). Ctrl-C stops between two frames with KeyboardInterrupt."""
+    n = len(dataset)
+    times, ms = np.zeros(n), np.zeros(n)
+    poses, motions = np.zeros((n, 3)), np.zeros((n, 3))
+    covariances = np.zeros((n, 3, 3))
+    statuses = np.zeros(n, dtype=np.int8)
+    with Tracker(context, dataset.info.camera, extrinsics, options) as tracker:
+        for i in range(n):
+            data = dataset.frame_data(i)
+            r = tracker.track(dataset.frame(i), data.timestamp, data.odometry if use_odometry else None)
+            times[i], ms[i], statuses[i] = data.timestamp, r.ms, int(r.status)
+            poses[i], motions[i] = r.pose.as_array(), r.motion.as_array()
+            covariances[i] = r.covariance
+    return TrackedDrive(times, poses, motions, covariances, statuses, ms)

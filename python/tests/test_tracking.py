@@ -290,3 +290,16 @@ def test_extrinsics_in_the_wrong_unit_are_refused_unless_accepted(context, track
     millimetres = planarvo.Extrinsics(e.x, e.y, e.z * 1000.0, e.roll, e.pitch, e.yaw)
     with pytest.raises(planarvo.Error, match="millimetres by mistake"):
         planarvo.Tracker(context, info.camera, millimetres)
+
+
+def test_track_dataset_returns_the_trackers_results_as_arrays(context, drive, tracked):
+    info, frames, _, results = tracked
+    with planarvo.Dataset(drive) as ds:
+        run = planarvo.track_dataset(context, ds, info.extrinsics_gt)
+    assert len(run) == len(results) == run.poses.shape[0] and run.covariances.shape == (len(results), 3, 3)
+    np.testing.assert_array_equal(run.times, [t for t, _ in frames])
+    np.testing.assert_array_equal(run.poses, [r.pose.as_array() for r in results])
+    np.testing.assert_array_equal(run.motions, [r.motion.as_array() for r in results])
+    np.testing.assert_array_equal(run.covariances, [r.covariance for r in results])
+    assert [planarvo.TrackStatus(s) for s in run.statuses] == [r.status for r in results]
+    assert "%d frames" % len(results) in repr(run)
