@@ -1,5 +1,6 @@
 #include "live_calibration.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 
@@ -20,6 +21,7 @@ LiveCalibration::LiveCalibration(planarvo_context* context, const planarvo_camer
   planarvo_camera_calibration_options_init(&o);
   o.method = PLANARVO_CALIBRATE_ODOMETRY;
   o.height = params.calibration_height;
+  o.accept_unusual_extrinsics = params.force ? 1 : 0;
   o.tracker = &params.tracker;
   if (planarvo_camera_calibrator_create(context, &camera, &o, &calibrator_) != PLANARVO_OK)
     throw std::runtime_error(std::string("planarvo_camera_calibrator_create: ") + planarvo_last_error());
@@ -140,8 +142,13 @@ void LiveCalibration::complete() {
   }
   succeeded_ = true;
   const planarvo_extrinsics& e = result_.extrinsics;
-  ROS_INFO("planarvo_node: calibrated: x %.4f y %.4f z %.4f m, roll %.3f pitch %.3f yaw %.3f deg; wrote %s", e.x, e.y,
-           e.z, e.roll * 180 / M_PI, e.pitch * 180 / M_PI, e.yaw * 180 / M_PI, params_.calibration_output.c_str());
+  double sigma[6];  // the standard deviations: the covariance's diagonal (x y z roll pitch yaw)
+  for (int i = 0; i < 6; ++i) sigma[i] = std::sqrt(std::max(0.0, result_.covariance[7 * i]));
+  const double deg = 180 / M_PI;
+  ROS_INFO("planarvo_node: calibrated: x %.4f +- %.4f, y %.4f +- %.4f, z %.4f +- %.4f m; roll %.3f +- %.3f, pitch "
+           "%.3f +- %.3f, yaw %.3f +- %.3f deg; wrote %s",
+           e.x, sigma[0], e.y, sigma[1], e.z, sigma[2], e.roll * deg, sigma[3] * deg, e.pitch * deg, sigma[4] * deg,
+           e.yaw * deg, sigma[5] * deg, params_.calibration_output.c_str());
 }
 
 }  // namespace planarvo_node

@@ -1,7 +1,10 @@
 #include "node_params.h"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
+#include <string>
+#include <vector>
 
 #include <ros/ros.h>
 
@@ -76,9 +79,59 @@ bool get_frame(const ros::NodeHandle& nh, const std::string& name, std::string* 
   return true;
 }
 
+// Every private parameter the node reads (read_params), for refusing the ones it does not.
+const char* const kKnown[] = {
+    "camera", "extrinsics", "device", "cache_dir", "kernel_binaries", "prepare_kernels", "odom_frame",
+    "base_frame", "publish_tf", "levels", "finest_level", "level0_subsample", "flat_field", "readout_time",
+    "exposure_time", "max_iterations", "local_plane", "local_plane_prior_deg", "mounting_change",
+    "mounting_step_deg", "keyframe_overlap", "queue_size", "max_pending", "drain_seconds", "calibrate",
+    "calibration_output", "calibration_frames", "calibration_height", "calibration_odom_wait", "force"};
+
+size_t edit_distance(const std::string& a, const std::string& b) {
+  std::vector<size_t> row(b.size() + 1);
+  for (size_t j = 0; j <= b.size(); ++j) row[j] = j;
+  for (size_t i = 1; i <= a.size(); ++i) {
+    size_t diagonal = row[0];
+    row[0] = i;
+    for (size_t j = 1; j <= b.size(); ++j) {
+      const size_t up = row[j];
+      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] == b[j - 1] ? 0 : 1)});
+      diagonal = up;
+    }
+  }
+  return row[b.size()];
+}
+
+// A private parameter the node does not read is a misspelt one (~publish_tfs for ~publish_tf):
+// ROS_FATAL naming it and the nearest the node knows.
+bool no_unknown_params(const ros::NodeHandle& nh) {
+  std::vector<std::string> names;
+  if (!nh.getParamNames(names)) return true;
+  const std::string prefix = nh.getNamespace() + "/";
+  for (const std::string& full : names) {
+    if (full.compare(0, prefix.size(), prefix) != 0) continue;
+    const std::string name = full.substr(prefix.size(), full.find('/', prefix.size()) - prefix.size());
+    const char* nearest = kKnown[0];
+    size_t best = std::string::npos;
+    bool known = false;
+    for (const char* k : kKnown) {
+      if (name == k) known = true;
+      const size_t d = edit_distance(name, k);
+      if (d < best) best = d, nearest = k;
+    }
+    if (!known) {
+      ROS_FATAL("planarvo_node: unknown parameter ~%s (did you mean ~%s? ros/README.md lists the parameters)",
+                name.c_str(), nearest);
+      return false;
+    }
+  }
+  return true;
+}
+
 }  // namespace
 
 bool read_params(const ros::NodeHandle& nh, NodeParams* p) {
+  if (!no_unknown_params(nh)) return false;
   planarvo_tracker_options_init(&p->tracker);
   planarvo_tracker_options& t = p->tracker;
   int levels = t.levels, finest = t.finest_level, subsample = t.level0_subsample, iterations = t.max_iterations;
@@ -107,12 +160,14 @@ bool read_params(const ros::NodeHandle& nh, NodeParams* p) {
             get_text(nh, "calibration_output", &p->calibration_output) &&
             get_int(nh, "calibration_frames", 0, 10000000, &p->calibration_frames) &&
             get_double(nh, "calibration_height", 0.0, 100.0, &p->calibration_height) &&
-            get_double(nh, "calibration_odom_wait", 0.0, 60.0, &p->calibration_odom_wait);
+            get_double(nh, "calibration_odom_wait", 0.0, 60.0, &p->calibration_odom_wait) &&
+            get_bool(nh, "force", &p->force);
   if (!ok) return false;
   t.levels = levels;
   t.finest_level = finest;
   t.level0_subsample = subsample;
   t.max_iterations = iterations;
+  t.accept_unusual_extrinsics = p->force ? 1 : 0;
   t.local_plane = local_plane ? 1 : 0;
   t.local_plane_prior_sigma = plane_prior_deg * M_PI / 180.0;
   t.mounting_min_step = mounting_step_deg * M_PI / 180.0;

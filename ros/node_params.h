@@ -41,6 +41,10 @@ struct NodeParams {
   int calibration_frames = 0;      // ~calibration_frames: finish after this many frames; 0 = on shutdown
   double calibration_height = 0;   // ~calibration_height: the camera height when known (held); 0 = estimated
   double calibration_odom_wait = 2.0;  // ~calibration_odom_wait: seconds of frames held for odometry
+  // ~force: accept extrinsics (and a calibration height) outside the plausible ranges (an offset
+  // over 20 m, a height over 5 m, an angle over a turn: most likely millimetres or degrees), for an
+  // unusual rig (planarvo_tracker_options.accept_unusual_extrinsics).
+  bool force = false;
 };
 
 // Reads and checks every parameter; false (after ROS_FATAL naming the bad one) when one is bad.

@@ -459,6 +459,9 @@ int run(int argc, char** argv) {
 }  // namespace planarvo_node
 
 int main(int argc, char** argv) {
+  // Line-buffered even when stdout is a file or a pipe (a service, a container): each log line is
+  // there as it happens, not when the node exits.
+  std::setvbuf(stdout, nullptr, _IOLBF, 0);
   try {
     return planarvo_node::run(argc, argv);
   } catch (const std::exception& e) {

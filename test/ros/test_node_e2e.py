@@ -310,6 +310,8 @@ def test_colour_images(ros_env, drive, tmp_path):
     listener = Listener(name)
     node = start_node(ros_env, name, {"extrinsics": extrinsics}, tmp_path / "node.log")
     try:
+        # The log is line-buffered into a file (as under a service manager): there while it runs.
+        assert "planarvo_node: ready" in (tmp_path / "node.log").read_text()
         wait_for("the test's subscriber to connect", lambda: listener.subs[0].get_num_connections() > 0, 30)
         play(bag)
         wait_for("30 odometry messages", lambda: len(listener.odometry) >= 30, 30)
@@ -358,6 +360,13 @@ def test_live_calibration_then_tracking(ros_env, drive, tmp_path):
         assert abs(got[k] - truth[k]) < 3e-3, k
     for k in ("roll", "pitch", "yaw"):
         assert abs(got[k] - truth[k]) < math.radians(0.2), k
+    # The calibrated line gives each value with its standard deviation, as the file's covariance.
+    import re
+    line = next(l for l in log.splitlines() if "planarvo_node: calibrated:" in l)
+    m = re.search(r"x (\S+) \+- (\S+), y \S+ \+- \S+, z (\S+) \+- (\S+) m", line)
+    assert m, line
+    assert abs(float(m.group(1)) - got["x"]) < 1e-4 and abs(float(m.group(3)) - got["z"]) < 1e-4
+    assert 0 < float(m.group(2)) < 0.01 and 0 < float(m.group(4)) < 0.01, line
 
 
 def test_image_size_not_the_cameras_is_counted_not_tracked(ros_env, drive, tmp_path):
@@ -390,3 +399,16 @@ def test_image_size_not_the_cameras_is_counted_not_tracked(ros_env, drive, tmp_p
     assert counts["dropped"] == counts["rejected"]
     assert not listener.odometry
     assert "the image is 640x480 but the camera (%s) is 320x240" % camera in log
+
+
+def test_a_misspelt_parameter_is_fatal_naming_the_nearest(ros_env, tmp_path):
+    """~publish_tfs (for ~publish_tf) stops the node at once with a FATAL naming both, instead of
+    being ignored; ~force (an unusual rig) is a parameter it knows."""
+    node = required_env("PLANARVO_NODE")
+    log = tmp_path / "node.log"
+    with open(log, "w") as f:
+        p = subprocess.run([node, "__name:=planarvo_node_misspelt", "_publish_tfs:=false"], stdout=f,
+                           stderr=subprocess.STDOUT, timeout=60 * SLOW)
+    text = log.read_text()
+    assert p.returncode != 0, text
+    assert "unknown parameter ~publish_tfs" in text and "did you mean ~publish_tf?" in text, text
