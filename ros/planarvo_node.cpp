@@ -141,6 +141,7 @@ class Node {
           }
           lock.unlock();
           maybe_publish_counts(&last_counts);
+          report_progress();
           continue;
         }
         q = std::move(queue_.front());
@@ -149,6 +150,7 @@ class Node {
       }
       process(q, camera);
       maybe_publish_counts(&last_counts);
+      report_progress();
     }
     if (calibration_) {
       calibration_->finish();
@@ -333,6 +335,43 @@ class Node {
     ++counts_.rejected;
   }
 
+  // Said while nothing seems to happen: no image on the topic a few seconds after the start (with
+  // the image topics that are published, every 30 s while none comes), and the live calibration's
+  // progress every 5 s while it takes frames.
+  void report_progress() {
+    const auto now = std::chrono::steady_clock::now();
+    int64_t received = 0;
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      received = counts_.received;
+    }
+    if (received == 0 && now - start_time_ >= std::chrono::seconds(4) && now >= next_no_image_warning_) {
+      next_no_image_warning_ = now + std::chrono::seconds(30);
+      ros::master::V_TopicInfo topics;
+      std::string published;
+      if (ros::master::getTopics(topics))
+        for (const ros::master::TopicInfo& t : topics)
+          if (t.datatype == "sensor_msgs/Image" || t.datatype == "sensor_msgs/CompressedImage")
+            published += (published.empty() ? "" : ", ") + t.name + " (" + t.datatype + ")";
+      ROS_WARN("planarvo_node: no image on %s after %.0f s; image topics being published: %s%s",
+               ros::names::resolve("image").c_str(), std::chrono::duration<double>(now - start_time_).count(),
+               published.empty() ? "none" : published.c_str(),
+               published.empty() ? "" : " (remap with image:=TOPIC)");
+    }
+    if (calibration_ && !calibration_->finished() && calibration_->frames_fed() != progress_fed_ &&
+        now - last_progress_ >= std::chrono::seconds(5)) {
+      last_progress_ = now;
+      progress_fed_ = calibration_->frames_fed();
+      if (params_.calibration_frames > 0)
+        ROS_INFO("planarvo_node: calibration: %lld of %d frames (%lld with odometry)",
+                 static_cast<long long>(progress_fed_), params_.calibration_frames,
+                 static_cast<long long>(calibration_->frames_with_odometry()));
+      else
+        ROS_INFO("planarvo_node: calibration: %lld frames so far (%lld with odometry); it finishes at shutdown",
+                 static_cast<long long>(progress_fed_), static_cast<long long>(calibration_->frames_with_odometry()));
+    }
+  }
+
   void maybe_publish_counts(std::chrono::steady_clock::time_point* last) {
     const auto now = std::chrono::steady_clock::now();
     if (now - *last < std::chrono::seconds(1)) return;
@@ -366,6 +405,9 @@ class Node {
   bool have_seq_ = false, warned_camera_ = false, warned_waiting_camera_ = false;
   uint32_t last_seq_ = 0;
   int64_t published_received_ = -1, published_tracked_ = -1;
+  const std::chrono::steady_clock::time_point start_time_ = std::chrono::steady_clock::now();
+  std::chrono::steady_clock::time_point next_no_image_warning_ = start_time_, last_progress_ = start_time_;
+  int64_t progress_fed_ = 0;
 
   std::mutex odometry_mutex_;  // guards calibration_'s creation against on_odometry
   std::vector<nav_msgs::OdometryConstPtr> early_odometry_;

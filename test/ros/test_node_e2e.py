@@ -412,3 +412,28 @@ def test_a_misspelt_parameter_is_fatal_naming_the_nearest(ros_env, tmp_path):
     text = log.read_text()
     assert p.returncode != 0, text
     assert "unknown parameter ~publish_tfs" in text and "did you mean ~publish_tf?" in text, text
+
+
+def test_a_wrong_image_topic_is_warned_within_5_s_naming_the_published_ones(ros_env, drive, tmp_path):
+    """Subscribed to a topic nobody publishes while the drive plays on /camera/image_raw: a WARN
+    naming the topic subscribed and the image topics that are published, within 5 s of starting."""
+    dataset, bag = drive[:2]
+    node = required_env("PLANARVO_NODE")
+    log_path = tmp_path / "node.log"
+    log = open(log_path, "w")
+    player = subprocess.Popen(["rosbag", "play", "-q", "-l", bag, "--topics", "/camera/image_raw"],
+                              stdout=subprocess.DEVNULL, start_new_session=True)
+    process = subprocess.Popen([node, "__name:=planarvo_node_wrong_topic", "image:=/wrong/image_raw",
+                                "_extrinsics:=" + os.path.join(dataset, "extrinsics_gt.yaml")],
+                               stdout=log, stderr=subprocess.STDOUT, start_new_session=True)
+    try:
+        wait_for("the node to be ready", lambda: "planarvo_node: ready" in log_path.read_text(), 120)
+        ready = time.monotonic()
+        wait_for("the WARN", lambda: "no image on /wrong/image_raw" in log_path.read_text(), 10)
+        warned = time.monotonic()
+    finally:
+        stop(process)
+        stop(player)
+    line = next(l for l in log_path.read_text().splitlines() if "no image on /wrong/image_raw" in l)
+    assert "/camera/image_raw (sensor_msgs/Image)" in line, line
+    assert warned - ready < 5.0 * SLOW, warned - ready
