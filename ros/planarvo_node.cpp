@@ -16,6 +16,7 @@
 #include <memory>
 #include <mutex>
 #include <optional>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -58,7 +59,7 @@ class Node {
         extrinsics_(extrinsics),
         publisher_(nh, params.odom_frame, params.base_frame, params.publish_tf) {
     counts_topic_ = pnh.advertise<std_msgs::String>("counts", 1, true);
-    if (params.tracker.local_plane) diagnostics_ = nh.advertise<diagnostic_msgs::DiagnosticArray>("/diagnostics", 10);
+    diagnostics_ = nh.advertise<diagnostic_msgs::DiagnosticArray>("/diagnostics", 10);
   }
 
   void on_image(const sensor_msgs::ImageConstPtr& m) {
@@ -391,6 +392,29 @@ class Node {
     std_msgs::String s;
     s.data = c.yaml();
     counts_topic_.publish(s);
+    // The same counts as the ROS convention for a node's health, which rqt_runtime_monitor and
+    // /diagnostics aggregators read: one status, each count a key/value; WARN once frames were
+    // dropped or lost.
+    diagnostic_msgs::DiagnosticArray a;
+    a.header.stamp = ros::Time::now();
+    diagnostic_msgs::DiagnosticStatus d;
+    d.name = ros::this_node::getName() + ": frames";
+    d.hardware_id = ros::this_node::getName();
+    d.level = c.dropped() > 0 || c.lost > 0 ? diagnostic_msgs::DiagnosticStatus::WARN : diagnostic_msgs::DiagnosticStatus::OK;
+    d.message = "received " + std::to_string(c.received) + ", tracked " + std::to_string(c.tracked) + ", lost " +
+                std::to_string(c.lost) + ", dropped " + std::to_string(c.dropped());
+    std::istringstream lines(s.data);
+    std::string line;
+    while (std::getline(lines, line)) {
+      const size_t colon = line.find(": ");
+      if (colon == std::string::npos) continue;
+      diagnostic_msgs::KeyValue kv;
+      kv.key = line.substr(0, colon);
+      kv.value = line.substr(colon + 2);
+      d.values.push_back(kv);
+    }
+    a.status.push_back(d);
+    diagnostics_.publish(a);
   }
 
   const NodeParams& params_;
@@ -417,7 +441,7 @@ class Node {
   std::optional<planarvo_extrinsics> extrinsics_;
   std::unique_ptr<planarvo_tracker, TrackerDeleter> tracker_;
   OdometryPublisher publisher_;
-  ros::Publisher diagnostics_;  // with the local plane: a change of the camera's mounting
+  ros::Publisher diagnostics_;  // the counts, and with the local plane a change of the camera's mounting
   ros::Publisher counts_topic_;
   std::vector<uint8_t> buffer_;
   bool started_ = false, have_origin_ = false, have_last_ = false, have_calibration_origin_ = false;

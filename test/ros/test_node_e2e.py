@@ -163,14 +163,17 @@ class Listener:
         import rospy
         from nav_msgs.msg import Odometry
         from std_msgs.msg import String
+        from diagnostic_msgs.msg import DiagnosticArray
         from tf2_msgs.msg import TFMessage
         self.lock = threading.Lock()
-        self.odometry, self.tf, self.counts = [], [], []
+        self.odometry, self.tf, self.counts, self.diagnostics = [], [], [], []
         self.subs = [
             rospy.Subscriber("/odometry", Odometry, self._add(self.odometry), queue_size=10000),
             rospy.Subscriber("/tf", TFMessage, self._add(self.tf), queue_size=10000),
             rospy.Subscriber("/%s/counts" % node_name, String, self._add(self.counts), queue_size=100),
+            rospy.Subscriber("/diagnostics", DiagnosticArray, self._add(self.diagnostics), queue_size=100),
         ]
+        self.node_name = node_name
 
     def _add(self, where):
         def callback(msg):
@@ -182,6 +185,15 @@ class Listener:
         import yaml
         with self.lock:
             return yaml.safe_load(self.counts[-1].data) if self.counts else {}
+
+    def last_diagnostics(self):
+        """The node's last frames status on /diagnostics: (level, message, {key: value})."""
+        with self.lock:
+            for array in reversed(self.diagnostics):
+                for st in array.status:
+                    if st.name == "/%s: frames" % self.node_name:
+                        return st.level, st.message, {kv.key: kv.value for kv in st.values}
+        return None
 
     def close(self):
         for s in self.subs:
@@ -320,6 +332,10 @@ def test_colour_images(ros_env, drive, tmp_path):
         listener.close()
     assert rc == 0
     assert len(listener.odometry) == len(cli) == 30
+    # The counts on /diagnostics as well (what rqt_runtime_monitor shows): the same numbers.
+    level, message, values = listener.last_diagnostics()
+    assert level == 0 and "tracked 30" in message
+    assert int(values["received"]) == int(values["tracked"]) == 30 and int(values["dropped"]) == 0
     assert max(max(abs(a - b) for a, b in zip(pose_of(m), q)) for m, q in zip(listener.odometry, cli)) < 1e-9
 
 
