@@ -70,3 +70,30 @@ def test_a_missing_topic_names_the_topics_there_are(drive, tmp_path):
     assert "image_topic=" in e.value.message and "--image-topic" not in e.value.message
     with pytest.raises(ValueError):
         planarvo.Dataset(path, image_topic=3)
+
+
+def test_info_names_the_topic_of_each_stream(drive, tmp_path):
+    """planarvo info on a bag: for each stream the topic it comes from (given, or the only one of
+    its type), or the candidates and the option that picks one, on the line that said yes/no."""
+    from conftest import cli_path
+    cli = cli_path()
+    if not cli:
+        pytest.skip("the planarvo CLI was not found (set PLANARVO_CLI)")
+    path = tmp_path / "drive.bag"
+    subprocess.run(_rosbag_writer() + [str(drive), str(path)], check=True, capture_output=True)
+    with planarvo.Dataset(drive) as folder:
+        n = folder.info.frame_count
+
+    def lines(*extra):
+        out = subprocess.run([cli, "info", str(path), "--quiet", *extra], check=True, capture_output=True, text=True)
+        return {l[2:13].strip(): l[14:] for l in out.stdout.splitlines() if l.startswith("  ") and len(l) > 14}
+
+    got = lines()
+    assert got["images"] == "/camera/image_raw (sensor_msgs/Image, %d messages), the only one" % n
+    assert got["camera from"] == "/camera/camera_info (sensor_msgs/CameraInfo, %d messages), the only one" % n
+    assert got["odometry"].startswith("not read: give --odom-topic (")
+    assert "/odom (nav_msgs/Odometry, %d messages)" % n in got["odometry"]
+    assert "/ground_truth (nav_msgs/Odometry, %d messages)" % n in got["odometry"]
+    got = lines("--odom-topic", "/odom", "--groundtruth-topic", "/ground_truth")
+    assert got["odometry"] == "/odom (nav_msgs/Odometry, %d messages)" % n
+    assert got["groundtruth"] == "/ground_truth (nav_msgs/Odometry, %d messages)" % n

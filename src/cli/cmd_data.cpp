@@ -185,23 +185,80 @@ DriveSummary summarise(planarvo_dataset* ds, int64_t n) {
 }
 
 // A bag's topics, before it is opened as a data set (which needs the right topics).
-void print_bag_topics(const std::string& path) {
+struct BagTopic {
+  std::string name, type, count;  // count "" when the file does not say
+  std::string described() const { return name + " (" + type + (count.empty() ? "" : ", " + count + " messages") + ")"; }
+};
+
+std::vector<BagTopic> bag_topics(const std::string& path) {
   size_t needed = 0;
   check(planarvo_bag_topics(path.c_str(), nullptr, 0, &needed));
   std::string list(needed, '\0');
   check(planarvo_bag_topics(path.c_str(), list.data(), list.size(), nullptr));
-  std::printf("topics of %s\n", path.c_str());
+  std::vector<BagTopic> topics;
   size_t at = 0;
   for (size_t end = list.find('\n'); end != std::string::npos; at = end + 1, end = list.find('\n', at)) {
     const std::string line = list.substr(at, end - at);
     const size_t a = line.find('\t'), b = line.rfind('\t');
     const std::string count = line.substr(b + 1);
-    std::printf("  %-32s %-32s %s\n", line.substr(0, a).c_str(), line.substr(a + 1, b - a - 1).c_str(),
-                count == "-1" ? "" : (count + " messages").c_str());
+    topics.push_back({line.substr(0, a), line.substr(a + 1, b - a - 1), count == "-1" ? "" : count});
   }
+  return topics;
 }
 
-void print_dataset(planarvo_dataset* ds, const std::string& dir) {
+void print_bag_topics(const std::string& path) {
+  std::printf("topics of %s\n", path.c_str());
+  for (const BagTopic& t : bag_topics(path))
+    std::printf("  %-32s %-32s %s\n", t.name.c_str(), t.type.c_str(), t.count.empty() ? "" : (t.count + " messages").c_str());
+}
+
+// For a bag, which topic each of the data set's streams comes from: the one given (--...-topic),
+// else the only candidate the library picked, else the candidates and the option that picks one.
+void print_bag_streams(const std::string& path, const Args& args) {
+  const std::vector<BagTopic> topics = bag_topics(path);
+  const auto of_type = [&](std::initializer_list<const char*> types) {
+    std::vector<BagTopic> out;
+    for (const BagTopic& t : topics)
+      for (const char* type : types)
+        if (t.type == type) {
+          out.push_back(t);
+          break;
+        }
+    return out;
+  };
+  const auto find = [&](const std::string& name) {
+    for (const BagTopic& t : topics)
+      if (t.name == name) return t.described();
+    return name;
+  };
+  const auto line = [&](const char* label, const std::string& option, std::initializer_list<const char*> types,
+                        bool picks_the_only_one) {
+    const std::vector<BagTopic> candidates = of_type(types);
+    std::string text;
+    if (args.has(option)) {
+      text = find(args.get(option));
+    } else if (picks_the_only_one && candidates.size() == 1) {
+      text = candidates[0].described() + ", the only one";
+    } else if (candidates.empty()) {
+      text = "none in the bag";
+    } else {
+      text = "not read: give --" + option + " (";
+      for (size_t i = 0; i < candidates.size(); ++i) text += (i ? ", " : "") + candidates[i].described();
+      text += ")";
+    }
+    std::printf("  %-11s %s\n", label, text.c_str());
+  };
+  line("images", "image-topic", {"sensor_msgs/Image", "sensor_msgs/CompressedImage", "sensor_msgs/msg/Image",
+                                 "sensor_msgs/msg/CompressedImage"}, true);
+  if (args.has("camera"))
+    std::printf("  %-11s %s\n", "camera from", args.get("camera").c_str());
+  else
+    line("camera from", "camera-info-topic", {"sensor_msgs/CameraInfo", "sensor_msgs/msg/CameraInfo"}, true);
+  line("odometry", "odom-topic", {"nav_msgs/Odometry", "nav_msgs/msg/Odometry"}, false);
+  line("groundtruth", "groundtruth-topic", {"nav_msgs/Odometry", "nav_msgs/msg/Odometry"}, false);
+}
+
+void print_dataset(planarvo_dataset* ds, const std::string& dir, const Args& args) {
   planarvo_dataset_info info{};
   info.struct_size = sizeof info;
   check(planarvo_dataset_info_get(ds, &info));
@@ -225,8 +282,12 @@ void print_dataset(planarvo_dataset* ds, const std::string& dir) {
     std::printf("  shutter     rolling, %.3f ms from the first row's read to the last's\n",
                 c.rolling_shutter_readout * 1e3);
   if (c.exposure_time > 0) std::printf("  exposure    %.3f ms\n", c.exposure_time * 1e3);
-  std::printf("  odometry    %s\n  direction   %s\n  groundtruth %s\n", info.has_odometry ? "yes" : "no",
-              info.has_direction ? "yes" : "no", info.has_groundtruth ? "yes" : "no");
+  if (info.is_bag) {
+    print_bag_streams(dir, args);  // which topic each stream comes from, or which could
+  } else {
+    std::printf("  odometry    %s\n  direction   %s\n  groundtruth %s\n", info.has_odometry ? "yes" : "no",
+                info.has_direction ? "yes" : "no", info.has_groundtruth ? "yes" : "no");
+  }
   auto ext = [](const char* label, int has, const planarvo_extrinsics& e) {
     if (!has) {
       std::printf("  %-11s no\n", label);
@@ -298,7 +359,7 @@ int cmd_info(int argc, char** argv) {
   Progress progress(!args.has("quiet"));
   DatasetPtr ds = open_dataset(args.positionals()[0], args, args.has("verify"), &progress);
   progress.finish();
-  print_dataset(ds.get(), args.positionals()[0]);
+  print_dataset(ds.get(), args.positionals()[0], args);
   if (args.has("verify")) std::printf("  every image decoded and checked\n");
   return kExitOk;
 }
