@@ -11,6 +11,17 @@
 namespace planarvo_node {
 namespace {
 
+// The private namespace, remembering every parameter asked for: what the node knows, so that any
+// other one there is refused (no_unknown_params) without a second list of the names.
+struct Reader {
+  const ros::NodeHandle& nh;
+  std::vector<std::string> asked;
+  bool getParam(const std::string& name, XmlRpc::XmlRpcValue& v) {
+    asked.push_back(name);
+    return nh.getParam(name, v);
+  }
+};
+
 // A parameter's value as a user wrote it ("12", "true", "abc"), for the error messages.
 std::string text(XmlRpc::XmlRpcValue& v) {
   std::ostringstream os;
@@ -19,7 +30,7 @@ std::string text(XmlRpc::XmlRpcValue& v) {
 }
 
 // A string parameter that a user may also give as a number (~device:=1 arrives as an int).
-bool get_text(const ros::NodeHandle& nh, const std::string& name, std::string* out) {
+bool get_text(Reader& nh, const std::string& name, std::string* out) {
   XmlRpc::XmlRpcValue v;
   if (!nh.getParam(name, v)) return true;
   switch (v.getType()) {
@@ -31,7 +42,7 @@ bool get_text(const ros::NodeHandle& nh, const std::string& name, std::string* o
   }
 }
 
-bool get_int(const ros::NodeHandle& nh, const std::string& name, int lo, int hi, int* out) {
+bool get_int(Reader& nh, const std::string& name, int lo, int hi, int* out) {
   XmlRpc::XmlRpcValue v;
   if (!nh.getParam(name, v)) return true;
   if (v.getType() != XmlRpc::XmlRpcValue::TypeInt || static_cast<int>(v) < lo || static_cast<int>(v) > hi) {
@@ -43,7 +54,7 @@ bool get_int(const ros::NodeHandle& nh, const std::string& name, int lo, int hi,
   return true;
 }
 
-bool get_double(const ros::NodeHandle& nh, const std::string& name, double lo, double hi, double* out) {
+bool get_double(Reader& nh, const std::string& name, double lo, double hi, double* out) {
   XmlRpc::XmlRpcValue v;
   if (!nh.getParam(name, v)) return true;
   double x = NAN;
@@ -58,7 +69,7 @@ bool get_double(const ros::NodeHandle& nh, const std::string& name, double lo, d
   return true;
 }
 
-bool get_bool(const ros::NodeHandle& nh, const std::string& name, bool* out) {
+bool get_bool(Reader& nh, const std::string& name, bool* out) {
   XmlRpc::XmlRpcValue v;
   if (!nh.getParam(name, v)) return true;
   if (v.getType() != XmlRpc::XmlRpcValue::TypeBoolean) {
@@ -69,7 +80,7 @@ bool get_bool(const ros::NodeHandle& nh, const std::string& name, bool* out) {
   return true;
 }
 
-bool get_frame(const ros::NodeHandle& nh, const std::string& name, std::string* out) {
+bool get_frame(Reader& nh, const std::string& name, std::string* out) {
   if (!get_text(nh, name, out)) return false;
   if (out->empty() || out->find(' ') != std::string::npos) {
     ROS_FATAL("planarvo_node: parameter ~%s must be a frame name without spaces, not \"%s\"", name.c_str(),
@@ -78,14 +89,6 @@ bool get_frame(const ros::NodeHandle& nh, const std::string& name, std::string* 
   }
   return true;
 }
-
-// Every private parameter the node reads (read_params), for refusing the ones it does not.
-const char* const kKnown[] = {
-    "camera", "extrinsics", "device", "cache_dir", "kernel_binaries", "prepare_kernels", "odom_frame",
-    "base_frame", "publish_tf", "levels", "finest_level", "level0_subsample", "flat_field", "readout_time",
-    "exposure_time", "max_iterations", "local_plane", "local_plane_prior_deg", "mounting_change",
-    "mounting_step_deg", "keyframe_overlap", "queue_size", "max_pending", "drain_seconds", "calibrate",
-    "calibration_output", "calibration_frames", "calibration_height", "calibration_odom_wait", "force"};
 
 size_t edit_distance(const std::string& a, const std::string& b) {
   std::vector<size_t> row(b.size() + 1);
@@ -103,35 +106,29 @@ size_t edit_distance(const std::string& a, const std::string& b) {
 }
 
 // A private parameter the node does not read is a misspelt one (~publish_tfs for ~publish_tf):
-// ROS_FATAL naming it and the nearest the node knows.
-bool no_unknown_params(const ros::NodeHandle& nh) {
+// ROS_FATAL naming it and the nearest of those the node asked for.
+bool no_unknown_params(const Reader& r) {
   std::vector<std::string> names;
-  if (!nh.getParamNames(names)) return true;
-  const std::string prefix = nh.getNamespace() + "/";
+  if (!r.nh.getParamNames(names)) return true;
+  const std::string prefix = r.nh.getNamespace() + "/";
   for (const std::string& full : names) {
     if (full.compare(0, prefix.size(), prefix) != 0) continue;
     const std::string name = full.substr(prefix.size(), full.find('/', prefix.size()) - prefix.size());
-    const char* nearest = kKnown[0];
-    size_t best = std::string::npos;
-    bool known = false;
-    for (const char* k : kKnown) {
-      if (name == k) known = true;
-      const size_t d = edit_distance(name, k);
-      if (d < best) best = d, nearest = k;
-    }
-    if (!known) {
-      ROS_FATAL("planarvo_node: unknown parameter ~%s (did you mean ~%s? ros/README.md lists the parameters)",
-                name.c_str(), nearest);
-      return false;
-    }
+    if (std::find(r.asked.begin(), r.asked.end(), name) != r.asked.end()) continue;
+    const auto nearest = std::min_element(
+        r.asked.begin(), r.asked.end(),
+        [&](const std::string& a, const std::string& b) { return edit_distance(name, a) < edit_distance(name, b); });
+    ROS_FATAL("planarvo_node: unknown parameter ~%s (did you mean ~%s? ros/README.md lists the parameters)",
+              name.c_str(), nearest == r.asked.end() ? "" : nearest->c_str());
+    return false;
   }
   return true;
 }
 
 }  // namespace
 
-bool read_params(const ros::NodeHandle& nh, NodeParams* p) {
-  if (!no_unknown_params(nh)) return false;
+bool read_params(const ros::NodeHandle& private_nh, NodeParams* p) {
+  Reader nh{private_nh, {}};
   planarvo_tracker_options_init(&p->tracker);
   planarvo_tracker_options& t = p->tracker;
   int levels = t.levels, finest = t.finest_level, subsample = t.level0_subsample, iterations = t.max_iterations;
@@ -162,7 +159,7 @@ bool read_params(const ros::NodeHandle& nh, NodeParams* p) {
             get_double(nh, "calibration_height", 0.0, 100.0, &p->calibration_height) &&
             get_double(nh, "calibration_odom_wait", 0.0, 60.0, &p->calibration_odom_wait) &&
             get_bool(nh, "force", &p->force);
-  if (!ok) return false;
+  if (!ok || !no_unknown_params(nh)) return false;
   t.levels = levels;
   t.finest_level = finest;
   t.level0_subsample = subsample;

@@ -69,7 +69,7 @@ def test_every_function_of_the_header_has_a_prototype_from_the_library():
     headers: every PLANARVO_API function the header declares (read here from the header's text, an
     independent list) is declared with ctypes, with as many argument types as it has parameters."""
     header = open(os.path.join(HEADER_DIR, "planarvo", "planarvo.h")).read()
-    for extra in ("dataset.h", "mosaic.h"):
+    for extra in ("dataset.h", "calibration.h", "mosaic.h"):
         header += open(os.path.join(HEADER_DIR, "planarvo", extra)).read()
     header = re.sub(r"/\*.*?\*/", " ", header, flags=re.S)
     declared = dict(re.findall(r"PLANARVO_API\s+[^;{]*?\b(planarvo_\w+)\s*\(([^;{]*?)\)\s*;", header, flags=re.S))

@@ -206,16 +206,16 @@ std::vector<BagTopic> bag_topics(const std::string& path) {
   return topics;
 }
 
-void print_bag_topics(const std::string& path) {
+void print_bag_topics(const std::string& path, const std::vector<BagTopic>& topics) {
   std::printf("topics of %s\n", path.c_str());
-  for (const BagTopic& t : bag_topics(path))
-    std::printf("  %-32s %-32s %s\n", t.name.c_str(), t.type.c_str(), t.count.empty() ? "" : (t.count + " messages").c_str());
+  for (const BagTopic& t : topics)
+    std::printf("  %-32s %-32s %s\n", t.name.c_str(), t.type.c_str(),
+                t.count.empty() ? "" : (t.count + " messages").c_str());
 }
 
 // For a bag, which topic each of the data set's streams comes from: the one given (--...-topic),
 // else the only candidate the library picked, else the candidates and the option that picks one.
-void print_bag_streams(const std::string& path, const Args& args) {
-  const std::vector<BagTopic> topics = bag_topics(path);
+void print_bag_streams(const std::vector<BagTopic>& topics, const Args& args) {
   const auto of_type = [&](std::initializer_list<const char*> types) {
     std::vector<BagTopic> out;
     for (const BagTopic& t : topics)
@@ -258,7 +258,9 @@ void print_bag_streams(const std::string& path, const Args& args) {
   line("groundtruth", "groundtruth-topic", {"nav_msgs/Odometry", "nav_msgs/msg/Odometry"}, false);
 }
 
-void print_dataset(planarvo_dataset* ds, const std::string& dir, const Args& args) {
+// topics: a bag's (bag_topics), empty for a folder.
+void print_dataset(planarvo_dataset* ds, const std::string& dir, const Args& args,
+                   const std::vector<BagTopic>& topics) {
   planarvo_dataset_info info{};
   info.struct_size = sizeof info;
   check(planarvo_dataset_info_get(ds, &info));
@@ -283,7 +285,7 @@ void print_dataset(planarvo_dataset* ds, const std::string& dir, const Args& arg
                 c.rolling_shutter_readout * 1e3);
   if (c.exposure_time > 0) std::printf("  exposure    %.3f ms\n", c.exposure_time * 1e3);
   if (info.is_bag) {
-    print_bag_streams(dir, args);  // which topic each stream comes from, or which could
+    print_bag_streams(topics, args);  // which topic each stream comes from, or which could
   } else {
     std::printf("  odometry    %s\n  direction   %s\n  groundtruth %s\n", info.has_odometry ? "yes" : "no",
                 info.has_direction ? "yes" : "no", info.has_groundtruth ? "yes" : "no");
@@ -355,11 +357,15 @@ int cmd_info(int argc, char** argv) {
     return kExitOk;
   }
   args.expect_positionals(1, "DATASET, the data set folder or a bag");
-  if (is_bag_path(args.positionals()[0])) print_bag_topics(args.positionals()[0]);
+  std::vector<BagTopic> topics;  // read once, for the list and the streams
+  if (is_bag_path(args.positionals()[0])) {
+    topics = bag_topics(args.positionals()[0]);
+    print_bag_topics(args.positionals()[0], topics);
+  }
   Progress progress(!args.has("quiet"));
   DatasetPtr ds = open_dataset(args.positionals()[0], args, args.has("verify"), &progress);
   progress.finish();
-  print_dataset(ds.get(), args.positionals()[0], args);
+  print_dataset(ds.get(), args.positionals()[0], args, topics);
   if (args.has("verify")) std::printf("  every image decoded and checked\n");
   return kExitOk;
 }

@@ -496,6 +496,26 @@ Mosaic build_mosaic(ocl::Runtime& runtime, io::Dataset& dataset, const Extrinsic
   return m;
 }
 
+namespace {
+
+// An image encoded by its path's extension and written through OutputFile, complete or not at
+// all: InvalidArgument for a format OpenCV cannot write, Io naming the file when writing fails.
+void write_image(const std::string& path, const cv::Mat& image, const std::vector<int>& params) {
+  const std::string extension = std::filesystem::path(path).extension().string();
+  std::vector<uint8_t> bytes;
+  try {
+    if (!cv::imencode(extension, image, bytes, params)) throw Error(ErrorCode::Io, "cannot encode " + path);
+  } catch (const cv::Exception& e) {
+    throw_invalid_argument("mosaic: cannot write an image as " + extension + " (" + path + "): " + e.what());
+  }
+  OutputFile file(path);
+  if (std::fwrite(bytes.data(), 1, bytes.size(), file.stream()) != bytes.size())
+    throw Error(ErrorCode::Io, "cannot write " + path);
+  file.commit();
+}
+
+}  // namespace
+
 void save_mosaic(const Mosaic& mosaic, const std::string& image_path) {
   namespace fs = std::filesystem;
   const fs::path img(image_path);
@@ -506,18 +526,7 @@ void save_mosaic(const Mosaic& mosaic, const std::string& image_path) {
   // Both files through OutputFile: each appears complete or not at all, the image first, so a
   // YAML never names a missing or partial image. PNG at zlib level 1 (OpenCV's default is 3):
   // the mosaic of the 20-s simulated drive is 17% larger, and written faster.
-  std::vector<uint8_t> bytes;
-  try {
-    if (!cv::imencode(img.extension().string(), mosaic.image, bytes, {cv::IMWRITE_PNG_COMPRESSION, 1}))
-      throw Error(ErrorCode::Io, "cannot encode " + image_path);
-  } catch (const cv::Exception& e) {
-    throw_invalid_argument("mosaic: cannot write an image as " + img.extension().string() + " (" + image_path +
-                           "): " + e.what());
-  }
-  OutputFile image(image_path);
-  if (std::fwrite(bytes.data(), 1, bytes.size(), image.stream()) != bytes.size())
-    throw Error(ErrorCode::Io, "cannot write " + image_path);
-  image.commit();
+  write_image(image_path, mosaic.image, {cv::IMWRITE_PNG_COMPRESSION, 1});
   std::ostringstream out;
   out.imbue(std::locale::classic());
   out << "# planarvo mosaic: the ground under the trajectory, placed as ROS map_server reads a map.\n"
@@ -575,18 +584,7 @@ cv::Mat contrast_preview(const cv::Mat& image) {
 }
 
 void save_preview(const Mosaic& mosaic, const std::string& path) {
-  const cv::Mat preview = contrast_preview(mosaic.image);
-  std::vector<uint8_t> bytes;
-  try {
-    if (!cv::imencode(std::filesystem::path(path).extension().string(), preview, bytes))
-      throw Error(ErrorCode::Io, "cannot encode " + path);
-  } catch (const cv::Exception& e) {
-    throw_invalid_argument("mosaic preview: cannot write an image as " + path + ": " + e.what());
-  }
-  OutputFile file(path);
-  if (std::fwrite(bytes.data(), 1, bytes.size(), file.stream()) != bytes.size())
-    throw Error(ErrorCode::Io, "cannot write " + path);
-  file.commit();
+  write_image(path, contrast_preview(mosaic.image), {});
 }
 
 }  // namespace planarvo::mosaic

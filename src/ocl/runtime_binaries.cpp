@@ -187,7 +187,6 @@ cl::Program Runtime::load_from_binaries(const std::string& name, const std::stri
 
 size_t Runtime::export_binaries(const std::string& dir, const std::vector<std::string>& uses) {
   check_uses(uses);
-  const auto wanted = [&](const std::string& program) { return variants_for(program, uses); };
 
   std::lock_guard<std::mutex> lock(mutex_);
   std::error_code ec;
@@ -209,7 +208,7 @@ size_t Runtime::export_binaries(const std::string& dir, const std::vector<std::s
   for (const EmbeddedSource* s = embedded_sources(); s->name; ++s) {
     const std::string name = s->name;
     if (name == kPreludeName) continue;
-    for (const std::string& options : wanted(name)) {
+    for (const std::string& options : variants_for(name, uses)) {
       if (options.find_first_of("\t\r\n") != std::string::npos)
         throw Error(ErrorCode::InvalidArgument,
                     "the options " + quote(options) + " registered for program " + quote(name) +

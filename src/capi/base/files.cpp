@@ -22,6 +22,24 @@ using planarvo::capi::require;
 
 using planarvo::capi::require_path;
 
+namespace {
+
+// The readers' "ask, then fill" convention: *count (when not NULL) receives the file's entries;
+// with capacity 0 nothing else happens; a capacity short of them is InvalidArgument, writing
+// nothing; else put(i, entry) writes each.
+template <class T, class Put>
+void copy_out(const std::vector<T>& entries, size_t capacity, size_t* count, const char* fn, const char* path,
+              const char* what, Put&& put) {
+  if (count) *count = entries.size();
+  if (capacity == 0) return;
+  if (capacity < entries.size())
+    planarvo::throw_invalid_argument(std::string(fn) + ": " + path + " has " + std::to_string(entries.size()) + " " +
+                                     what + ", the arrays hold " + std::to_string(capacity));
+  for (size_t i = 0; i < entries.size(); ++i) put(i, entries[i]);
+}
+
+}  // namespace
+
 extern "C" {
 
 PLANARVO_API planarvo_status planarvo_camera_save(const char* path, const planarvo_camera* camera) {
@@ -132,16 +150,11 @@ PLANARVO_API planarvo_status planarvo_read_tum(const char* path, double* timesta
   return guard([&] {
     require_path(path, "planarvo_read_tum");
     require(capacity == 0 || (timestamps != nullptr && poses != nullptr), "planarvo_read_tum: NULL arrays");
-    const std::vector<planarvo::io::StampedPose> v = planarvo::io::read_tum(path);
-    if (count) *count = v.size();
-    if (capacity == 0) return;
-    if (capacity < v.size())
-      planarvo::throw_invalid_argument("planarvo_read_tum: " + std::string(path) + " has " + std::to_string(v.size()) +
-                                       " poses, the arrays hold " + std::to_string(capacity));
-    for (size_t i = 0; i < v.size(); ++i) {
-      timestamps[i] = v[i].t;
-      poses[i] = planarvo::capi::to_c(v[i].pose);
-    }
+    copy_out(planarvo::io::read_tum(path), capacity, count, "planarvo_read_tum", path, "poses",
+             [&](size_t i, const planarvo::io::StampedPose& p) {
+               timestamps[i] = p.t;
+               poses[i] = planarvo::capi::to_c(p.pose);
+             });
   });
 }
 
@@ -161,14 +174,10 @@ PLANARVO_API planarvo_status planarvo_read_plane(const char* path, planarvo_plan
   return guard([&] {
     require_path(path, "planarvo_read_plane");
     require(capacity == 0 || rows != nullptr, "planarvo_read_plane: rows is NULL");
-    const std::vector<planarvo::io::PlaneAttitude> v = planarvo::io::read_plane(path);
-    if (count) *count = v.size();
-    if (capacity == 0) return;
-    if (capacity < v.size())
-      planarvo::throw_invalid_argument("planarvo_read_plane: " + std::string(path) + " has " +
-                                       std::to_string(v.size()) + " rows, the array holds " + std::to_string(capacity));
-    for (size_t i = 0; i < v.size(); ++i)
-      rows[i] = {v[i].t, v[i].roll, v[i].pitch, v[i].sigma_roll, v[i].sigma_pitch};
+    copy_out(planarvo::io::read_plane(path), capacity, count, "planarvo_read_plane", path, "rows",
+             [&](size_t i, const planarvo::io::PlaneAttitude& a) {
+               rows[i] = {a.t, a.roll, a.pitch, a.sigma_roll, a.sigma_pitch};
+             });
   });
 }
 
