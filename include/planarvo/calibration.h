@@ -345,8 +345,10 @@ typedef struct planarvo_camera_calibration_result {
 } planarvo_camera_calibration_result;
 
 PLANARVO_API void planarvo_camera_calibration_options_init(planarvo_camera_calibration_options* options);
-/* Calibrates from a data set (its frames, odometry.txt for the odometry method, direction.txt for
- * the nonholonomic one). PLANARVO_ERROR_INVALID_INPUT when the method's inputs are missing;
+/* Calibrates from a data set (its frames, odometry.txt or the odometry topic for the odometry
+ * method; direction.txt for the nonholonomic one, or, without labels, the odometry's sign: +1 / -1
+ * by its forward motion, 0 when slower than the graph's still_speed, and the result's method says
+ * so). PLANARVO_ERROR_INVALID_INPUT when the method's inputs are missing;
  * PLANARVO_ERROR_FAILED (the reason as the message) when the status is not OK, the result filled
  * in either case. */
 PLANARVO_API planarvo_status planarvo_calibrate_dataset(planarvo_context* context, planarvo_dataset* dataset,

@@ -32,10 +32,13 @@ ExtrinsicsEstimate compose_extrinsics(double roll, double pitch, const Eigen::Ma
   return out;
 }
 
-std::string describe_camera_calibration(graph::CalibrationMethod method) {
-  return method == graph::CalibrationMethod::Odometry
-             ? "roll and pitch from images (sec. 5.1); x, y, z, yaw against wheel odometry (5.2.1)"
-             : "roll and pitch from images (sec. 5.1); x, yaw nonholonomic, y from direction labels (5.2.2), z given";
+std::string describe_camera_calibration(graph::CalibrationMethod method, bool labels_from_odometry) {
+  if (method == graph::CalibrationMethod::Odometry)
+    return "roll and pitch from images (sec. 5.1); x, y, z, yaw against wheel odometry (5.2.1)";
+  return labels_from_odometry ? "roll and pitch from images (sec. 5.1); x, yaw nonholonomic, y from direction labels "
+                                "taken from the sign of the wheel odometry (5.2.2), z given"
+                              : "roll and pitch from images (sec. 5.1); x, yaw nonholonomic, y from direction labels "
+                                "(5.2.2), z given";
 }
 
 }  // namespace planarvo::calib

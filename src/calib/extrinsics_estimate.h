@@ -35,7 +35,9 @@ ExtrinsicsEstimate compose_extrinsics(double roll, double pitch, const Eigen::Ma
                                       const Eigen::Matrix<double, 4, 2>* tilt_jacobian = nullptr);
 
 // How the whole calibration (calib/pipeline.h) finds the extrinsics with the graph's method, one
-// sentence (extrinsics.yaml's method).
-std::string describe_camera_calibration(graph::CalibrationMethod method);
+// sentence (extrinsics.yaml's method). labels_from_odometry: the nonholonomic method's direction
+// labels came from the odometry's forward motion (graph::CalibrationOptions::still_speed), the
+// drive having no labels of its own.
+std::string describe_camera_calibration(graph::CalibrationMethod method, bool labels_from_odometry = false);
 
 }  // namespace planarvo::calib

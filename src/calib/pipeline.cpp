@@ -259,7 +259,13 @@ struct CameraCalibrator::Impl {
     report.tilt_jacobian = J;
     report.extrinsics =
         compose_extrinsics(rp.roll, rp.pitch, rp.covariance, opt.estimate_roll_pitch, report.graph, J ? &*J : nullptr);
-    report.extrinsics.method = describe_camera_calibration(go.method);
+    // The nonholonomic method takes a sample's label from its odometry where it has none (the
+    // graph's rule); said in the method when no sample had a label of its own.
+    const bool labels_from_odometry =
+        go.method == graph::CalibrationMethod::Nonholonomic &&
+        std::none_of(samples.begin(), samples.end(), [](const graph::MotionSample& s) { return s.direction.has_value(); }) &&
+        std::any_of(samples.begin(), samples.end(), [](const graph::MotionSample& s) { return s.odometry.has_value(); });
+    report.extrinsics.method = describe_camera_calibration(go.method, labels_from_odometry);
     if (report.graph.ok()) {
       report.status = PipelineReport::Status::Ok;
       report.reason.clear();
@@ -354,9 +360,14 @@ PipelineReport calibrate_dataset(ocl::Runtime& runtime, io::Dataset& ds, const P
     throw_invalid_input(ds.directory() + (ds.is_bag() ? ": no odometry topic given (--odom-topic, odometry_topic)" : " has no odometry.txt") +
                         ": the odometry method needs wheel odometry (or use the nonholonomic method with direction "
                         "labels and the camera height)");
-  if (options.graph.method == graph::CalibrationMethod::Nonholonomic && !ds.has_direction())
-    throw_invalid_input(ds.directory() + (ds.is_bag() ? ": a bag has no direction labels" : " has no direction.txt") +
-                        ": the nonholonomic method needs direction labels for y and the branch");
+  // Without labels the odometry's sign gives them (graph::CalibrationOptions::still_speed).
+  if (options.graph.method == graph::CalibrationMethod::Nonholonomic && !ds.has_direction() && !ds.has_odometry())
+    throw_invalid_input(ds.directory() +
+                        (ds.is_bag() ? ": a bag has no direction labels, and no odometry topic was given (--odom-topic, "
+                                       "odometry_topic) to take them from"
+                                     : " has neither direction.txt nor odometry.txt") +
+                        ": the nonholonomic method needs direction labels for y and the branch (the odometry's sign "
+                        "gives them)");
   PipelineOptions o = options;
   if (o.readout == PipelineOptions::Readout::IfUnknown)
     o.readout = ds.readout_given() ? PipelineOptions::Readout::Off : PipelineOptions::Readout::On;

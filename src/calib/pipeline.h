@@ -155,7 +155,8 @@ class CameraCalibrator {
 
 // The whole pipeline over a data set: every frame, its odometry (odometry.txt) and direction
 // label (direction.txt). Throws InvalidInput when the method's inputs are missing (odometry for
-// the odometry method; direction labels for the nonholonomic one) or a frame cannot be read.
+// the odometry method; direction labels or odometry, whose sign gives them, for the nonholonomic
+// one) or a frame cannot be read.
 PipelineReport calibrate_dataset(ocl::Runtime& runtime, io::Dataset& dataset, const PipelineOptions& options);
 
 // Stage 2 on its own: every frame of the data set tracked with the given extrinsics (for the graph

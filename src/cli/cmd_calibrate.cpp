@@ -86,6 +86,14 @@ int cmd_calibrate_dataset(const Args& args, const planarvo_calibration_options& 
   const planarvo_status st = calibrate_dataset(ctx.get(), ds.get(), &o, &progress, &r);
 
   std::printf("calibrated %s (%s) on %s\n", dir.c_str(), method.c_str(), device_name(ctx.get()).c_str());
+  if (o.method == PLANARVO_CALIBRATE_NONHOLONOMIC) {
+    planarvo_dataset_info info{};
+    info.struct_size = sizeof info;
+    check(planarvo_dataset_info_get(ds.get(), &info));
+    if (!info.has_direction)
+      std::printf("direction labels: none in %s; taken from the wheel odometry's sign (forward +1, backward -1)\n",
+                  dir.c_str());
+  }
   if (r.roll_pitch.status == PLANARVO_CALIBRATION_OK && r.roll_pitch.keyframes > 0)
     std::printf("roll and pitch: %d keyframes (%d pairs) from %d frames, %.2f s\n", r.roll_pitch.keyframes,
                 r.roll_pitch.pairs, r.roll_pitch.frames_used, r.seconds_roll_pitch);

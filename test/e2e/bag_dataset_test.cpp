@@ -6,6 +6,7 @@
 // (scripts/install-deps.sh installs both).
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
@@ -386,6 +387,70 @@ TEST_F(BagDataset, CalibrateReadsTheOdometryTopic) {
   } else {
     EXPECT_EQ(tool.exit_code, 1) << tool.output;
     EXPECT_FALSE(fs::exists(out));
+  }
+}
+
+// Issue 25: the nonholonomic method from a bag, whose direction labels come from the odometry's
+// sign (a bag has no direction.txt). Against an independent route to the same numbers: the folder
+// with its direction.txt removed, where the graph takes the labels from odometry.txt's sign; and
+// against the folder's own labels, the same x, yaw, roll and pitch and a y within its sigma.
+// From the bag of each independent writer (python3-rosbag, the MCAP TypeScript library).
+TEST_F(BagDataset, NonholonomicTakesItsDirectionsFromTheOdometrysSign) {
+  SKIP_WITHOUT(rosbag_missing());
+  SKIP_WITHOUT(mcap_missing());
+  const ExtrinsicsEstimate truth = io::read_extrinsics_yaml((dataset_dir() / "extrinsics_gt.yaml").string());
+  const auto calibrate = [&](const std::string& path, const planarvo_dataset_options* options) {
+    test::ApiContext context = test::api_context();
+    planarvo_dataset* d = nullptr;
+    EXPECT_EQ(planarvo_dataset_open(path.c_str(), options, &d), PLANARVO_OK) << planarvo_last_error();
+    test::ApiDataset dataset(d);
+    planarvo_camera_calibration_options o;
+    planarvo_camera_calibration_options_init(&o);
+    o.method = PLANARVO_CALIBRATE_NONHOLONOMIC;
+    o.height = truth.value.z;
+    planarvo_camera_calibration_result r;
+    std::memset(&r, 0, sizeof r);
+    r.struct_size = sizeof r;
+    const planarvo_status st = planarvo_calibrate_dataset(context.get(), dataset.get(), &o, &r);
+    EXPECT_EQ(st, PLANARVO_OK) << planarvo_last_error();
+    return r;
+  };
+  const fs::path unlabelled = scratch() / "unlabelled";
+  fs::create_directories(unlabelled);
+  fs::copy(dataset_dir(), unlabelled, fs::copy_options::recursive | fs::copy_options::overwrite_existing);
+  ASSERT_TRUE(fs::remove(unlabelled / "direction.txt"));
+  const planarvo_camera_calibration_result from_odometry = calibrate(unlabelled.string(), nullptr);
+  const planarvo_camera_calibration_result labelled = calibrate(dataset_dir().string(), nullptr);
+  ASSERT_GT(from_odometry.samples, 30);
+  const double* expected = &from_odometry.extrinsics.x;
+  const double* with_labels = &labelled.extrinsics.x;
+  for (int k : {0, 3, 4, 5}) EXPECT_NEAR(expected[k], with_labels[k], 1e-6) << k;
+  EXPECT_LT(std::abs(expected[1] - with_labels[1]), std::sqrt(labelled.covariance[7]));
+
+  planarvo_dataset_options o = bag_options();
+  o.groundtruth_topic = nullptr;
+  for (const fs::path& bag : {write_rosbag("mono8_lz4.bag", "--compression lz4"), write_mcap("zstd.mcap", "--compression zstd")}) {
+    SCOPED_TRACE(bag.string());
+    const planarvo_camera_calibration_result r = calibrate(bag.string(), &o);
+    EXPECT_EQ(r.samples, from_odometry.samples);
+    const double* v = &r.extrinsics.x;
+    for (int k = 0; k < 6; ++k) EXPECT_NEAR(v[k], expected[k], 1e-9) << k;
+
+    // The tool: without the odometry topic there is nothing to take the labels from (exit 2,
+    // naming the option, no file); with it, the values above.
+    const fs::path out = scratch() / (bag.filename().string() + ".nonholonomic.yaml");
+    char z[32];
+    std::snprintf(z, sizeof z, "%.17g", truth.value.z);
+    const std::string height = std::string(" --method nonholonomic --height ") + z;
+    const auto refused = run_cli("calibrate --quiet " + bag.string() + height + " -o " + out.string());
+    EXPECT_EQ(refused.exit_code, 2) << refused.output;
+    EXPECT_THAT(refused.output, HasSubstr("--odom-topic"));
+    EXPECT_FALSE(fs::exists(out));
+    const auto tool = run_cli("calibrate --quiet " + bag.string() + height + " --odom-topic /odom -o " + out.string());
+    ASSERT_EQ(tool.exit_code, 0) << tool.output;
+    const ExtrinsicsEstimate e = io::read_extrinsics_yaml(out.string());
+    const double w[6] = {e.value.x, e.value.y, e.value.z, e.value.roll, e.value.pitch, e.value.yaw};
+    for (int k = 0; k < 6; ++k) EXPECT_NEAR(w[k], expected[k], 1e-9) << k;
   }
 }
 
