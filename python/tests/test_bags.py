@@ -97,3 +97,57 @@ def test_info_names_the_topic_of_each_stream(drive, tmp_path):
     got = lines("--odom-topic", "/odom", "--groundtruth-topic", "/ground_truth")
     assert got["odometry"] == "/odom (nav_msgs/Odometry, %d messages)" % n
     assert got["groundtruth"] == "/ground_truth (nav_msgs/Odometry, %d messages)" % n
+
+
+@pytest.mark.parametrize("writer, name", [(_rosbag_writer, "drive.bag"), (_mcap_writer, "drive.mcap")])
+def test_the_plots_read_a_bags_topics(drive, tmp_path, writer, name):
+    """plot track, calibration and outliers take track's bag options (issue 25): with them each
+    reads from the bag what it reads from the folder, to the last bit of the library's numbers;
+    without the odometry topic, the calibration figures are exit 2 naming the option."""
+    pytest.importorskip("matplotlib")
+    from planarvo.plot import _cli
+    from planarvo.plot._calibration_data import prepare
+    from planarvo.plot._io import read_dataset
+    from planarvo.plot._outliers import track_frame
+    bag = tmp_path / name
+    subprocess.run(writer() + [str(drive), str(bag)], check=True, capture_output=True)
+    topics = {"odometry_topic": "/odom", "groundtruth_topic": "/ground_truth"}
+    flags = ["--odom-topic", "/odom", "--groundtruth-topic", "/ground_truth"]
+
+    folder, series = read_dataset(str(drive)), read_dataset(str(bag), topics)
+    np.testing.assert_allclose(series.times, folder.times - folder.times[0], atol=1e-9)
+    np.testing.assert_allclose(series.odometry, folder.odometry, atol=1e-9)
+    np.testing.assert_allclose(series.groundtruth, folder.groundtruth, atol=1e-9)
+    bare = read_dataset(str(bag))
+    assert bare.odometry is None and bare.groundtruth is None
+
+    # plot track: the velocity figures need the reference the topics give.
+    planarvo.write_tum(tmp_path / "t.txt", series.times + series.time_origin_s, series.groundtruth)  # as track writes
+    for out, extra, expected in (("bare", [], {"trajectory.png"}),
+                                 ("topics", flags, {"trajectory.png", "velocity.png", "velocity_hist.png"})):
+        assert _cli.main(["track", str(bag), "--trajectory", str(tmp_path / "t.txt"),
+                          "--out-dir", str(tmp_path / out)] + extra) == 0
+        assert set(os.listdir(tmp_path / out)) == expected
+
+    # plot calibration: the motion pairs tracked from the bag are the folder's, so is the result.
+    extrinsics = os.path.join(drive, "extrinsics_gt.yaml")
+    a = prepare(str(drive), None, extrinsics, None, 2, None)[0]
+    b = prepare(str(bag), None, extrinsics, None, 2, None, {"odometry_topic": "/odom"})[0]
+    assert len(a.pairs) == len(b.pairs) > 20
+    np.testing.assert_allclose(b.whole.result.value, a.whole.result.value, atol=1e-9)
+    assert _cli.main(["calibration", str(bag), "--extrinsics", extrinsics, "--windows", "0",
+                      "--out-dir", str(tmp_path / "c0")]) == 2
+    assert not (tmp_path / "c0" / "calibration_estimates.png").exists()
+    assert _cli.main(["calibration", str(bag), "--extrinsics", extrinsics, "--windows", "0", "--odom-topic", "/odom",
+                      "--out-dir", str(tmp_path / "c1")]) == 0
+    assert (tmp_path / "c1" / "calibration_estimates.png").exists()
+
+    # plot outliers: the same frame's residuals.
+    fa = track_frame(str(drive), extrinsics, 12, 1)
+    fb = track_frame(str(bag), extrinsics, 12, 1, {"camera_info_topic": "/camera/camera_info"})
+    np.testing.assert_array_equal(fb.residuals.residual, fa.residuals.residual)
+    assert _cli.main(["outliers", str(bag), "--extrinsics", extrinsics, "--frame", "12",
+                      "--camera-info-topic", "/camera/camera_info", "--out-dir", str(tmp_path / "o")]) == 0
+    # A bag option on a folder is bad input.
+    assert _cli.main(["outliers", str(drive), "--extrinsics", extrinsics, "--frame", "12", "--odom-topic", "/odom",
+                      "--out-dir", str(tmp_path / "o2")]) == 2

@@ -5,6 +5,7 @@ import sys
 from typing import List
 
 from . import _calibration_data as C
+from ._io import bag_options
 
 
 def plot_calibration(args) -> List[str]:
@@ -12,7 +13,7 @@ def plot_calibration(args) -> List[str]:
     from ._style import parse_formats
     formats = parse_formats(args.format)
     data, extr, truth, truth_path = C.prepare(args.dataset, args.motions, args.extrinsics, args.truth, args.windows,
-                                            args.fix_scale)
+                                            args.fix_scale, bag_options(args))
     written = F.estimates_figure(data, extr, truth, args.out_dir, formats)
     written += F.residuals_figure(data, args.out_dir, formats)
     if args.report:

@@ -7,12 +7,12 @@ import math
 import os
 import sys
 from dataclasses import dataclass, field
-from typing import List, Optional
+from typing import Any, Dict, List, Optional
 
 import numpy as np
 
 from ._errors import InputError
-from ._io import ExtrinsicsFile, read_extrinsics
+from ._io import ExtrinsicsFile, open_dataset, read_extrinsics
 
 GRAPH_NAMES = ("x", "y", "z", "yaw")  # the graph's (x, y, scale, yaw); the scale is the camera height
 
@@ -45,20 +45,23 @@ def _log(text: str) -> None:
     print(text, file=sys.stderr, flush=True)
 
 
-def pairs_from_dataset(path: str, extr: ExtrinsicsFile) -> list:
-    """Tracks the data set at x = y = 0, z = 1, yaw = 0 with the calibrated roll and pitch, as the
-    calibration's second stage does, and keeps the pairs with odometry."""
+def pairs_from_dataset(path: str, extr: ExtrinsicsFile, options: Optional[Dict[str, Any]] = None) -> list:
+    """Tracks the data set (options: planarvo.Dataset's bag keywords) at x = y = 0, z = 1, yaw = 0
+    with the calibrated roll and pitch, as the calibration's second stage does, and keeps the
+    pairs with odometry."""
     import planarvo
     roll, pitch = extr.values[3], extr.values[4]
-    _log("tracking %s at roll %.3f deg, pitch %.3f deg for the motion pairs..." % (path, math.degrees(roll),
-                                                                                  math.degrees(pitch)))
-    try:
-        with planarvo.Context() as ctx, planarvo.Dataset(path) as ds:
-            if not ds.info.has_odometry:
-                raise InputError("%s has no wheel odometry: the residuals need the odometry method's pairs" % path)
-            pairs = planarvo.track_motions(ctx, ds, planarvo.Extrinsics(0.0, 0.0, 1.0, roll, pitch, 0.0))
-    except planarvo.Error as e:
-        raise InputError("cannot track %s: %s" % (path, e.message)) from None
+    with open_dataset(path, options) as ds:
+        if not ds.info.has_odometry:
+            raise InputError("%s has no wheel odometry%s: the residuals need the odometry method's pairs" % (
+                path, " (give its topic: --odom-topic TOPIC)" if ds.info.is_bag else ""))
+        _log("tracking %s at roll %.3f deg, pitch %.3f deg for the motion pairs..." % (
+            path, math.degrees(roll), math.degrees(pitch)))
+        try:
+            with planarvo.Context() as ctx:
+                pairs = planarvo.track_motions(ctx, ds, planarvo.Extrinsics(0.0, 0.0, 1.0, roll, pitch, 0.0))
+        except planarvo.Error as e:
+            raise InputError("cannot track %s: %s" % (path, e.message)) from None
     return [p for p in pairs if p.odometry is not None]
 
 
@@ -121,15 +124,16 @@ def residuals(data: CalibrationData) -> None:
                            "constant + per travel² + per turn²)")
 
 
-def prepare(dataset, motions, extrinsics, truth_path, n_windows, fix_scale):
-    """Reads the inputs and runs the calibrations: (data, extrinsics, truth or None)."""
+def prepare(dataset, motions, extrinsics, truth_path, n_windows, fix_scale, options=None):
+    """Reads the inputs and runs the calibrations: (data, extrinsics, truth or None). options:
+    planarvo.Dataset's bag keywords for the data set."""
     extr = read_extrinsics(extrinsics)
-    if truth_path is None and dataset is not None:
+    if truth_path is None and dataset is not None and os.path.isdir(dataset):
         default = os.path.join(dataset, "extrinsics_gt.yaml")
         truth_path = default if os.path.isfile(default) else None
     truth = read_extrinsics(truth_path) if truth_path else None
     if dataset is not None:
-        pairs, source = pairs_from_dataset(dataset, extr), "tracked from %s" % dataset
+        pairs, source = pairs_from_dataset(dataset, extr, options), "tracked from %s" % dataset
     else:
         pairs, source = load_pairs(motions), motions
     if len(pairs) < 3:

@@ -11,6 +11,7 @@ import time
 from typing import List, Optional
 
 from ._errors import InputError
+from ._io import add_bag_options, bag_options
 
 PROG = "planarvo plot"
 
@@ -40,6 +41,7 @@ def _parser() -> argparse.ArgumentParser:
     t.add_argument("dataset", metavar="DATASET", help="the data set folder, bag or MCAP file that was tracked")
     t.add_argument("--trajectory", required=True, help="the TUM trajectory from planarvo track -o")
     t.add_argument("--stats", help="the per-frame statistics CSV from planarvo track --stats")
+    add_bag_options(t)
     _common(t)
     c = sub.add_parser("calibration", help="calibration estimates and residual figures, and an HTML report",
                        description="calibration_estimates.FMT and calibration_residuals.FMT, and with --report "
@@ -54,6 +56,7 @@ def _parser() -> argparse.ArgumentParser:
     c.add_argument("--fix-scale", type=float, metavar="SCALE", help="motion pairs of a metric sensor: hold the "
                    "scale at SCALE (1 for a laser) as calibrate --motions --fix-scale does")
     c.add_argument("--report", metavar="HTML", help="also write a self-contained HTML report here")
+    add_bag_options(c)
     _common(c)
     o = sub.add_parser("outliers", help="the pixels the tracker's robust norm down-weighted in one frame",
                        description="outliers_N.FMT: tracks frames 0..N with the extrinsics and draws frame N's "
@@ -63,6 +66,7 @@ def _parser() -> argparse.ArgumentParser:
     o.add_argument("--extrinsics", required=True, help="the camera's extrinsics YAML")
     o.add_argument("--frame", required=True, type=int, metavar="N", help="the frame (index from 0; at least 1)")
     o.add_argument("--level", type=int, default=0, metavar="L", help="pyramid level (default 0: full resolution)")
+    add_bag_options(o)
     _common(o)
     r = sub.add_parser("report", help="track and calibration figures in one HTML file",
                        description="Everything above for one data set: the track figures (with --trajectory) "
@@ -74,6 +78,7 @@ def _parser() -> argparse.ArgumentParser:
     r.add_argument("--truth", help="true extrinsics YAML (default: DATASET/extrinsics_gt.yaml when present)")
     r.add_argument("--windows", type=int, default=4)
     r.add_argument("-o", "--output", required=True, metavar="HTML", help="the HTML file to write")
+    add_bag_options(r)
     m = sub.add_parser("mosaic", help="floor mosaics in metres, side by side, with the trajectory over them",
                        description="mosaic.FMT (or --name): each mosaic that planarvo mosaic wrote (its image and "
                        "map_server YAML) in metric axes, side by side, optionally with a trajectory over it and "
@@ -93,11 +98,13 @@ def _run(args: argparse.Namespace) -> List[str]:
         formats = _formats(args.format)
         os.makedirs(args.out_dir, exist_ok=True)
         from ._track import plot_track
-        return plot_track(args.dataset, args.trajectory, args.stats, args.out_dir, formats)
+        return plot_track(args.dataset, args.trajectory, args.stats, args.out_dir, formats, bag_options(args))
     if args.command == "calibration":
         formats = _formats(args.format)
         if (args.dataset is None) == (args.motions is None):
             raise InputError("give either DATASET or --motions FILE (one of them)")
+        if args.motions is not None and bag_options(args):
+            raise InputError("the bag options (--odom-topic, ...) apply to DATASET, not to --motions")
         if args.windows < 0:
             raise InputError("--windows must be 0 or more")
         os.makedirs(args.out_dir, exist_ok=True)

@@ -7,7 +7,7 @@ from __future__ import annotations
 import math
 import os
 from dataclasses import dataclass
-from typing import Callable, Dict, Optional, TypeVar
+from typing import Any, Callable, Dict, Optional, TypeVar
 
 import numpy as np
 
@@ -77,15 +77,49 @@ class Series:
     is_bag: bool
 
 
-def read_dataset(path: str) -> Series:
-    """Opens the data set (a folder, a bag or MCAP file) with planarvo.Dataset and reads every
-    frame's time and poses (not the images)."""
+# The bag options, as `planarvo track` takes them: (flag, planarvo.Dataset keyword, help).
+BAG_OPTIONS = (
+    ("--image-topic", "image_topic", "bag: the images (sensor_msgs/Image or CompressedImage; default: the only one)"),
+    ("--camera-info-topic", "camera_info_topic", "bag: the camera (sensor_msgs/CameraInfo; default: the only one)"),
+    ("--camera", "camera_yaml", "bag: the camera from an OpenCV calibration YAML instead of a CameraInfo topic"),
+    ("--odom-topic", "odometry_topic", "bag: wheel odometry (nav_msgs/Odometry; default none)"),
+    ("--groundtruth-topic", "groundtruth_topic", "bag: true poses (nav_msgs/Odometry; default none)"),
+)
+
+
+def add_bag_options(p) -> None:
+    """The bag options of `planarvo track` on an argparse parser."""
+    for flag, keyword, text in BAG_OPTIONS:
+        p.add_argument(flag, dest=keyword, metavar="FILE" if keyword == "camera_yaml" else "TOPIC", help=text)
+    p.add_argument("--receive-time", dest="use_receive_time", action="store_true",
+                   help="bag: time messages by when they were recorded, not by their header stamps")
+
+
+def bag_options(args) -> Dict[str, Any]:
+    """planarvo.Dataset's keywords from the options add_bag_options added (those given only)."""
+    kw: Dict[str, Any] = {k: getattr(args, k) for _, k, _ in BAG_OPTIONS if getattr(args, k, None) is not None}
+    if getattr(args, "use_receive_time", False):
+        kw["use_receive_time"] = True
+    return kw
+
+
+def open_dataset(path: str, options: Optional[Dict[str, Any]] = None) -> planarvo.Dataset:
+    """planarvo.Dataset(path, **options); its errors as InputError naming the tool's options."""
     if not os.path.exists(path):
         raise InputError("the data set %s does not exist" % path)
     try:
-        ds = planarvo.Dataset(path)
+        return planarvo.Dataset(path, **(options or {}))
     except planarvo.Error as e:
-        raise InputError("cannot open the data set %s: %s" % (path, e.message)) from None
+        message = e.message
+        for flag, keyword, _ in BAG_OPTIONS:  # the library's words for the Python keywords, back to flags
+            message = message.replace(keyword + "=FILE", flag + " FILE").replace(keyword + "=", flag)
+        raise InputError("cannot open the data set %s: %s" % (path, message)) from None
+
+
+def read_dataset(path: str, options: Optional[Dict[str, Any]] = None) -> Series:
+    """Opens the data set (a folder, a bag or MCAP file; options: planarvo.Dataset's bag keywords)
+    and reads every frame's time and poses (not the images)."""
+    ds = open_dataset(path, options)
     with ds:
         info = ds.info
         n = info.frame_count

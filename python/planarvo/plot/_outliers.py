@@ -4,12 +4,12 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import List, Sequence
+from typing import Any, Dict, List, Optional, Sequence
 
 import numpy as np
 
 from ._errors import InputError
-from ._io import read_extrinsics
+from ._io import bag_options, open_dataset, read_extrinsics
 
 # Down-weighted pixels are drawn with alpha ALPHA_MIN + (1 - ALPHA_MIN) (1 - weight): those just
 # beyond the threshold faintly, the ones the norm all but ignores (|r| >> k) nearly opaque.
@@ -28,13 +28,15 @@ class FrameResiduals:
     residuals: object     # planarvo.Residuals
 
 
-def track_frame(dataset: str, extrinsics: str, frame: int, level: int) -> FrameResiduals:
-    """Tracks frames 0..frame of the data set with the extrinsics and returns frame's residuals
-    against its keyframe at `level`. Raises InputError for bad input or a frame without them."""
+def track_frame(dataset: str, extrinsics: str, frame: int, level: int,
+                options: Optional[Dict[str, Any]] = None) -> FrameResiduals:
+    """Tracks frames 0..frame of the data set (options: planarvo.Dataset's bag keywords) with the
+    extrinsics and returns frame's residuals against its keyframe at `level`. Raises InputError
+    for bad input or a frame without them."""
     import planarvo
     values = read_extrinsics(extrinsics).values
     try:
-        with planarvo.Context() as ctx, planarvo.Dataset(dataset) as ds:
+        with open_dataset(dataset, options) as ds, planarvo.Context() as ctx:
             if not 0 <= frame < len(ds):
                 raise InputError("--frame %d: the data set has frames 0..%d" % (frame, len(ds) - 1))
             with planarvo.Tracker(ctx, ds.info.camera, planarvo.Extrinsics(*map(float, values))) as tracker:
@@ -139,5 +141,5 @@ def plot_outliers(args) -> List[str]:
         raise InputError("--frame must be 1 or more (frame 0 is the first keyframe: nothing to compare with)")
     if args.level < 0:
         raise InputError("--level must be 0 or more")
-    fr = track_frame(args.dataset, args.extrinsics, args.frame, args.level)
+    fr = track_frame(args.dataset, args.extrinsics, args.frame, args.level, bag_options(args))
     return outliers_figure(fr, args.out_dir, formats)

@@ -123,19 +123,21 @@ def calibration_report(path: str, data: CalibrationData, extr: ExtrinsicsFile, t
 def full_report(args) -> List[str]:
     """`plot report`: the track figures (with --trajectory) and the calibration (with --extrinsics)."""
     from ._errors import InputError
+    from ._io import bag_options
     from ._track import plot_track
     if not args.trajectory and not args.extrinsics:
         raise InputError("give --trajectory, --extrinsics or both")
     body = []
     with tempfile.TemporaryDirectory() as tmp:
         if args.trajectory:
-            figs = plot_track(args.dataset, args.trajectory, args.stats, tmp, ["png"])
+            figs = plot_track(args.dataset, args.trajectory, args.stats, tmp, ["png"], bag_options(args))
             body.append("<h2>Tracking</h2><p>%s</p>%s" % (html.escape("%s, trajectory %s" % (args.dataset, args.trajectory)),
                                                           "\n".join(_img(f) for f in figs)))
         if args.extrinsics:
             from . import _calibration_figures as F
             from ._calibration_data import prepare
-            data, extr, truth, truth_path = prepare(args.dataset, None, args.extrinsics, args.truth, args.windows, None)
+            data, extr, truth, truth_path = prepare(args.dataset, None, args.extrinsics, args.truth, args.windows, None,
+                                                    bag_options(args))
             figs = F.estimates_figure(data, extr, truth, tmp, ["png"]) + F.residuals_figure(data, tmp, ["png"])
             inputs = {"extrinsics": args.extrinsics, "motion pairs": data.source, "truth": truth_path or "none"}
             body.append("<h2>Calibration</h2>" + calibration_section(data, extr, truth, inputs, figs))

@@ -3,7 +3,7 @@ with the local plane the body's roll against the yaw rate and its pitch over tim
 from __future__ import annotations
 
 import sys
-from typing import List, Optional, Sequence
+from typing import Any, Dict, List, Optional, Sequence
 
 import numpy as np
 
@@ -16,13 +16,18 @@ def _note(text: str) -> None:
     print("note: " + text, file=sys.stderr)
 
 
+def _bag_hint(series) -> str:
+    return " (a bag's odometry and ground truth need --odom-topic, --groundtruth-topic)" if series.is_bag else ""
+
+
 def plot_track(dataset: str, trajectory: str, stats: Optional[str], out_dir: str,
-               formats: Sequence[str]) -> List[str]:
-    """Writes the figures, returns their paths. Raises InputError for bad input."""
+               formats: Sequence[str], options: Optional[Dict[str, Any]] = None) -> List[str]:
+    """Writes the figures, returns their paths (options: planarvo.Dataset's bag keywords, as the
+    track that wrote the trajectory was given). Raises InputError for bad input."""
     from . import _trajectory, _velocity  # noqa: F401  (matplotlib only once the input is read)
     traj = read_tum(trajectory)
     st = read_stats(stats) if stats else None
-    series = read_dataset(dataset)
+    series = read_dataset(dataset, options)
     frames = match_frames(traj, series)
     times = series.times[frames]
     if np.any(np.diff(times) <= 0):  # two poses matched to one frame
@@ -47,9 +52,9 @@ def plot_track(dataset: str, trajectory: str, stats: Optional[str], out_dir: str
     elif len(traj.stamps) < 2:
         _note("the trajectory %s has one pose: no velocities to plot" % trajectory)
     else:
-        _note("no ground truth and no odometry in %s: velocity left out" % dataset)
+        _note("no ground truth and no odometry in %s: velocity left out%s" % (dataset, _bag_hint(series)))
     if series.groundtruth is None:
-        _note("no ground truth in %s: velocity_hist left out" % dataset)
+        _note("no ground truth in %s: velocity_hist left out%s" % (dataset, _bag_hint(series)))
     elif len(traj.stamps) > 2:
         written += _velocity.velocity_hist_figure(est, velocities(times, series.groundtruth[frames]), out_dir, formats)
     if st is not None:

@@ -32,6 +32,7 @@ def _hist_panel(fig, ax, true: np.ndarray, est: np.ndarray, unit: str, name: str
     lo, hi = float(min(x.min(), y.min())), float(max(x.max(), y.max()))
     pad = 0.05 * (hi - lo) if hi > lo else 0.1
     lim = (lo - pad, hi + pad)
+    ax.grid(False)  # the style's grid under a pcolormesh (matplotlib deprecates removing it there)
     _, _, _, img = ax.hist2d(x, y, bins=70, range=[lim, lim], cmap="viridis", norm=LogNorm(), cmin=1)
     fig.colorbar(img, ax=ax, label="intervals", fraction=0.046, pad=0.04)
     ax.plot(lim, lim, color="black", ls=":", lw=1.2, label="y = x", zorder=3)
