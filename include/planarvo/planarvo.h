@@ -209,6 +209,10 @@ typedef struct planarvo_device_info {
   uint64_t global_mem_size;
   uint64_t max_work_group_size;
   uint32_t compute_units;
+  /* 1 when the driver keeps the kernels it compiles in a persistent cache of its own (PoCL's
+   * kcache, unless POCL_KERNEL_CACHE=0): planarvo's program cache is then off unless a directory
+   * is chosen (planarvo_context_options.cache_dir). Read only when struct_size covers it. */
+  int32_t driver_caches_kernels;
 } planarvo_device_info;
 
 /* Lists every OpenCL device. Call with devices = NULL to get the count; then with an array of
@@ -229,11 +233,13 @@ typedef struct planarvo_context_options {
    * else the first device. A number selects by index (planarvo_list_devices), anything else is a
    * case-insensitive substring of "platform name / device name". */
   const char* device;
-  /* Directory of the on-disk kernel program cache. NULL: $PLANARVO_CACHE_DIR, else
-   * $XDG_CACHE_HOME/planarvo, else ~/.cache/planarvo; when that cannot be created or written
-   * (a service user with no home), $TMPDIR/planarvo-<uid>/programs (a directory only this user
-   * can write), else none: kernels are then compiled every time (planarvo_context_cache_dir
-   * returns ""). */
+  /* Directory of the on-disk kernel program cache. NULL: $PLANARVO_CACHE_DIR, else none when
+   * the driver caches compiled kernels itself (planarvo_device_info.driver_caches_kernels: PoCL,
+   * whose own cache serves later runs, and for which writing ours would cost a first run a
+   * second compile of every program), else $XDG_CACHE_HOME/planarvo, else ~/.cache/planarvo;
+   * when that cannot be created or written (a service user with no home),
+   * $TMPDIR/planarvo-<uid>/programs (a directory only this user can write), else none: kernels
+   * are then compiled every time (planarvo_context_cache_dir returns ""). */
   const char* cache_dir;
   int32_t disable_cache; /* non-zero: always compile from source */
   /* Directory of prebuilt program binaries (planarvo_context_export_kernels). When set, the
@@ -258,7 +264,8 @@ PLANARVO_API void planarvo_context_destroy(planarvo_context* context);
 PLANARVO_API planarvo_status planarvo_context_device(const planarvo_context* context,
                                                      planarvo_device_info* info);
 /* The directory of the context's kernel program cache, valid until the context is destroyed;
- * "" when the cache is off: disable_cache, or no usable default location (see cache_dir). With
+ * "" when the cache is off: disable_cache, a driver that caches kernels itself, or no usable
+ * default location (see cache_dir). With
  * kernel_binaries_dir set the cache is not used whatever this says. "" for a NULL context. */
 PLANARVO_API const char* planarvo_context_cache_dir(const planarvo_context* context);
 /* Builds every kernel program variant that the library's calls use with their default options

@@ -34,6 +34,7 @@ class DeviceInfo:
     global_mem_size: int
     max_work_group_size: int
     compute_units: int
+    driver_caches_kernels: bool  # the driver keeps compiled kernels itself (PoCL): no program cache by default
 
     @classmethod
     def _from_c(cls, d: N.DeviceInfo) -> "DeviceInfo":

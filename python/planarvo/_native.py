@@ -62,7 +62,8 @@ class DeviceInfo(ctypes.Structure):
                 ("device_version", ctypes.c_char * 128), ("opencl_c_version", ctypes.c_char * 64),
                 ("driver_version", ctypes.c_char * 64), ("image_support", c_int32), ("fp64", c_int32),
                 ("local_mem_size", c_uint64), ("global_mem_size", c_uint64),
-                ("max_work_group_size", c_uint64), ("compute_units", c_uint32)]
+                ("max_work_group_size", c_uint64), ("compute_units", c_uint32),
+                ("driver_caches_kernels", c_int32)]
 
 
 class ContextOptions(ctypes.Structure):

@@ -76,6 +76,7 @@ int cmd_devices(int argc, char** argv) {
                 d.image_support ? "yes" : "no", d.fp64 ? "yes" : "no", bytes(d.local_mem_size).c_str(),
                 bytes(d.global_mem_size).c_str(), static_cast<unsigned long long>(d.max_work_group_size),
                 d.compute_units);
+    if (d.driver_caches_kernels) std::printf("   compiled kernels cached by the driver itself\n");
   }
   return kExitOk;
 }

@@ -49,7 +49,10 @@ ContextPtr make_context(const Args& args) {
   check(planarvo_context_create(&o, &c));
   // The library stays silent about a cache it could not place (a service user with no home
   // and no usable temp directory); the tool says so once, since every run then compiles.
-  if (!o.disable_cache && !o.kernel_binaries_dir && !*planarvo_context_cache_dir(c))
+  planarvo_device_info chosen{};
+  chosen.struct_size = sizeof chosen;
+  check(planarvo_context_device(c, &chosen));
+  if (!o.disable_cache && !o.kernel_binaries_dir && !*planarvo_context_cache_dir(c) && !chosen.driver_caches_kernels)
     std::fprintf(stderr, "planarvo: note: no writable directory for the kernel program cache (HOME, "
                          "XDG_CACHE_HOME, temp directory), so kernels are compiled on every run; set "
                          "PLANARVO_CACHE_DIR or --cache-dir, or --no-cache to silence this\n");

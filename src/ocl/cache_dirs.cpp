@@ -3,6 +3,7 @@
 
 #include <cerrno>
 #include <cstdlib>
+#include <string>
 #include <system_error>
 
 #include <sys/stat.h>
@@ -59,6 +60,12 @@ fs::path private_temp_dir() {
       (st.st_mode & (S_IWGRP | S_IWOTH)) != 0 || ::access(dir.c_str(), W_OK | X_OK) != 0)
     return {};
   return dir;
+}
+
+bool driver_caches_kernels(const std::string& platform_name) {
+  if (platform_name != "Portable Computing Language") return false;
+  const char* off = std::getenv("POCL_KERNEL_CACHE");
+  return !(off && std::string(off) == "0");
 }
 
 const std::string& prepare_driver_environment() {

@@ -24,6 +24,15 @@ std::filesystem::path user_cache_dir(const std::string& app);
 // user could then plant binaries in it.
 std::filesystem::path private_temp_dir();
 
+// Whether the driver keeps the kernels it compiles in a persistent cache of its own, keyed by the
+// program's source and build options, so that a later run does not compile them again: PoCL
+// (its kcache), unless POCL_KERNEL_CACHE=0 turns that off. The engine's program cache is then off
+// unless a directory was chosen (RuntimeOptions::cache_dir, PLANARVO_CACHE_DIR): it would add
+// nothing to the driver's, and writing an entry costs PoCL a compile of every kernel of the
+// program for a generic work-group size (CL_PROGRAM_BINARIES), measured at about 5 s over the
+// tracker's and the calibration's programs on a first run.
+bool driver_caches_kernels(const std::string& platform_name);
+
 // Called before the first OpenCL platform query. When POCL_CACHE_DIR is not set and the
 // directory PoCL would otherwise use is not usable, sets POCL_CACHE_DIR to
 // private_temp_dir()/pocl. (PoCL 3.1 fails to initialise its device when it cannot create its

@@ -250,7 +250,10 @@ Runtime::Runtime(const RuntimeOptions& options) : options_(options) {
     throw Error(ErrorCode::NoDevice, "could not create an OpenCL context on " + info_.device_name +
                                          ": " + e.what() + " " + error_name(e.err()));
   }
-  cache_dir_ = detail::resolve_cache_dir(options_);
+  // A driver with a kernel cache of its own needs none of ours, unless a directory was chosen.
+  const char* env_dir = std::getenv("PLANARVO_CACHE_DIR");
+  const bool dir_chosen = !options_.cache_dir.empty() || (env_dir && *env_dir);
+  cache_dir_ = !dir_chosen && detail::driver_caches_kernels(info_.platform_name) ? "" : detail::resolve_cache_dir(options_);
 }
 
 Runtime::~Runtime() = default;

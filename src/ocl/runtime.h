@@ -39,8 +39,9 @@ struct RuntimeOptions {
   // platform version" (the platform version is where e.g. "PoCL" or "CUDA" shows). When
   // empty, the environment variable PLANARVO_DEVICE is used.
   std::string device;
-  // On-disk program cache; "" means $PLANARVO_CACHE_DIR, else $XDG_CACHE_HOME/planarvo, else
-  // ~/.cache/planarvo, and when that cannot be created or written (a service user with no
+  // On-disk program cache; "" means $PLANARVO_CACHE_DIR, else none on a driver that caches
+  // compiled kernels itself (PoCL: detail::driver_caches_kernels), else $XDG_CACHE_HOME/planarvo,
+  // else ~/.cache/planarvo, and when that cannot be created or written (a service user with no
   // home), <temp>/planarvo-<uid>/programs (cache_dirs.h), else none. Set use_cache = false to
   // always build from source. A cache directory that cannot be created or written is not an
   // error: programs are then simply not cached.

@@ -12,6 +12,7 @@
 #include <unistd.h>
 
 #include "common/test_util.h"
+#include "planarvo/planarvo.h"
 
 namespace planarvo {
 namespace {
@@ -34,6 +35,15 @@ void expect_only_owner_can_enter(const fs::path& dir) {
   ASSERT_EQ(::lstat(dir.c_str(), &st), 0) << dir;
   EXPECT_TRUE(S_ISDIR(st.st_mode)) << dir;
   EXPECT_EQ(st.st_mode & 0777, 0700u) << dir;
+}
+
+// Whether the first device's driver keeps compiled kernels itself (PoCL; then the engine keeps
+// no program cache unless told where).
+bool driver_caches_kernels() {
+  planarvo_device_info d{};
+  d.struct_size = sizeof d;
+  size_t n = 1;
+  return planarvo_list_devices(&d, 1, &n) == PLANARVO_OK && n >= 1 && d.driver_caches_kernels != 0;
 }
 
 bool has_file_with_extension(const fs::path& dir, const std::string& ext) {
@@ -70,7 +80,8 @@ TEST(CliNoHome, DevicesWithAHomeThatCannotBeWritten) {
 TEST(CliNoHome, SimulateAndTrack) {
   ScratchDir d;
   fs::create_directories(d / "tmp");
-  const std::string env = kNoHome + in_temp(d / "tmp");
+  // POCL_KERNEL_CACHE=0: PoCL keeps no kernel cache of its own, so the engine needs its program cache.
+  const std::string env = kNoHome + "POCL_KERNEL_CACHE=0 " + in_temp(d / "tmp");
   auto r = run_cli("simulate --quiet --out \"" + (d / "seq").string() +
                        "\" --seconds 0.5 --width 160 --height 120",
                    env);
@@ -85,6 +96,15 @@ TEST(CliNoHome, SimulateAndTrack) {
   // The program cache found a home too, so the tool had nothing to say about it.
   EXPECT_TRUE(has_file_with_extension(private_dir(d / "tmp") / "programs", ".clbin")) << r.output;
   EXPECT_EQ(r.output.find("note:"), std::string::npos) << r.output;
+
+  // With PoCL's own cache on, the engine keeps none (the driver's serves later runs) and says nothing.
+  fs::create_directories(d / "tmp2");
+  r = run_cli("track --quiet \"" + (d / "seq").string() + "\" --extrinsics \"" +
+                  (d / "seq" / "extrinsics_gt.yaml").string() + "\"",
+              kNoHome + in_temp(d / "tmp2"));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_EQ(fs::exists(private_dir(d / "tmp2") / "programs"), !driver_caches_kernels()) << r.output;
+  EXPECT_EQ(r.output.find("note:"), std::string::npos) << r.output;
 }
 
 // No home and no usable temp directory: the program cache is off and the tool says so on one
@@ -92,7 +112,8 @@ TEST(CliNoHome, SimulateAndTrack) {
 TEST(CliNoHome, NoPlaceForTheCacheIsANote) {
   ScratchDir d;
   std::ofstream(d / "tmp") << "not a directory\n";
-  const std::string env = "-u HOME -u XDG_CACHE_HOME -u PLANARVO_CACHE_DIR POCL_CACHE_DIR=\"" +
+  // POCL_KERNEL_CACHE=0: a driver without a kernel cache of its own, for which the engine's matters.
+  const std::string env = "-u HOME -u XDG_CACHE_HOME -u PLANARVO_CACHE_DIR POCL_KERNEL_CACHE=0 POCL_CACHE_DIR=\"" +
                           (d / "pocl").string() + "\" " + in_temp(d / "tmp");
   const std::string simulate = "simulate --quiet --seconds 0.2 --width 96 --height 64 --out ";
   auto r = run_cli(simulate + "\"" + (d / "seq").string() + "\"", env);

@@ -187,13 +187,34 @@ TEST(OclCache, DirectoryComesFromOptionsThenEnvironment) {
   EXPECT_EQ(ocl::Runtime().cache_dir(), from_env);
   EXPECT_EQ(ocl::Runtime(cached_in(scratch / "opt")).cache_dir(), (scratch / "opt").string());
   {
+    // Nothing chosen: none on a driver that caches compiled kernels itself (PoCL), else the
+    // user's cache directory.
     test::ScopedEnv no_env("PLANARVO_CACHE_DIR", nullptr);
     test::ScopedEnv xdg("XDG_CACHE_HOME", (scratch / "xdg").string().c_str());
-    EXPECT_EQ(ocl::Runtime().cache_dir(), (scratch / "xdg" / "planarvo").string());
+    const bool own = ocl::detail::driver_caches_kernels(ocl::Runtime().device_info().platform_name);
+    EXPECT_EQ(ocl::Runtime().cache_dir(), own ? "" : (scratch / "xdg" / "planarvo").string());
     test::ScopedEnv no_xdg("XDG_CACHE_HOME", nullptr);
     test::ScopedEnv home("HOME", (scratch / "home").string().c_str());
-    EXPECT_EQ(ocl::Runtime().cache_dir(), (scratch / "home" / ".cache" / "planarvo").string());
+    EXPECT_EQ(ocl::Runtime().cache_dir(), own ? "" : (scratch / "home" / ".cache" / "planarvo").string());
+    // A chosen directory is used whatever the driver.
+    EXPECT_EQ(ocl::Runtime(cached_in(scratch / "opt")).cache_dir(), (scratch / "opt").string());
   }
+}
+
+// Which drivers cache compiled kernels themselves: PoCL, unless POCL_KERNEL_CACHE=0 turns its
+// cache off (then the engine's is the only one).
+TEST(OclCache, PoclKeepsItsOwnKernelCache) {
+  ocl::Runtime first;  // the driver initialised before POCL_KERNEL_CACHE changes (PoCL reads it then)
+  test::ScopedEnv on("POCL_KERNEL_CACHE", nullptr);
+  EXPECT_TRUE(ocl::detail::driver_caches_kernels("Portable Computing Language"));
+  EXPECT_FALSE(ocl::detail::driver_caches_kernels("NVIDIA CUDA"));
+  EXPECT_FALSE(ocl::detail::driver_caches_kernels("Intel(R) OpenCL"));
+  test::ScopedEnv off("POCL_KERNEL_CACHE", "0");
+  EXPECT_FALSE(ocl::detail::driver_caches_kernels("Portable Computing Language"));
+  test::ScopedEnv no_env("PLANARVO_CACHE_DIR", nullptr);
+  test::ScratchDir scratch;
+  test::ScopedEnv xdg("XDG_CACHE_HOME", scratch.path().string().c_str());
+  EXPECT_EQ(ocl::Runtime().cache_dir(), (scratch / "planarvo").string());
 }
 
 TEST(OclCache, CacheDirUsableWhenItIsOrCanBeAWritableDirectory) {

@@ -8,6 +8,7 @@
 #include "capi/handles.h"
 #include "capi/status.h"
 #include "core/error.h"
+#include "ocl/cache_dirs.h"
 #include "ocl/runtime.h"
 
 using planarvo::capi::guard;
@@ -33,6 +34,7 @@ void fill_info(const planarvo::ocl::DeviceInfo& d, planarvo_device_info* out) {
   info.global_mem_size = d.global_mem_size;
   info.max_work_group_size = d.max_work_group_size;
   info.compute_units = d.compute_units;
+  info.driver_caches_kernels = planarvo::ocl::detail::driver_caches_kernels(d.platform_name) ? 1 : 0;
   // Copy only as much as the caller's struct holds (an older, shorter struct stays valid).
   std::memcpy(out, &info, std::min(struct_size, sizeof info));
 }
