@@ -79,8 +79,14 @@ void LiveCalibration::feed(Frame& f, bool final) {
       ROS_WARN_THROTTLE(5, "planarvo_node: calibration: odometry left out: %s", planarvo_last_error());
       continue;
     }
-    if (first_given_ns_ < 0) first_given_ns_ = p.ns;
+    if (first_given_ns_ < 0) {
+      first_given_ns_ = p.ns;
+    } else {
+      travelled_ += std::hypot(p.pose.x - last_given_.x, p.pose.y - last_given_.y);
+      turned_ += std::abs(std::remainder(p.pose.theta - last_given_.theta, 2 * M_PI));
+    }
     last_given_ns_ = p.ns;
+    last_given_ = p.pose;
   }
   const bool has = first_given_ns_ >= 0 && first_given_ns_ <= f.ns && f.ns <= last_given_ns_;
   if (!has && !warned_no_odometry_) {

@@ -38,6 +38,10 @@ class LiveCalibration {
   const planarvo_extrinsics& extrinsics() const { return result_.extrinsics; }
   int64_t frames_fed() const { return fed_; }
   int64_t frames_with_odometry() const { return with_odometry_; }
+  // The wheel odometry's motion handed to the calibrator so far: the path's length (m) and the
+  // sum of the absolute turns (rad) between consecutive samples.
+  double odometry_travelled() const { return travelled_; }
+  double odometry_turned() const { return turned_; }
 
  private:
   struct Frame {
@@ -61,6 +65,8 @@ class LiveCalibration {
   int64_t origin_ns_ = 0;      // the stamp of t = 0 (the first frame's)
   bool has_origin_ = false;
   int64_t first_given_ns_ = -1, last_given_ns_ = -1;  // the odometry handed to the calibrator
+  planarvo_se2 last_given_{};
+  double travelled_ = 0, turned_ = 0;
   std::deque<Frame> waiting_;
   int64_t fed_ = 0, with_odometry_ = 0;
   double last_t_ = -1;

@@ -10,6 +10,7 @@
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
+#include <cmath>
 #include <csignal>
 #include <cstdio>
 #include <deque>
@@ -363,13 +364,17 @@ class Node {
         now - last_progress_ >= std::chrono::seconds(5)) {
       last_progress_ = now;
       progress_fed_ = calibration_->frames_fed();
+      const double metres = calibration_->odometry_travelled(), degrees = calibration_->odometry_turned() * 180 / M_PI;
       if (params_.calibration_frames > 0)
-        ROS_INFO("planarvo_node: calibration: %lld of %d frames (%lld with odometry)",
+        ROS_INFO("planarvo_node: calibration: %lld of %d frames (%lld with odometry); odometry so far %.3f m, "
+                 "%.1f deg turned",
                  static_cast<long long>(progress_fed_), params_.calibration_frames,
-                 static_cast<long long>(calibration_->frames_with_odometry()));
+                 static_cast<long long>(calibration_->frames_with_odometry()), metres, degrees);
       else
-        ROS_INFO("planarvo_node: calibration: %lld frames so far (%lld with odometry); it finishes at shutdown",
-                 static_cast<long long>(progress_fed_), static_cast<long long>(calibration_->frames_with_odometry()));
+        ROS_INFO("planarvo_node: calibration: %lld frames so far (%lld with odometry); odometry so far %.3f m, "
+                 "%.1f deg turned; it finishes at shutdown",
+                 static_cast<long long>(progress_fed_), static_cast<long long>(calibration_->frames_with_odometry()),
+                 metres, degrees);
     }
   }
 

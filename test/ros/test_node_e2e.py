@@ -453,3 +453,46 @@ def test_a_wrong_image_topic_is_warned_within_5_s_naming_the_published_ones(ros_
     line = next(l for l in log_path.read_text().splitlines() if "no image on /wrong/image_raw" in l)
     assert "/camera/image_raw (sensor_msgs/Image)" in line, line
     assert warned - ready < 5.0 * SLOW, warned - ready
+
+
+def test_live_calibration_reports_its_progress_every_5_s(ros_env, drive, tmp_path):
+    """The drive at half its rate (12 s) into a calibration of 170 frames: while it takes frames, an
+    INFO every 5 s with the frames fed of those needed, how many had odometry, and the odometry's
+    motion so far, each figure consistent with the one before and with the bag's own odometry."""
+    dataset, bag = drive[:2]
+    name = "planarvo_node_progress"
+    log_path = tmp_path / "node.log"
+    node = start_node(ros_env, name, {"calibrate": "true", "calibration_output": str(tmp_path / "c.yaml"),
+                                      "calibration_frames": "170"}, log_path)
+    try:
+        play(bag, "-r", "0.5", topics=("/camera/image_raw", "/camera/camera_info", "/odom"))
+        wait_for("the calibration", lambda: (tmp_path / "c.yaml").exists(), 60)
+    finally:
+        rc = stop(node)
+    log = log_path.read_text()
+    assert rc == 0, log
+    import re
+    pattern = re.compile(r"\[(\d+\.\d+)\]: planarvo_node: calibration: (\d+) of 170 frames \((\d+) with odometry\); "
+                         r"odometry so far (\S+) m, (\S+) deg turned")
+    lines = [m.groups() for m in map(pattern.search, log.splitlines()) if m]
+    assert len(lines) >= 1, log
+    # The bag's odometry path: its length and its absolute turns (odometry.txt, TUM: t x y z qx qy qz qw).
+    poses = []
+    with open(os.path.join(dataset, "odometry.txt")) as f:
+        for line in f:
+            if line.strip() and not line.startswith("#"):
+                v = [float(x) for x in line.split()]
+                poses.append((v[1], v[2], 2 * math.atan2(v[6], v[7])))
+    length = sum(math.hypot(b[0] - a[0], b[1] - a[1]) for a, b in zip(poses, poses[1:]))
+    turned = sum(abs(math.remainder(b[2] - a[2], 2 * math.pi)) for a, b in zip(poses, poses[1:]))
+    print(lines, length, math.degrees(turned))
+    previous = None
+    for stamp, fed, with_odometry, metres, degrees in lines:
+        stamp, fed, with_odometry, metres, degrees = float(stamp), int(fed), int(with_odometry), float(metres), float(degrees)
+        assert 0 < fed < 170 and 0 <= with_odometry <= fed
+        assert 0 <= metres <= length + 1e-3 and 0 <= degrees <= math.degrees(turned) + 0.05
+        if previous:
+            assert stamp - previous[0] >= 5.0 - 0.01  # every 5 s, no more often
+            assert fed > previous[1] and metres >= previous[2] and degrees >= previous[3]
+        previous = (stamp, fed, metres, degrees)
+    assert previous[2] > 0, "the odometry played, so it moved"
