@@ -392,9 +392,12 @@ PLANARVO_API planarvo_status planarvo_camera_calibration_save(const char* path,
                                                               const char* notes);
 
 /* The stages on their own. Motions from a data set: tracks every frame with the given extrinsics
- * (for the graph calibration of a camera: x = y = 0, z = 1, yaw = 0 and its roll and pitch) and
- * writes one motion pair per tracked interval (lost ones left out): the tracker's motion with its
- * covariance as the sensor's, the data set's odometry and direction label where it has them.
+ * (the camera's roll and pitch matter; the graph calibration tracks with x = y = 0, z = 1, yaw = 0)
+ * and writes one motion pair per tracked interval (lost ones left out): as the sensor's, the
+ * camera's own motion (planarvo_sensor_motion of the tracked robot motion and its covariance,
+ * which is the tracked motion itself at x = y = 0, z = 1, yaw = 0), so that the pairs calibrate
+ * correctly whatever extrinsics tracked them, as track --motions-out writes them; the data set's
+ * odometry and direction label where it has them.
  * capacity must be at least the frame count - 1; *count receives the pairs written (each with
  * struct_size = sizeof(planarvo_motion_pair)). options may be NULL. */
 PLANARVO_API planarvo_status planarvo_track_motions(planarvo_context* context, planarvo_dataset* dataset,

@@ -89,11 +89,17 @@ def test_graph_calibration_from_motion_pairs(context, calibration_drive, tmp_pat
     with planarvo.Dataset(calibration_drive) as ds:
         truth = ds.info.extrinsics_gt
         pairs = planarvo.track_motions(context, ds, planarvo.Extrinsics(z=1.0, roll=truth.roll, pitch=truth.pitch))
+        # Tracked with the true extrinsics instead: the same calibration (issue 25: the pairs are
+        # the camera's own motions whatever extrinsics tracked them).
+        true_pairs = planarvo.track_motions(context, ds, truth)
     result = planarvo.calibrate(pairs)
     assert result.ok and all(result.estimated)
     expected = np.array([truth.x, truth.y, truth.z, truth.yaw])
     sigma = np.sqrt(np.diag(result.covariance))
     assert np.all(np.abs(result.value - expected) < 5 * sigma + 1e-4), (result.value - expected, sigma)
+    again = planarvo.calibrate(true_pairs)
+    assert again.ok
+    assert np.all(np.abs(again.value - result.value) < 0.1 * sigma), (again.value - result.value, sigma)
     # Composed with the true roll and pitch: the graph's x, y, height and yaw, roll and pitch as given.
     rp_cov = np.diag([1e-6, 2e-6])
     e, cov, estimated = planarvo.compose_extrinsics(truth.roll, truth.pitch, rp_cov, result)

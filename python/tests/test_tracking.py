@@ -65,14 +65,37 @@ def test_matches_cli(tracked, drive, tmp_path):
     np.testing.assert_allclose([p.sensor.as_array() for p in loaded], cli_motions, rtol=0, atol=1e-15)
 
 
+def _camera_motions(e, robot_motions):
+    """The camera's own motion (docs/conventions.md): T^-1 M T with T = (x, y, yaw) of the
+    extrinsics, in units of the height; computed here, independently of the library."""
+    def hom(x, y, t):
+        return np.array([[np.cos(t), -np.sin(t), x], [np.sin(t), np.cos(t), y], [0.0, 0.0, 1.0]])
+    T = hom(e.x, e.y, e.yaw)
+    out = []
+    for m in robot_motions:
+        c = np.linalg.inv(T) @ hom(*m) @ T
+        out.append((c[0, 2] / e.z, c[1, 2] / e.z, np.arctan2(c[1, 0], c[0, 0])))
+    return np.array(out)
+
+
 def test_track_motions_matches_tracker(context, drive, tracked):
+    """track_motions' pairs hold the camera's own motion, whatever extrinsics tracked it (issue 25:
+    pairs that calibrate correctly); at x = y = 0, z = 1, yaw = 0 that is the tracker's motion."""
     _, _, _, results = tracked
     with planarvo.Dataset(drive) as ds:
-        pairs = planarvo.track_motions(context, ds, ds.info.extrinsics_gt)
+        e = ds.info.extrinsics_gt
+        pairs = planarvo.track_motions(context, ds, e)
+        neutral = planarvo.Extrinsics(z=1.0, roll=e.roll, pitch=e.pitch)
+        neutral_pairs = planarvo.track_motions(context, ds, neutral)
+        camera = ds.info.camera
     assert len(pairs) == len(results) - 1
-    np.testing.assert_allclose([p.sensor.as_array() for p in pairs], [r.motion.as_array() for r in results[1:]],
+    np.testing.assert_allclose([p.sensor.as_array() for p in pairs],
+                               _camera_motions(e, [r.motion.as_array() for r in results[1:]]), rtol=0, atol=1e-12)
+    with planarvo.Tracker(context, camera, neutral) as tracker, planarvo.Dataset(drive) as ds:
+        mine = [tracker.track(ds.frame(i), ds.frame_data(i).timestamp) for i in range(len(ds))]
+    np.testing.assert_allclose([p.sensor.as_array() for p in neutral_pairs], [r.motion.as_array() for r in mine[1:]],
                                rtol=0, atol=1e-12)
-    np.testing.assert_allclose(pairs[-1].sensor_covariance, results[-1].covariance, rtol=1e-12, atol=0)
+    np.testing.assert_allclose(neutral_pairs[-1].sensor_covariance, mine[-1].covariance, rtol=1e-12, atol=0)
 
 
 def test_against_ground_truth(tracked):

@@ -15,6 +15,7 @@
 #include "capi/status.h"
 #include "capi/track_convert.h"
 #include "core/error.h"
+#include "core/sensor_motion.h"
 #include "track/roll_pitch.h"
 
 using planarvo::capi::guard;
@@ -376,13 +377,17 @@ PLANARVO_API planarvo_status planarvo_track_motions(planarvo_context* context, p
     if (capacity + 1 < n)
       throw planarvo::capi::BufferTooSmall("planarvo_track_motions: " + std::to_string(n) + " frames need capacity " +
                                            std::to_string(n - 1) + ", not " + std::to_string(capacity));
+    const planarvo::Extrinsics e = planarvo::capi::to_cpp(*extrinsics);
     const std::vector<planarvo::graph::MotionSample> samples = planarvo::calib::track_motions(
-        *context->runtime, ds, planarvo::capi::to_cpp(*extrinsics), planarvo::capi::tracker_options_from_c(options));
+        *context->runtime, ds, e, planarvo::capi::tracker_options_from_c(options));
     for (const planarvo::graph::MotionSample& s : samples) {
       planarvo_motion_pair p;
       planarvo_motion_pair_init(&p);
       p.interval = s.interval;
-      planarvo::capi::motion_to_c(s.sensor, &p.sensor, &p.has_sensor_covariance, p.sensor_covariance);
+      // The camera's own motion, whatever extrinsics tracked it (the tracked motion itself at
+      // x = y = 0, z = 1, yaw = 0): pairs that calibrate correctly, as track --motions-out writes.
+      planarvo::capi::motion_to_c(planarvo::sensor_motion(e, s.sensor), &p.sensor, &p.has_sensor_covariance,
+                                  p.sensor_covariance);
       p.has_odometry = s.odometry.has_value();
       if (s.odometry) planarvo::capi::motion_to_c(*s.odometry, &p.odometry, &p.has_odometry_covariance, p.odometry_covariance);
       p.has_direction = s.direction.has_value();
