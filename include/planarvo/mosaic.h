@@ -35,6 +35,11 @@ typedef struct planarvo_mosaic_options {
                              default 20000 */
   planarvo_progress_fn progress;
   void* progress_user_data;
+  /* Extrinsics outside the plausible ranges of a camera on a vehicle (|x|, |y| <= 20 m, 0 < z <=
+   * 5 m, angles within 2 pi; millimetres or degrees by mistake) are PLANARVO_ERROR_INVALID_ARGUMENT
+   * naming the likely mistake unless this is non-zero; default 0. Read only when struct_size
+   * covers it. */
+  int32_t accept_unusual_extrinsics;
 } planarvo_mosaic_options;
 
 typedef struct planarvo_mosaic_info {

@@ -54,7 +54,7 @@ std::vector<OptionSpec> calibrate_options(const planarvo_calibration_options& o)
       {"method", "KIND", "odometry | nonholonomic", "odometry"},
       {"fix-scale", "", "a metric sensor (e.g. a laser scan matcher): scale 1, z written as 0", ""},
       {"height", "METRES", "the camera height is known: hold the scale at it", ""},
-      {"force", "", "accept extrinsics outside the plausible ranges (an offset over 20 m, a height over 5 m, an angle over a turn): an unusual rig, not a unit mistake", ""},
+      force_option(),
       {"initial", "x,y,scale,yaw", "start here (metres, degrees) instead of the built-in initialisation", ""},
       {"velocity-form", "", "nonholonomic: the paper's velocity form instead of the exact arc form", ""},
       {"sensor-sigma", "REL,FLOOR,THETA_DEG", "noise of the sensor's motions: relative part (per unit of travel and "

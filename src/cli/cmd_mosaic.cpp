@@ -47,6 +47,7 @@ int cmd_mosaic(int argc, char** argv) {
       {"every-frame", "", "use every frame of the trajectory", ""},
       {"no-gain", "", "no per-frame brightness correction", ""},
       readout_option(),
+      force_option(),
       {"quiet", "", "no progress bar", ""},
       {"help", "", "show this help", ""}};
   for (auto& b : bag_options()) specs.push_back(b);
@@ -85,6 +86,7 @@ int cmd_mosaic(int argc, char** argv) {
   o.frame_spacing = args.has("every-frame") ? -1.0 : args.get_double("frame-spacing", 0.0);
   if (!(o.frame_spacing >= -1.0) || !std::isfinite(o.frame_spacing)) throw UsageError("--frame-spacing must be positive");
   o.estimate_gain = args.has("no-gain") ? 0 : 1;
+  o.accept_unusual_extrinsics = args.has("force") ? 1 : 0;
   const std::optional<double> readout = parse_readout(args);
   const planarvo_extrinsics e = extrinsics_for(args, dir);
   ContextPtr ctx = make_context(args);

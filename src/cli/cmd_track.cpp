@@ -410,7 +410,7 @@ std::vector<OptionSpec> track_options() {
                              "of the camera's size (as DSO's vignette.png; --save-flat-field writes one)", ""},
       {"save-flat-field", "FILE", "after tracking, write the photometric model in use (learnt, or --flat-field's) as "
                                   "a 16-bit flat-field PNG for --flat-field (a warning when none was learnt)", ""},
-      {"force", "", "accept extrinsics outside the plausible ranges (an offset over 20 m, a height over 5 m, an angle over a turn): an unusual rig, not a unit mistake", ""},
+      force_option(),
       {"local-plane", "", "estimate the body's roll and pitch relative to the local ground plane with every frame's "
                           "motion (a car whose body leans in turns and pitches over bumps; the extrinsics are the "
                           "camera's mounting on the body at rest)", "off: a rigid body"},

@@ -89,6 +89,11 @@ void apply_roi(const std::optional<planarvo_region>& roi, planarvo_dataset* data
   if (roi) check(planarvo_dataset_set_roi(dataset, &*roi));
 }
 
+OptionSpec force_option() {
+  return {"force", "", "accept extrinsics outside the plausible ranges (an offset over 20 m, a height over 5 m, an "
+                       "angle over a turn): an unusual rig, not a unit mistake", ""};
+}
+
 OptionSpec readout_option() {
   return {"readout-time", "SECONDS", "rolling shutter: seconds from the first row's read to the last's (0: a global "
                                      "shutter); overrides the camera file's rolling_shutter_readout", "camera.yaml's, else 0"};

@@ -66,6 +66,8 @@ void apply_roi(const std::optional<planarvo_region>& roi, planarvo_dataset* data
 // --readout-time SECONDS: the camera's rolling-shutter readout, overriding camera.yaml's
 // rolling_shutter_readout (0: a global shutter).
 OptionSpec readout_option();
+// --force: extrinsics outside the plausible ranges let through (accept_unusual_extrinsics).
+OptionSpec force_option();
 // The value when given: UsageError unless a finite number >= 0 (the data set checks it against
 // the frame interval in apply_readout, naming the option).
 std::optional<double> parse_readout(const Args& args);

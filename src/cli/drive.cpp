@@ -39,7 +39,7 @@ std::vector<OptionSpec> simulate_options() {
       {"seconds", "S", "duration", "10"},
       {"fps", "F", "frame rate", "30"},
       {"seed", "N", "random seed (same seed, same data set)", "1"},
-      {"force", "", "accept extrinsics outside the plausible ranges (an offset over 20 m, a height over 5 m, an angle over a turn): an unusual rig, not a unit mistake", ""},
+      force_option(),
       {"motion", "KIND", "mixed | straight | circle | spin | car", "mixed"},
       {"min-turn-radius", "M", "car: the tightest turn, metres (0: limited by --max-turn-rate only)", "0"},
       {"max-speed", "M/S", "peak linear speed", "0.8"},

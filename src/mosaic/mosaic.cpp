@@ -447,6 +447,7 @@ Mosaic build_mosaic(ocl::Runtime& runtime, io::Dataset& dataset, const Extrinsic
   check_options(options);
   if (!extrinsics.finite() || !(extrinsics.z > 0))
     throw_invalid_argument("mosaic: the extrinsics must be finite numbers with a height z > 0");
+  if (!options.accept_unusual_extrinsics) check_plausible_extrinsics(extrinsics, "mosaic: the extrinsics");
   if (frames.empty()) throw_invalid_input("mosaic: no poses: the trajectory is empty");
   check_frames(dataset, frames);
   const CameraModel& cam = dataset.camera();

@@ -35,6 +35,9 @@ struct MosaicOptions {
   bool estimate_gain = true;  // a gain per frame against the mosaic built so far
   int max_side = 20000;       // a mosaic larger than this on a side is refused (InvalidInput)
   int tile_size = 256;
+  // Extrinsics outside core/extrinsics.h's plausible ranges (millimetres for metres, degrees for
+  // radians) are refused (InvalidArgument naming the likely mistake) unless this is set.
+  bool accept_unusual_extrinsics = false;
   // fraction done, stage; returns false to cancel (Error(Cancelled)).
   std::function<bool(double, const char*)> progress;
 };

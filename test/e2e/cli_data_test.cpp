@@ -387,6 +387,18 @@ TEST(CliPlausibility, UnitMistakesAreExit2AndForceLetsAnUnusualRigThrough) {
   r = test::run_cli("track " + seq + " --quiet --force --extrinsics " + yaml + " -o " + traj);
   EXPECT_NE(r.exit_code, 2) << r.output;  // let through (and, being wrong, it loses frames: exit 1)
   EXPECT_TRUE(std::filesystem::exists(traj));
+
+  // The mosaic of a good trajectory with the extrinsics in degrees: refused, nothing written; with
+  // --force built.
+  const std::string good = (d / "good.txt").string(), png = (d / "floor.png").string();
+  r = test::run_cli("track " + seq + " --quiet --extrinsics " + seq + "/extrinsics_gt.yaml -o " + good);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  r = test::run_cli("mosaic " + seq + " --quiet --trajectory " + good + " --extrinsics " + yaml + " -o " + png);
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("roll = 12.4 rad is more than a turn: degrees by mistake?"), std::string::npos) << r.output;
+  EXPECT_FALSE(std::filesystem::exists(png));
+  r = test::run_cli("mosaic " + seq + " --quiet --force --trajectory " + good + " --extrinsics " + yaml + " -o " + png);
+  EXPECT_NE(r.exit_code, 2) << r.output;
 }
 
 }  // namespace

@@ -51,6 +51,8 @@ PLANARVO_API planarvo_status planarvo_mosaic_build(planarvo_context* context, pl
       o.frame_spacing = options->frame_spacing;
       o.estimate_gain = options->estimate_gain != 0;
       o.max_side = options->max_side;
+      if (options->struct_size >= offsetof(planarvo_mosaic_options, accept_unusual_extrinsics) + sizeof(int32_t))
+        o.accept_unusual_extrinsics = options->accept_unusual_extrinsics != 0;
       if (options->progress) {
         const planarvo_progress_fn fn = options->progress;
         void* user = options->progress_user_data;
