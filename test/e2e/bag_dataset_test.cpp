@@ -454,6 +454,31 @@ TEST_F(BagDataset, NonholonomicTakesItsDirectionsFromTheOdometrysSign) {
   }
 }
 
+// The mosaic from a bag (a trajectory tracked from it, the camera from its CameraInfo topic) is
+// the folder's, pixel for pixel (issue 25: bags as first-class data sets), from the bag of each
+// independent writer; without the camera info topic's choice it is the same too (the only one).
+TEST_F(BagDataset, MosaicFromABagIsTheFolders) {
+  SKIP_WITHOUT(rosbag_missing());
+  SKIP_WITHOUT(mcap_missing());
+  const std::string extrinsics = " --extrinsics " + (dataset_dir() / "extrinsics_gt.yaml").string();
+  const auto mosaic_of = [&](const fs::path& data, const std::string& options, const std::string& name) {
+    const fs::path traj = scratch() / (name + ".txt"), png = scratch() / (name + ".png");
+    auto r = run_cli("track --quiet " + data.string() + extrinsics + options + " -o " + traj.string());
+    EXPECT_EQ(r.exit_code, 0) << r.output;
+    r = run_cli("mosaic --quiet " + data.string() + extrinsics + options + " --trajectory " + traj.string() + " -o " +
+                png.string());
+    EXPECT_EQ(r.exit_code, 0) << r.output;
+    std::ifstream in(png, std::ios::binary);
+    return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  };
+  const std::string folder = mosaic_of(dataset_dir(), "", "mosaic_folder");
+  ASSERT_GT(folder.size(), 1000u);
+  EXPECT_EQ(mosaic_of(write_rosbag("mono8_lz4.bag", "--compression lz4"), " --camera-info-topic /camera/camera_info",
+                      "mosaic_rosbag"),
+            folder);
+  EXPECT_EQ(mosaic_of(write_mcap("zstd.mcap", "--compression zstd"), "", "mosaic_mcap"), folder);
+}
+
 // Bad input: a topic that is not there (exit 2, listing the topics there are with their types),
 // a topic of the wrong type, a file that is no bag, a truncated bag, a camera info whose size
 // disagrees with the images.
