@@ -42,7 +42,8 @@ typedef struct planarvo_dataset_options {
    * (sensor_msgs/Image mono8, bgr8, rgb8, bgra8, rgba8, bayer_*8, or CompressedImage); NULL: the
    * bag's only image topic. camera_info_topic (sensor_msgs/CameraInfo, plumb_bob or no
    * distortion) or camera_yaml (OpenCV calibration YAML): the camera; exactly one of them.
-   * odometry_topic, groundtruth_topic: nav_msgs/Odometry. */
+   * odometry_topic, groundtruth_topic: nav_msgs/Odometry; odometry_topic NULL: the bag's only
+   * Odometry topic other than groundtruth_topic, none when it has several. */
   const char* image_topic;
   const char* camera_info_topic;
   const char* camera_yaml;

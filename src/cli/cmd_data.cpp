@@ -66,13 +66,16 @@ void print_bag_streams(const std::vector<BagTopic>& topics, const Args& args) {
     return name;
   };
   const auto line = [&](const char* label, const std::string& option, std::initializer_list<const char*> types,
-                        bool picks_the_only_one) {
-    const std::vector<BagTopic> candidates = of_type(types);
+                        bool picks_the_only_one, const std::string& taken = "") {
+    std::vector<BagTopic> candidates = of_type(types);
+    candidates.erase(std::remove_if(candidates.begin(), candidates.end(),
+                                    [&](const BagTopic& t) { return t.name == taken; }),
+                     candidates.end());
     std::string text;
     if (args.has(option)) {
       text = find(args.get(option));
     } else if (picks_the_only_one && candidates.size() == 1) {
-      text = candidates[0].described() + ", the only one";
+      text = candidates[0].described() + (taken.empty() ? ", the only one" : ", the only one besides " + taken);
     } else if (candidates.empty()) {
       text = "none in the bag";
     } else {
@@ -88,7 +91,8 @@ void print_bag_streams(const std::vector<BagTopic>& topics, const Args& args) {
     std::printf("  %-11s %s\n", "camera from", args.get("camera").c_str());
   else
     line("camera from", "camera-info-topic", {"sensor_msgs/CameraInfo", "sensor_msgs/msg/CameraInfo"}, true);
-  line("odometry", "odom-topic", {"nav_msgs/Odometry", "nav_msgs/msg/Odometry"}, false);
+  // Odometry: the only Odometry topic besides the ground truth's (the library's rule, io/dataset/dataset_bag.cpp).
+  line("odometry", "odom-topic", {"nav_msgs/Odometry", "nav_msgs/msg/Odometry"}, true, args.get("groundtruth-topic"));
   line("groundtruth", "groundtruth-topic", {"nav_msgs/Odometry", "nav_msgs/msg/Odometry"}, false);
 }
 

@@ -390,6 +390,48 @@ TEST_F(BagDataset, CalibrateReadsTheOdometryTopic) {
   }
 }
 
+// Issue 25: a bag's only nav_msgs/Odometry topic besides the ground truth's is its odometry, as
+// its only image and CameraInfo topics are picked: the frames' odometry is then the folder's.
+// With two candidates and neither named, none is (which is which is the user's to say).
+TEST_F(BagDataset, TheOnlyOdometryTopicIsPickedByItself) {
+  SKIP_WITHOUT(rosbag_missing());
+  SKIP_WITHOUT(mcap_missing());
+  const fs::path rosbag = rewrite_rosbag(write_rosbag("mono8_lz4.bag", "--compression lz4"), "no_truth.bag",
+                                         "  if topic != '/ground_truth': out.write(topic, m, t)\n");
+  const fs::path mcap = write_mcap("zstd.mcap", "--compression zstd");
+  const auto odometry_of = [](const fs::path& path, const char* groundtruth_topic) {
+    planarvo_dataset_options o;
+    planarvo_dataset_options_init(&o);
+    o.groundtruth_topic = groundtruth_topic;
+    planarvo_dataset* d = nullptr;
+    EXPECT_EQ(planarvo_dataset_open(path.string().c_str(), &o, &d), PLANARVO_OK) << planarvo_last_error();
+    test::ApiDataset dataset(d);
+    planarvo_dataset_info info{};
+    info.struct_size = sizeof info;
+    EXPECT_EQ(planarvo_dataset_info_get(d, &info), PLANARVO_OK);
+    std::vector<planarvo_frame_data> frames;
+    for (int64_t i = 0; info.has_odometry && i < info.frame_count; ++i) {
+      planarvo_frame_data f{};
+      EXPECT_EQ(planarvo_dataset_frame_data(d, i, &f), PLANARVO_OK);
+      frames.push_back(f);
+    }
+    return frames;
+  };
+  for (const auto& [bag, groundtruth] : {std::pair{rosbag, (const char*)nullptr}, std::pair{mcap, "/ground_truth"}}) {
+    SCOPED_TRACE(bag.string());
+    const std::vector<planarvo_frame_data> frames = odometry_of(bag, groundtruth);
+    ASSERT_EQ(frames.size(), folder_.size());
+    double worst = 0;
+    for (size_t i = 0; i < frames.size(); ++i) {
+      ASSERT_EQ(frames[i].has_odometry, folder_[i].data.has_odometry) << i;
+      const planarvo_se2 &a = frames[i].odometry, &b = folder_[i].data.odometry;
+      worst = std::max({worst, std::abs(a.x - b.x), std::abs(a.y - b.y), std::abs(a.theta - b.theta)});
+    }
+    EXPECT_LE(worst, 1e-9);
+  }
+  EXPECT_TRUE(odometry_of(mcap, nullptr).empty());  // /odom and /ground_truth, neither named
+}
+
 // Issue 25: the nonholonomic method from a bag, whose direction labels come from the odometry's
 // sign (a bag has no direction.txt). Against an independent route to the same numbers: the folder
 // with its direction.txt removed, where the graph takes the labels from odometry.txt's sign; and

@@ -187,9 +187,18 @@ Topics select_topics(const bag::BagFile& file, const BagDatasetOptions& o) {
     t.info = find_topic(file, o.camera_info_topic, {MessageKind::CameraInfo}, "--camera-info-topic");
   else if (o.camera_yaml.empty())
     t.info = only_topic(file, {MessageKind::CameraInfo}, "the camera (--camera-info-topic, or --camera FILE)", true);
-  if (!o.odometry_topic.empty()) t.odom = find_topic(file, o.odometry_topic, {MessageKind::Odometry}, "--odom-topic");
   if (!o.groundtruth_topic.empty())
     t.gt = find_topic(file, o.groundtruth_topic, {MessageKind::Odometry}, "--groundtruth-topic");
+  if (!o.odometry_topic.empty()) {
+    t.odom = find_topic(file, o.odometry_topic, {MessageKind::Odometry}, "--odom-topic");
+  } else {
+    // The bag's only Odometry topic besides the ground truth's; none when there are several (a
+    // simulator's /odom and /ground_truth: which is which is the user's to say).
+    std::vector<uint32_t> odometry;
+    for (uint32_t i = 0; i < file.topics().size(); ++i)
+      if (bag::message_kind(file.topics()[i].type) == MessageKind::Odometry && t.gt != i) odometry.push_back(i);
+    if (odometry.size() == 1) t.odom = odometry[0];
+  }
   return t;
 }
 

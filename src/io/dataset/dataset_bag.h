@@ -26,7 +26,7 @@ struct BagDatasetOptions {
   std::string image_topic;        // empty: the bag's only image topic
   std::string camera_info_topic;  // these two empty: the bag's only CameraInfo topic
   std::string camera_yaml;
-  std::string odometry_topic;     // empty: none
+  std::string odometry_topic;     // empty: the only nav_msgs/Odometry topic but groundtruth_topic, else none
   std::string groundtruth_topic;  // empty: none
   bool use_receive_time = false;  // time by the recorder's receive time, not header stamps
 };
