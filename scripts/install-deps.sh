@@ -16,6 +16,8 @@ packages=(
   # clang with libFuzzer and the sanitizers' runtimes.
   clang libclang-rt-dev
   python3 python3-numpy python3-pytest
+  # python/tests/test_typing.py: mypy --strict over the examples and the package (issue 25).
+  python3-mypy
   # planarvo plot (python/planarvo/plot): the figures and the calibration report.
   python3-matplotlib
   # ROS 1 bag tests: the official writer (brings python3-roslz4) and the message modules

@@ -14,13 +14,17 @@ import argparse
 import math
 import sys
 import tempfile
+from typing import TYPE_CHECKING, List, cast
 
 import numpy as np
 
 import planarvo
 
+if TYPE_CHECKING:  # numpy.typing (numpy 1.21+) for the type checker only: the example runs with an older numpy
+    from numpy.typing import NDArray
 
-def main(argv):
+
+def main(argv: List[str]) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--seconds", type=float, default=8.0, help="length of the drive (default 8)")
     parser.add_argument("--plot", default="trajectory.png", help="where to save the plot (default trajectory.png)")
@@ -52,7 +56,8 @@ def main(argv):
                     for i in range(info.frame_count):
                         data = ds.frame_data(i)
                         poses.append(tracker.track(ds.frame(i), data.timestamp).pose.as_array())
-                        truth_poses.append(data.groundtruth.as_array())
+                        # A simulated drive has ground truth at every frame.
+                        truth_poses.append(cast(planarvo.SE2, data.groundtruth).as_array())
         plot(np.array(poses), np.array(truth_poses), args.plot)
         return 0
     except planarvo.Error as e:
@@ -62,11 +67,12 @@ def main(argv):
         return 1
 
 
-def plot(poses, truth, path):
+def plot(poses: "NDArray[np.float64]", truth: "NDArray[np.float64]", path: str) -> None:
     try:
-        import matplotlib
+        # Debian's matplotlib (3.6) has neither type stubs nor a py.typed marker: untyped here.
+        import matplotlib  # type: ignore[import]
         matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
+        import matplotlib.pyplot as plt  # type: ignore[import]
     except ImportError:
         print("matplotlib is not installed (apt-get install python3-matplotlib): no plot")
         return

@@ -9,6 +9,7 @@ Without PLANARVO_LIBRARY the system's library search path is used (libplanarvo.s
 import ctypes
 import os
 import sys
+from typing import Optional
 
 
 class DeviceInfo(ctypes.Structure):
@@ -44,7 +45,7 @@ class PlanarvoError(RuntimeError):
     pass
 
 
-def load(path=None):
+def load(path: Optional[str] = None) -> ctypes.CDLL:
     lib = ctypes.CDLL(path or os.environ.get("PLANARVO_LIBRARY") or "libplanarvo.so.0.2")
     lib.planarvo_version_string.restype = ctypes.c_char_p
     lib.planarvo_last_error.restype = ctypes.c_char_p
@@ -60,13 +61,13 @@ def load(path=None):
     return lib
 
 
-def check(lib, status):
+def check(lib: ctypes.CDLL, status: int) -> None:
     if status != 0:
         raise PlanarvoError("%s: %s" % (lib.planarvo_status_name(status).decode(),
                                         lib.planarvo_last_error().decode()))
 
 
-def main():
+def main() -> int:
     lib = load()
     print("planarvo", lib.planarvo_version_string().decode())
     count = ctypes.c_size_t(0)

@@ -23,6 +23,7 @@ import ctypes.util
 import math
 import os
 import sys
+from typing import List, Optional
 
 c_int32, c_int64, c_double, c_size_t = ctypes.c_int32, ctypes.c_int64, ctypes.c_double, ctypes.c_size_t
 c_enum = ctypes.c_int  # a C enum
@@ -121,7 +122,7 @@ P = ctypes.POINTER
 VOID_P = ctypes.c_void_p
 
 
-def load_library():
+def load_library() -> ctypes.CDLL:
     path = os.environ.get("PLANARVO_LIBRARY") or ctypes.util.find_library("planarvo") or "libplanarvo.so.0.2"
     lib = ctypes.CDLL(path)
     signatures = {
@@ -153,18 +154,19 @@ def load_library():
 class Failure(Exception):
     """A failed call: the message and the exit status it gives."""
 
-    def __init__(self, message, exit_status):
+    def __init__(self, message: str, exit_status: int) -> None:
         super().__init__(message)
         self.exit_status = exit_status
 
 
-def check(lib, status, what):
+def check(lib: ctypes.CDLL, status: int, what: str) -> None:
     if status != OK:
         exit_status = 2 if status in (INVALID_ARGUMENT, INVALID_INPUT) else 1
         raise Failure("%s: %s" % (what, lib.planarvo_last_error().decode(errors="replace")), exit_status)
 
 
-def track(lib, context, dataset, info, extrinsics, trajectory_path):
+def track(lib: ctypes.CDLL, context: ctypes.c_void_p, dataset: ctypes.c_void_p, info: DatasetInfo,
+          extrinsics: Extrinsics, trajectory_path: str) -> None:
     """Tracks every frame and writes the poses (relative to the first frame) as a TUM trajectory."""
     n = info.frame_count
     times, poses = (c_double * n)(), (SE2 * n)()
@@ -190,7 +192,8 @@ def track(lib, context, dataset, info, extrinsics, trajectory_path):
           % (n, lost, last.x, last.y, math.degrees(last.theta), trajectory_path))
 
 
-def calibrate(lib, context, dataset, info, height, out_path):
+def calibrate(lib: ctypes.CDLL, context: ctypes.c_void_p, dataset: ctypes.c_void_p, info: DatasetInfo, height: float,
+              out_path: Optional[str]) -> None:
     """Calibrates the extrinsics from the drive, prints them and writes them to out_path if given."""
     names = ("x", "y", "z", "roll", "pitch", "yaw")
     options = CameraCalibrationOptions()
@@ -222,7 +225,7 @@ def calibrate(lib, context, dataset, info, height, out_path):
         print("wrote %s" % out_path)
 
 
-def main(argv):
+def main(argv: List[str]) -> int:
     if len(argv) not in (4, 5):
         print("usage: track_and_calibrate.py DATASET EXTRINSICS.yaml TRAJECTORY.txt [CALIBRATED.yaml]",
               file=sys.stderr)

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import ctypes
 from dataclasses import dataclass
-from typing import Optional, Sequence, Tuple
+from typing import Optional, Sequence, Tuple, cast
 
 import numpy as np
 
@@ -14,7 +14,7 @@ from ._errors import IntEnum, Status, _check
 from ._motion_pairs import MotionPair, _pairs_array
 from ._native import lib
 from ._posegraph import SolverSummary
-from ._util import LogFn, PathLike, _c_options, _Callback, _fill_matrix, _matrix, _opt, _path
+from ._util import ArrayLike, LogFn, NDArray, PathLike, _c_options, _Callback, _fill_matrix, _matrix, _opt, _path
 
 
 class CalibrationMethod(IntEnum):
@@ -72,8 +72,8 @@ def _calibration_options(options: Optional[CalibrationOptions], log: Optional[_C
 class CalibrationResult:
     """A graph calibration: value (x, y, scale, yaw), its (4, 4) covariance; per parameter
     estimated and observable; ok when converged, observable and not ambiguous."""
-    value: np.ndarray
-    covariance: np.ndarray
+    value: NDArray[np.float64]
+    covariance: NDArray[np.float64]
     estimated: Tuple[bool, ...]
     observable: Tuple[bool, ...]
     ambiguous: bool
@@ -139,16 +139,16 @@ class PairResiduals:
     own standard deviation. odometry_noise: (3, 3) the fitted model's variance coefficients per
     component (constant, per m^2 of travel, per rad^2 of turn), None when the options' model was
     used."""
-    d: np.ndarray
-    cov: np.ndarray
-    chi2: np.ndarray
-    outlier: np.ndarray
-    has_odometry: np.ndarray
-    odometry_noise: Optional[np.ndarray]
+    d: NDArray[np.float64]
+    cov: NDArray[np.float64]
+    chi2: NDArray[np.float64]
+    outlier: NDArray[np.bool_]
+    has_odometry: NDArray[np.bool_]
+    odometry_noise: Optional[NDArray[np.float64]]
 
     @property
-    def normalised(self) -> np.ndarray:
-        return self.d / np.sqrt(np.maximum(np.einsum("nii->ni", self.cov), 1e-300))
+    def normalised(self) -> NDArray[np.float64]:
+        return cast("NDArray[np.float64]", self.d / np.sqrt(np.maximum(np.einsum("nii->ni", self.cov), 1e-300)))
 
 
 def calibrate_residuals(pairs: Sequence[MotionPair], options: Optional[CalibrationOptions] = None
@@ -176,8 +176,8 @@ def calibrate_residuals(pairs: Sequence[MotionPair], options: Optional[Calibrati
     return result, residuals
 
 
-def compose_extrinsics(roll: float, pitch: float, roll_pitch_covariance: Optional[np.ndarray],
-                       graph: CalibrationResult) -> Tuple[Extrinsics, np.ndarray, Tuple[bool, ...]]:
+def compose_extrinsics(roll: float, pitch: float, roll_pitch_covariance: Optional[ArrayLike],
+                       graph: CalibrationResult) -> Tuple[Extrinsics, NDArray[np.float64], Tuple[bool, ...]]:
     """The camera's extrinsics from roll and pitch (with their (2, 2) covariance, or None when
     they were given) and a graph calibration's x, y, scale (the height) and yaw: returns the
     extrinsics, their (6, 6) covariance (order x y z roll pitch yaw) and per parameter whether it

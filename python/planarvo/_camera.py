@@ -4,14 +4,14 @@ from __future__ import annotations
 
 import ctypes
 from dataclasses import dataclass
-from typing import Optional, Sequence, Tuple
+from typing import Optional, Sequence, Tuple, cast
 
 import numpy as np
 
 from . import _native as N
 from ._errors import _check
 from ._native import lib
-from ._util import PathLike, _fill_matrix, _matrix, _opt, _path
+from ._util import ArrayLike, NDArray, PathLike, _fill_matrix, _matrix, _opt, _path
 
 
 @dataclass
@@ -86,7 +86,7 @@ class Extrinsics:
         _check(lib.planarvo_extrinsics_load(_path(path), ctypes.byref(e)))
         return cls._from_c(e)
 
-    def save(self, path: PathLike, covariance: Optional[np.ndarray] = None, estimated: Sequence[str] = (),
+    def save(self, path: PathLike, covariance: Optional[ArrayLike] = None, estimated: Sequence[str] = (),
              method: Optional[str] = None, notes: Optional[str] = None) -> None:
         """Writes extrinsics YAML: covariance a (6, 6) array (order x y z roll pitch yaw) or None
         (zeros); estimated the names of the estimated parameters."""
@@ -103,13 +103,13 @@ class Extrinsics:
                                             ",".join(estimated).encode() if estimated else None,
                                             _opt(method), _opt(notes)))
 
-    def matrix(self) -> np.ndarray:
+    def matrix(self) -> NDArray[np.float64]:
         """T_robot_camera as a (4, 4) float64 array."""
         m = (ctypes.c_double * 16)()
         _check(lib.planarvo_extrinsics_matrix(ctypes.byref(self._to_c()), m))
         return _matrix(m, 4)
 
-    def as_array(self) -> np.ndarray:
+    def as_array(self) -> NDArray[np.float64]:
         """(x, y, z, roll, pitch, yaw) as a float64 array of shape (6,)."""
         return np.array([getattr(self, n) for n in EXTRINSICS_NAMES])
 
@@ -127,7 +127,7 @@ class ExtrinsicsFile:
     covariance in EXTRINSICS_NAMES order (zeros when the file has none), the names of the
     estimated parameters, and the method and notes ('' when absent)."""
     extrinsics: Extrinsics
-    covariance: np.ndarray
+    covariance: NDArray[np.float64]
     estimated: Tuple[str, ...]
     method: str
     notes: str
@@ -141,11 +141,11 @@ class ExtrinsicsFile:
                    f.method.decode("utf-8", "replace"), f.notes.decode("utf-8", "replace"))
 
     @property
-    def values(self) -> np.ndarray:
+    def values(self) -> NDArray[np.float64]:
         """(x, y, z, roll, pitch, yaw), shape (6,)."""
         return self.extrinsics.as_array()
 
     @property
-    def sigmas(self) -> np.ndarray:
+    def sigmas(self) -> NDArray[np.float64]:
         """The standard deviations of the six, from the covariance's diagonal."""
-        return np.sqrt(np.maximum(np.diag(self.covariance), 0.0))
+        return cast("NDArray[np.float64]", np.sqrt(np.maximum(np.diag(self.covariance), 0.0)))

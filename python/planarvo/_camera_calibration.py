@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import ctypes
 from dataclasses import dataclass, field
-from typing import Optional, Tuple
+from typing import Optional, Tuple, Union, cast
 
 import numpy as np
 
@@ -19,7 +19,7 @@ from ._handle import _Handle
 from ._native import lib
 from ._se2 import SE2
 from ._tracking import TrackerOptions, _tracker_options
-from ._util import PathLike, ProgressFn, _c_options, _Callback, _matrix, _opt, _path
+from ._util import NDArray, PathLike, ProgressFn, _c_options, _Callback, _matrix, _opt, _path
 
 
 class CalibrationStatus(IntEnum):
@@ -50,7 +50,7 @@ class RollPitchResult:
     reason: str
     roll: float
     pitch: float
-    covariance: np.ndarray
+    covariance: NDArray[np.float64]
     frames_used: int
     keyframes: int
     pairs: int
@@ -75,7 +75,7 @@ class RollPitch(_Handle):
                                               ctypes.byref(h)))
         self._own(h, context)
 
-    def add_frame(self, frame: np.ndarray, timestamp: float) -> bool:
+    def add_frame(self, frame: NDArray[Union[np.uint8, np.float32]], timestamp: float) -> bool:
         """Feeds one frame (as Tracker.track takes it); True once the map is complete."""
         image, keep = _image(frame, self.camera.width, self.camera.height)
         complete = ctypes.c_int32(0)
@@ -125,7 +125,7 @@ class CameraCalibrationResult:
     status: CalibrationStatus
     reason: str
     extrinsics: Extrinsics
-    covariance: np.ndarray
+    covariance: NDArray[np.float64]
     estimated: Tuple[bool, ...]
     observable: Tuple[bool, ...]
     roll_pitch: RollPitchResult
@@ -159,9 +159,9 @@ class CameraCalibrationResult:
         _check(lib.planarvo_camera_calibration_save(_path(path), ctypes.byref(self._c), _opt(notes)))
 
     @property
-    def sigmas(self) -> np.ndarray:
+    def sigmas(self) -> NDArray[np.float64]:
         """Standard deviations of (x, y, z, roll, pitch, yaw); 0 where not estimated."""
-        return np.sqrt(np.maximum(np.diag(self.covariance), 0.0))
+        return cast("NDArray[np.float64]", np.sqrt(np.maximum(np.diag(self.covariance), 0.0)))
 
     @classmethod
     def _from_c(cls, r: N.CameraCalibrationResult) -> "CameraCalibrationResult":
@@ -225,8 +225,8 @@ class CameraCalibrator(_Handle):
                                                      ctypes.byref(self._options.c), ctypes.byref(h)))
         self._own(h, context, self._options)
 
-    def add_frame(self, frame: np.ndarray, timestamp: float, odometry_pose: Optional[SE2] = None,
-                  direction: Optional[int] = None) -> None:
+    def add_frame(self, frame: NDArray[Union[np.uint8, np.float32]], timestamp: float,
+                  odometry_pose: Optional[SE2] = None, direction: Optional[int] = None) -> None:
         """Feeds a frame with the robot's odometry pose at its time and the direction label of the
         interval ending at it (None where there is none)."""
         image, keep = _image(frame, self.camera.width, self.camera.height)

@@ -4,7 +4,7 @@ from __future__ import annotations
 import ctypes
 import os
 from dataclasses import dataclass, fields
-from typing import List, Optional, Sequence, Union
+from typing import List, Optional, Sequence, Union, cast
 
 from . import _native as N
 from ._errors import Status, _check
@@ -15,7 +15,7 @@ from ._util import PathLike, _names, _path
 
 def version() -> str:
     """The loaded library's version, "major.minor.patch"."""
-    return lib.planarvo_version_string().decode()
+    return cast(str, lib.planarvo_version_string().decode())
 
 
 @dataclass

@@ -15,7 +15,7 @@ from ._errors import Error, Status, _check, _error
 from ._handle import _Handle
 from ._native import lib
 from ._se2 import SE2
-from ._util import PathLike, ProgressFn, _Callback, _opt, _path
+from ._util import NDArray, PathLike, ProgressFn, _Callback, _opt, _path
 
 
 @dataclass
@@ -124,12 +124,13 @@ class Dataset(_Handle):
     # A sequence of (timestamp, grey frame): ds[i] (negative i from the end), ds[a:b:c] (a list),
     # iter(ds), len(ds).
     @overload
-    def __getitem__(self, index: int) -> Tuple[float, np.ndarray]: ...
+    def __getitem__(self, index: int) -> Tuple[float, NDArray[np.uint8]]: ...
 
     @overload
-    def __getitem__(self, index: slice) -> List[Tuple[float, np.ndarray]]: ...
+    def __getitem__(self, index: slice) -> List[Tuple[float, NDArray[np.uint8]]]: ...
 
-    def __getitem__(self, index: Union[int, slice]) -> Union[Tuple[float, np.ndarray], List[Tuple[float, np.ndarray]]]:
+    def __getitem__(self, index: Union[int, slice]
+                    ) -> Union[Tuple[float, NDArray[np.uint8]], List[Tuple[float, NDArray[np.uint8]]]]:
         n = len(self)
         if isinstance(index, slice):
             return [self[i] for i in range(*index.indices(n))]
@@ -140,7 +141,7 @@ class Dataset(_Handle):
             raise IndexError("frame index %d out of range for a data set of %d frames" % (index, n))
         return self.frame_data(i).timestamp, self.frame(i)
 
-    def __iter__(self) -> Iterator[Tuple[float, np.ndarray]]:
+    def __iter__(self) -> Iterator[Tuple[float, NDArray[np.uint8]]]:
         return self.frames()
 
     def __repr__(self) -> str:
@@ -169,7 +170,7 @@ class Dataset(_Handle):
                          SE2._from_c(d.groundtruth) if d.has_groundtruth else None,
                          d.direction if d.has_direction else None)
 
-    def frame(self, index: int) -> np.ndarray:
+    def frame(self, index: int) -> NDArray[np.uint8]:
         """Frame index decoded as 8-bit grey: a new (H, W) uint8 array."""
         img = N.Image()
         _check(lib.planarvo_dataset_frame(self._h(), index, ctypes.byref(img)))
@@ -179,7 +180,7 @@ class Dataset(_Handle):
         buf = (ctypes.c_uint8 * (img.stride * img.height)).from_address(img.data)
         return np.frombuffer(buf, dtype=np.uint8).reshape(img.height, img.stride)[:, :img.width].copy()
 
-    def frames(self) -> Iterator[Tuple[float, np.ndarray]]:
+    def frames(self) -> Iterator[Tuple[float, NDArray[np.uint8]]]:
         """(timestamp, grey frame) for every frame in order."""
         for i in range(len(self)):
             yield self.frame_data(i).timestamp, self.frame(i)

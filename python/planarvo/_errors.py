@@ -3,7 +3,7 @@ message."""
 from __future__ import annotations
 
 import enum
-from typing import Any
+from typing import Any, Callable, Tuple
 
 from ._native import lib
 
@@ -43,7 +43,7 @@ class Error(Exception):
         self.result = result
         super().__init__("%s: %s" % (self.status_name, message))
 
-    def __reduce__(self):
+    def __reduce__(self) -> Tuple[Callable[[int, str, Any], Error], Tuple[int, str, Any]]:
         # Pickled with its own arguments, so that it crosses processes (multiprocessing,
         # concurrent.futures) as itself, of the same class.
         return (_error, (int(self.status), self.message, self.result))

@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import ctypes
 from dataclasses import dataclass, fields
-from typing import Any, Optional, Sequence
+from typing import Optional, Sequence
 
 import numpy as np
 
@@ -11,6 +11,7 @@ from . import _native as N
 from ._errors import _check
 from ._native import lib
 from ._se2 import _se2_array
+from ._util import ArrayLike
 
 
 @dataclass
@@ -29,8 +30,8 @@ class MotionAccuracy:
     endpoint_heading: float
 
 
-def evaluate_motions(estimated: Any, truth: Any, dt: Sequence[float], valid: Optional[Sequence[bool]] = None,
-                     gross_threshold: float = 1e-3) -> MotionAccuracy:
+def evaluate_motions(estimated: ArrayLike, truth: ArrayLike, dt: Sequence[float],
+                     valid: Optional[Sequence[bool]] = None, gross_threshold: float = 1e-3) -> MotionAccuracy:
     """Compares (N, 3) estimated motions with (N, 3) true ones over intervals of dt (N,) seconds;
     valid (N,) flags leave intervals out of the per-interval figures (None: all count)."""
     e, t = _se2_array(estimated, "estimated"), _se2_array(truth, "truth")

@@ -1,15 +1,16 @@
 """Frames: numpy arrays as planarvo_image, validated before any C call."""
 from __future__ import annotations
 
-from typing import Any, Optional, Tuple
+from typing import Optional, Tuple, Union, cast
 
 import numpy as np
 
 from . import _native as N
+from ._util import NDArray
 
 
-def _image(frame: Any, width: Optional[int] = None, height: Optional[int] = None,
-           out: Optional[N.Image] = None) -> Tuple[N.Image, np.ndarray]:
+def _image(frame: object, width: Optional[int] = None, height: Optional[int] = None,
+           out: Optional[N.Image] = None) -> Tuple[N.Image, NDArray[Union[np.uint8, np.float32]]]:
     """A planarvo_image over frame's memory (no copy): uint8 (H, W) grey or (H, W, 3) BGR, or
     float32 (H, W) grey levels 0..255; any positive row stride, contiguous pixels. Raises
     ValueError with the reason for anything else, or a size other than width x height."""
@@ -46,7 +47,8 @@ def _image(frame: Any, width: Optional[int] = None, height: Optional[int] = None
         raise ValueError("frame: rows must be in increasing memory order without overlap (row stride %d bytes)"
                          % frame.strides[0])
     if (width is not None and w != width) or (height is not None and h != height):
-        raise ValueError("frame: %dx%d does not match the camera's %dx%d" % (w, h, width, height))
+        # Every caller gives both width and height (%d of None would raise TypeError).
+        raise ValueError("frame: %dx%d does not match the camera's %dx%d" % (w, h, cast(int, width), cast(int, height)))
     image = out if out is not None else N.Image()
     image.data, image.width, image.height, image.stride, image.format = frame.ctypes.data, w, h, frame.strides[0], fmt
     return image, frame

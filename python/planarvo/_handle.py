@@ -3,12 +3,15 @@ from __future__ import annotations
 
 import ctypes
 import weakref
-from typing import Any
+from types import TracebackType
+from typing import Callable, Optional, Type, TypeVar
 
 from ._native import lib
 
+_H = TypeVar("_H", bound="_Handle")
 
-def _release(destroy, handle, _keep_alive) -> None:
+
+def _release(destroy: Callable[[ctypes.c_void_p], None], handle: ctypes.c_void_p, _keep_alive: object) -> None:
     destroy(handle)
 
 
@@ -17,7 +20,7 @@ class _Handle:
     those, the garbage collector."""
     _destroy_name = ""
 
-    def _own(self, handle: ctypes.c_void_p, *parents: Any) -> None:
+    def _own(self, handle: ctypes.c_void_p, *parents: object) -> None:
         self._handle = handle
         self._children: "weakref.WeakSet[_Handle]" = weakref.WeakSet()
         # The finalizer holds the handles this one needs (a tracker its context), so that they
@@ -44,8 +47,9 @@ class _Handle:
             raise ValueError("%s is closed" % type(self).__name__)
         return self._handle
 
-    def __enter__(self):
+    def __enter__(self: _H) -> _H:
         return self
 
-    def __exit__(self, *exc) -> None:
+    def __exit__(self, exc_type: Optional[Type[BaseException]], exc_value: Optional[BaseException],
+                 traceback: Optional[TracebackType]) -> None:
         self.close()

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import ctypes
 from dataclasses import dataclass
-from typing import Any, Optional, Sequence, Tuple
+from typing import Optional, Sequence, Tuple
 
 import numpy as np
 
@@ -16,7 +16,7 @@ from ._errors import _check
 from ._handle import _Handle
 from ._native import lib
 from ._se2 import _se2_array
-from ._util import PathLike, ProgressFn, _Callback, _path
+from ._util import ArrayLike, NDArray, PathLike, ProgressFn, _Callback, _path
 
 
 @dataclass(frozen=True)
@@ -52,7 +52,7 @@ class Mosaic(_Handle):
                           i.seconds_warp, i.seconds_blend, i.seconds_total)
 
     @property
-    def image(self) -> np.ndarray:
+    def image(self) -> NDArray[np.uint8]:
         """A copy of the 8-bit image."""
         img = N.Image()
         _check(lib.planarvo_mosaic_image(self._h(), ctypes.byref(img)))
@@ -69,7 +69,7 @@ class Mosaic(_Handle):
 
 
 def build_mosaic(context: Context, dataset: Dataset, extrinsics: Extrinsics, timestamps: Sequence[float],
-                 poses: Any, resolution: float = 0.001, max_range: float = 0.0, frame_spacing: float = 0.0,
+                 poses: ArrayLike, resolution: float = 0.001, max_range: float = 0.0, frame_spacing: float = 0.0,
                  estimate_gain: bool = True, max_side: int = 20000,
                  progress: Optional[ProgressFn] = None) -> Mosaic:
     """The mosaic of the data set's frames at the robot's poses: timestamps (N,) in the data set's

@@ -16,7 +16,7 @@ from ._errors import _check
 from ._native import lib
 from ._se2 import SE2
 from ._tracking import TrackerOptions, _tracker_options
-from ._util import PathLike, _fill_matrix, _matrix, _path, _require
+from ._util import NDArray, PathLike, _fill_matrix, _matrix, _path, _require
 
 
 @dataclass
@@ -27,8 +27,8 @@ class MotionPair:
     sensor: SE2
     odometry: Optional[SE2] = None
     direction: Optional[int] = None
-    sensor_covariance: Optional[np.ndarray] = None
-    odometry_covariance: Optional[np.ndarray] = None
+    sensor_covariance: Optional[NDArray[np.float64]] = None
+    odometry_covariance: Optional[NDArray[np.float64]] = None
 
     @classmethod
     def _from_c(cls, p: N.MotionPair) -> "MotionPair":
@@ -54,7 +54,7 @@ class MotionPair:
             _fill_matrix(p.odometry_covariance, self.odometry_covariance, 3, "odometry_covariance")
 
 
-def _pairs_array(pairs: Sequence[MotionPair]):
+def _pairs_array(pairs: Sequence[MotionPair]) -> ctypes.Array[N.MotionPair]:
     a = (N.MotionPair * len(pairs))()
     for p, c in zip(pairs, a):
         p._fill(c)

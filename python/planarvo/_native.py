@@ -13,7 +13,7 @@ import ctypes.util
 import glob
 import os
 import sys
-from typing import List, Optional
+from typing import Dict, List, Optional, Tuple, Type, TypeVar, cast
 
 # The header version these structures mirror: a library older than this lacks fields used here.
 _MIN_VERSION = (0, 2)
@@ -234,7 +234,10 @@ class MosaicInfo(ctypes.Structure):
                 ("seconds_blend", c_double), ("seconds_total", c_double)]
 
 
-def sized(struct_type):
+_S = TypeVar("_S", bound=ctypes.Structure)
+
+
+def sized(struct_type: Type[_S]) -> _S:
     """A zeroed instance of a versioned struct with its struct_size set."""
     s = struct_type()
     s.struct_size = ctypes.sizeof(struct_type)
@@ -242,19 +245,20 @@ def sized(struct_type):
 
 
 # The C types of the library's signature table (planarvo_api_signatures) as ctypes types.
-_SCALARS = {"int": ctypes.c_int, "int32_t": c_int32, "int64_t": c_int64, "size_t": c_size_t, "double": c_double,
-            "float": ctypes.c_float, "uint8_t": ctypes.c_uint8, "void": None}
+_SCALARS: Dict[str, Optional[Type[ctypes._CData]]] = {
+    "int": ctypes.c_int, "int32_t": c_int32, "int64_t": c_int64, "size_t": c_size_t, "double": c_double,
+    "float": ctypes.c_float, "uint8_t": ctypes.c_uint8, "void": None}
 _CALLBACKS = {"planarvo_progress_fn": PROGRESS_FN, "planarvo_log_fn": LOG_FN}
 
 
-def _struct_class(c_name: str):
+def _struct_class(c_name: str) -> Optional[Type[ctypes.Structure]]:
     """The mirror of struct planarvo_<name> in this module (planarvo_motion_pair -> MotionPair), or None."""
     name = "".join(w.capitalize() for w in c_name[len("planarvo_"):].split("_")).replace("Se2", "SE2")
     cls = globals().get(name)
     return cls if isinstance(cls, type) and issubclass(cls, ctypes.Structure) else None
 
 
-def _ctype(c_type: str):
+def _ctype(c_type: str) -> Optional[Type[ctypes._CData]]:
     """The ctypes type of a C type of the signature table; KeyError when this module cannot
     express it (a struct without a mirror)."""
     t = c_type.replace("const ", "").strip()
@@ -274,8 +278,9 @@ def _ctype(c_type: str):
         return c_char_p
     if base == "void" and stars == 1:
         return c_void_p
-    if base in _SCALARS and stars == 1:
-        return P(_SCALARS[base])
+    scalar = _SCALARS.get(base)  # None for void, whose pointer is c_void_p (above)
+    if scalar is not None and stars == 1:
+        return P(scalar)
     cls = _struct_class(base)
     if cls is not None and stars == 1:
         return P(cls)
@@ -284,7 +289,7 @@ def _ctype(c_type: str):
     raise KeyError(c_type)
 
 
-def _signatures(table: str) -> dict:
+def _signatures(table: str) -> Dict[str, Tuple[Optional[Type[ctypes._CData]], List[Type[ctypes._CData]]]]:
     """name -> (restype, argtypes) for each function of the table that this module can declare."""
     out = {}
     for line in table.splitlines():
@@ -292,7 +297,8 @@ def _signatures(table: str) -> dict:
             continue
         name, ret, params = line.split("|")
         try:
-            out[name] = (_ctype(ret), [_ctype(p) for p in params.split(",") if p])
+            # A parameter is never void: _ctype gives its type.
+            out[name] = (_ctype(ret), [cast("Type[ctypes._CData]", _ctype(p)) for p in params.split(",") if p])
         except KeyError:
             pass  # a struct this module does not mirror: the function is not declared
     return out

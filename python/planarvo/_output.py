@@ -3,7 +3,8 @@ plane.txt and the per-frame statistics CSV."""
 from __future__ import annotations
 
 import ctypes
-from typing import Any, Dict, Optional, Sequence, Tuple
+from types import TracebackType
+from typing import Any, Dict, List, Optional, Sequence, Tuple, Type
 
 import numpy as np
 
@@ -12,10 +13,10 @@ from ._errors import _check
 from ._handle import _Handle
 from ._native import lib
 from ._se2 import _se2_array
-from ._util import PathLike, _path
+from ._util import ArrayLike, NDArray, PathLike, _path
 
 
-def read_tum(path: PathLike) -> Tuple[np.ndarray, np.ndarray]:
+def read_tum(path: PathLike) -> Tuple[NDArray[np.float64], NDArray[np.float64]]:
     """A TUM trajectory (planar poses only): timestamps (N,) and poses (N, 3) of (x, y, theta)."""
     n = ctypes.c_size_t()
     _check(lib.planarvo_read_tum(_path(path), None, None, 0, ctypes.byref(n)))
@@ -28,7 +29,7 @@ def read_tum(path: PathLike) -> Tuple[np.ndarray, np.ndarray]:
     return t, poses
 
 
-def read_plane(path: PathLike) -> np.ndarray:
+def read_plane(path: PathLike) -> NDArray[np.float64]:
     """plane.txt (`planarvo track --plane-out`, the simulator's truth): (N, 5) of timestamp, roll,
     pitch, sigma_roll, sigma_pitch (radians)."""
     n = ctypes.c_size_t()
@@ -44,7 +45,7 @@ STATS_COLUMNS = ("timestamp", "vx", "vy", "omega", "iterations", "final_cost", "
                  "roll", "pitch", "sigma_roll", "sigma_pitch", "mounting_changed")
 
 
-def read_stats(path: PathLike) -> Dict[str, np.ndarray]:
+def read_stats(path: PathLike) -> Dict[str, NDArray[Any]]:
     """The per-frame statistics CSV (`planarvo track --stats`, StatsWriter) as one array per
     column, named as in the file's header (STATS_COLUMNS): float64, but iterations (int64),
     status (str) and mounting_changed (bool); roll, pitch and their sigmas NaN where a row has no
@@ -53,7 +54,7 @@ def read_stats(path: PathLike) -> Dict[str, np.ndarray]:
     _check(lib.planarvo_stats_read(_path(path), ctypes.byref(table)))
     try:
         n = lib.planarvo_stats_table_size(table)
-        cols: Dict[str, list] = {name: [] for name in STATS_COLUMNS}
+        cols: Dict[str, List[object]] = {name: [] for name in STATS_COLUMNS}
         row = N.FrameStats()
         for i in range(n):
             _check(lib.planarvo_stats_table_row(table, i, ctypes.byref(row)))
@@ -69,7 +70,7 @@ def read_stats(path: PathLike) -> Dict[str, np.ndarray]:
     return {name: np.array(v, dtype=types.get(name, np.float64)) for name, v in cols.items()}
 
 
-def write_tum(path: PathLike, timestamps: Sequence[float], poses: Any) -> None:
+def write_tum(path: PathLike, timestamps: Sequence[float], poses: ArrayLike) -> None:
     """Writes a TUM trajectory: timestamps (N,), poses (N, 3) of (x, y, theta) or a list of SE2."""
     t = np.ascontiguousarray(timestamps, dtype=np.float64)
     p = _se2_array(poses, "poses")
@@ -117,7 +118,8 @@ class StatsWriter(_Handle):
         """Removes the partial file and leaves path as it was."""
         _Handle.close(self)
 
-    def __exit__(self, exc_type, *exc) -> None:
+    def __exit__(self, exc_type: Optional[Type[BaseException]], exc_value: Optional[BaseException],
+                 traceback: Optional[TracebackType]) -> None:
         if exc_type is None:
             self.close()
         else:

@@ -2,11 +2,12 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, Optional
 
 import numpy as np
 
 from . import _native as N
+from ._util import ArrayLike, NDArray
 
 
 @dataclass
@@ -16,10 +17,11 @@ class SE2:
     y: float = 0.0
     theta: float = 0.0
 
-    def __array__(self, dtype=None, copy=None):  # copy: numpy 2's protocol (always a new array)
+    def __array__(self, dtype: Optional[np.dtype[Any]] = None,
+                  copy: Optional[bool] = None) -> NDArray[Any]:  # copy: numpy 2's protocol (always a new array)
         return np.array([self.x, self.y, self.theta], dtype=dtype or np.float64)
 
-    def as_array(self) -> np.ndarray:
+    def as_array(self) -> NDArray[np.float64]:
         """(x, y, theta) as a float64 array of shape (3,)."""
         return np.array([self.x, self.y, self.theta])
 
@@ -31,7 +33,7 @@ class SE2:
         return N.SE2(self.x, self.y, self.theta)
 
 
-def _se2_array(poses: Any, what: str) -> np.ndarray:
+def _se2_array(poses: ArrayLike, what: str) -> NDArray[np.float64]:
     """(N, 3) float64 C-contiguous from an (N, 3) array or a sequence of SE2."""
     if isinstance(poses, (list, tuple)) and poses and isinstance(poses[0], SE2):
         poses = [p.as_array() for p in poses]

@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import ctypes
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Optional, Tuple
+from typing import TYPE_CHECKING, Optional, Tuple, Union
 
 import numpy as np
 
@@ -15,7 +15,7 @@ from ._frame import _image
 from ._handle import _Handle
 from ._native import lib
 from ._se2 import SE2
-from ._util import PathLike, _c_options, _path, _require
+from ._util import NDArray, PathLike, _c_options, _path, _require
 
 if TYPE_CHECKING:
     from ._dataset import Dataset
@@ -108,7 +108,7 @@ class TrackResult:
     status: TrackStatus
     reason: str
     motion: SE2
-    covariance: np.ndarray
+    covariance: NDArray[np.float64]
     pose: SE2
     iterations: Tuple[int, ...]
     levels_used: int
@@ -119,7 +119,7 @@ class TrackResult:
     ms: float
     roll: float = 0.0
     pitch: float = 0.0
-    attitude_covariance: np.ndarray = field(default_factory=lambda: np.zeros((2, 2)))
+    attitude_covariance: NDArray[np.float64] = field(default_factory=lambda: np.zeros((2, 2)))
     mounting: Optional[Extrinsics] = None
     mounting_change: Optional[MountingChange] = None
     attitude_observed: bool = False
@@ -133,18 +133,18 @@ class Residuals:
     norm down-weighted, 0 where invalid; intensity: the keyframe's undistorted image, NaN where it
     has none; threshold: the Huber threshold k in grey levels."""
     level: int
-    residual: np.ndarray
-    weight: np.ndarray
-    intensity: np.ndarray
+    residual: NDArray[np.float32]
+    weight: NDArray[np.float32]
+    intensity: NDArray[np.float32]
     threshold: float
 
     @property
-    def valid(self) -> np.ndarray:
+    def valid(self) -> NDArray[np.bool_]:
         """Pixels compared: a valid keyframe pixel whose warp lands on valid live pixels."""
         return self.weight > 0
 
     @property
-    def outliers(self) -> np.ndarray:
+    def outliers(self) -> NDArray[np.bool_]:
         """Pixels the robust norm down-weighted (|r| > threshold)."""
         return (self.weight > 0) & (self.weight < 1)
 
@@ -152,7 +152,11 @@ class Residuals:
 def _mounting_change(r: N.TrackResult) -> Optional[MountingChange]:
     if not r.mounting_changed:
         return None
-    return MountingChange(r.mounting_change_time, *r.mounting_step, *r.mounting_step_sigma,
+    # Unpacked by name: mypy cannot count positional arguments after an unpacked array.
+    step_roll, step_pitch, step_yaw, step_z = r.mounting_step
+    sigma_roll, sigma_pitch, sigma_yaw, sigma_z = r.mounting_step_sigma
+    return MountingChange(r.mounting_change_time, step_roll, step_pitch, step_yaw, step_z,
+                          sigma_roll, sigma_pitch, sigma_yaw, sigma_z,
                           Extrinsics._from_c(r.changed_mounting), bool(r.mounting_refinement))
 
 
@@ -175,7 +179,8 @@ class Tracker(_Handle):
         self._image = N.Image()
         self._result = N.sized(N.TrackResult)
 
-    def track(self, frame: np.ndarray, timestamp: float, odometry: Optional[SE2] = None) -> TrackResult:
+    def track(self, frame: NDArray[Union[np.uint8, np.float32]], timestamp: float,
+              odometry: Optional[SE2] = None) -> TrackResult:
         """Tracks one frame: uint8 (H, W) grey or (H, W, 3) BGR (or float32 grey), the camera's
         size, any row stride; timestamps in seconds, increasing. odometry: the wheel odometry's
         pose at the frame, if there is one (with the local plane, the camera's height is then
@@ -231,12 +236,12 @@ class TrackedDrive:
     (N, 3) x, y, theta relative to the first frame; motions (N, 3) each frame's motion from the
     previous (zeros for the first); covariances (N, 3, 3) of the motions; statuses (N,) TrackStatus
     values (int8; TrackStatus(s) names one); ms (N,) the engine's time per frame."""
-    times: np.ndarray
-    poses: np.ndarray
-    motions: np.ndarray
-    covariances: np.ndarray
-    statuses: np.ndarray
-    ms: np.ndarray
+    times: NDArray[np.float64]
+    poses: NDArray[np.float64]
+    motions: NDArray[np.float64]
+    covariances: NDArray[np.float64]
+    statuses: NDArray[np.int8]
+    ms: NDArray[np.float64]
 
     def __len__(self) -> int:
         return len(self.times)

@@ -12,7 +12,7 @@ from typing import Any, Callable, Dict, Optional, TypeVar
 import numpy as np
 
 import planarvo
-from planarvo import ExtrinsicsFile
+from planarvo import ExtrinsicsFile as ExtrinsicsFile  # re-exported: the figures' modules take it from here
 
 from ._errors import InputError
 

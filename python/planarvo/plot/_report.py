@@ -7,7 +7,7 @@ import html
 import math
 import os
 import tempfile
-from typing import Dict, List, Optional
+from typing import Dict, List, Optional, Tuple
 
 import numpy as np
 
@@ -73,7 +73,7 @@ def runs_table(data: CalibrationData) -> str:
     return "<table>%s</table>" % "\n".join(rows)
 
 
-def _observability(data: CalibrationData) -> (Dict[str, bool], str):
+def _observability(data: CalibrationData) -> Tuple[Dict[str, bool], str]:
     res = data.whole.result
     obs = {n: bool(o) for n, o, e in zip(("x", "y", "z", "yaw"), res.observable, res.estimated) if e}
     if not res.estimated[2]:
