@@ -24,7 +24,7 @@ from ._errors import (Error, InvalidArgumentError, InvalidInputError, MissingFil
                       Status)
 from ._evaluation import MotionAccuracy, evaluate_motions
 from ._mosaic import Mosaic, MosaicInfo, build_mosaic
-from ._motion_pairs import MotionPair, load_motion_pairs, save_motion_pairs, track_motions
+from ._motion_pairs import MotionPair, load_motion_pairs, save_motion_pairs, sensor_motion, track_motions
 from ._output import STATS_COLUMNS, StatsWriter, read_plane, read_stats, read_tum, write_tum
 from ._posegraph import PosegraphInit, SolverSummary, posegraph_optimize
 from ._se2 import SE2
@@ -43,4 +43,4 @@ __all__ = ["EXTRINSICS_NAMES", "CalibrationMethod", "CalibrationOptions", "Calib
     "RollPitchResult", "SE2", "SimOptions", "SolverSummary", "StatsWriter", "Status", "Tracker",
     "TrackedDrive", "TrackerOptions", "TrackResult", "TrackStatus", "track_dataset", "bag_topics", "calibrate", "calibrate_dataset", "calibrate_residuals", "PairResiduals", "compose_extrinsics",
     "build_mosaic", "default_texture", "evaluate_motions", "list_devices", "load_motion_pairs", "posegraph_optimize", "read_plane", "read_stats", "read_tum", "STATS_COLUMNS",
-    "save_motion_pairs", "simulate", "track_motions", "version", "write_tum"]
+    "save_motion_pairs", "sensor_motion", "simulate", "track_motions", "version", "write_tum"]

@@ -71,14 +71,15 @@ class Mosaic(_Handle):
 def build_mosaic(context: Context, dataset: Dataset, extrinsics: Extrinsics, timestamps: Sequence[float],
                  poses: ArrayLike, resolution: float = 0.001, max_range: float = 0.0, frame_spacing: float = 0.0,
                  estimate_gain: bool = True, max_side: int = 20000,
-                 progress: Optional[ProgressFn] = None) -> Mosaic:
+                 progress: Optional[ProgressFn] = None, accept_unusual_extrinsics: bool = False) -> Mosaic:
     """The mosaic of the data set's frames at the robot's poses: timestamps (N,) in the data set's
     times (seconds after its first frame's stamp for a bag), poses (N, 3) or SE2s, e.g. from
     read_tum of what planarvo track wrote (subtract dataset.info.time_origin_ns * 1e-9 for a bag).
     resolution: metres per pixel; max_range: metres from the camera's foot point (0: 4 x the
     camera height); frame_spacing: metres between frames used (0: automatic, negative: every
     frame). Raises Error (INVALID_INPUT) for a time that is no frame's, no poses, or a mosaic over
-    max_side pixels on a side."""
+    max_side pixels on a side, and InvalidArgumentError for extrinsics outside the plausible ranges
+    (millimetres or degrees by mistake) unless accept_unusual_extrinsics."""
     t = np.ascontiguousarray(timestamps, dtype=np.float64)
     p = _se2_array(poses, "poses")
     if t.ndim != 1 or t.shape[0] != p.shape[0]:
@@ -92,6 +93,7 @@ def build_mosaic(context: Context, dataset: Dataset, extrinsics: Extrinsics, tim
     lib.planarvo_mosaic_options_init(ctypes.byref(o))
     o.resolution, o.max_range, o.frame_spacing = float(resolution), float(max_range), float(frame_spacing)
     o.estimate_gain, o.max_side = int(bool(estimate_gain)), max_side
+    o.accept_unusual_extrinsics = int(bool(accept_unusual_extrinsics))
     cb = _Callback(progress, N.PROGRESS_FN)
     o.progress = cb.c
     e = extrinsics._to_c()

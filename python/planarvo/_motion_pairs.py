@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import ctypes
 from dataclasses import dataclass
-from typing import List, Optional, Sequence
+from typing import List, Optional, Sequence, Tuple
 
 import numpy as np
 
@@ -16,7 +16,7 @@ from ._errors import _check
 from ._native import lib
 from ._se2 import SE2
 from ._tracking import TrackerOptions, _tracker_options
-from ._util import NDArray, PathLike, _fill_matrix, _matrix, _path, _require
+from ._util import ArrayLike, NDArray, PathLike, _fill_matrix, _matrix, _path, _require
 
 
 @dataclass
@@ -77,11 +77,31 @@ def load_motion_pairs(path: PathLike) -> List[MotionPair]:
     return [MotionPair._from_c(p) for p in a[:count.value]]
 
 
+def sensor_motion(extrinsics: Extrinsics, robot_motion: SE2, covariance: Optional[ArrayLike] = None
+                  ) -> Tuple[SE2, Optional[NDArray[np.float64]]]:
+    """The camera's own motion (the graph calibration's sensor motion, docs/conventions.md) from a
+    robot motion tracked with these extrinsics: the motion of the ground point below the camera,
+    turned by its yaw, in units of its height; with the (3, 3) covariance carried through when one
+    is given (planarvo_sensor_motion). Raises InvalidArgumentError unless extrinsics.z > 0."""
+    _require(extrinsics, Extrinsics, "extrinsics")
+    _require(robot_motion, SE2, "robot_motion")
+    e, m, out = extrinsics._to_c(), robot_motion._to_c(), N.SE2()
+    if covariance is None:
+        _check(lib.planarvo_sensor_motion(ctypes.byref(e), ctypes.byref(m), None, ctypes.byref(out), None))
+        return SE2._from_c(out), None
+    cin, cout = (ctypes.c_double * 9)(), (ctypes.c_double * 9)()
+    _fill_matrix(cin, covariance, 3, "covariance")
+    _check(lib.planarvo_sensor_motion(ctypes.byref(e), ctypes.byref(m), cin, ctypes.byref(out), cout))
+    return SE2._from_c(out), _matrix(cout, 3)
+
+
 def track_motions(context: Context, dataset: Dataset, extrinsics: Extrinsics,
                   options: Optional[TrackerOptions] = None) -> List[MotionPair]:
     """Tracks every frame of dataset with extrinsics and returns one motion pair per tracked
-    interval (lost ones left out): the tracker's motion and covariance as the sensor's, with the
-    data set's odometry and direction labels where it has them."""
+    interval (lost ones left out): as the sensor's, the camera's own motion and covariance
+    (sensor_motion() of the tracked one; the tracked one itself at x = y = 0, z = 1, yaw = 0), so
+    that the pairs calibrate correctly whatever extrinsics tracked them, with the data set's
+    odometry and direction labels where it has them."""
     _require(extrinsics, Extrinsics, "extrinsics")
     capacity = max(len(dataset) - 1, 1)
     a = (N.MotionPair * capacity)()

@@ -223,7 +223,7 @@ class CameraCalibrationResult(ctypes.Structure):
 class MosaicOptions(ctypes.Structure):
     _fields_ = [("struct_size", c_size_t), ("resolution", c_double), ("max_range", c_double),
                 ("frame_spacing", c_double), ("estimate_gain", c_int32), ("max_side", c_int32),
-                ("progress", PROGRESS_FN), ("progress_user_data", c_void_p)]
+                ("progress", PROGRESS_FN), ("progress_user_data", c_void_p), ("accept_unusual_extrinsics", c_int32)]
 
 
 class MosaicInfo(ctypes.Structure):

@@ -85,3 +85,14 @@ def test_mosaic_bad_input(context, drive):
         with pytest.raises(planarvo.Error) as err:
             planarvo.build_mosaic(context, ds, e, t, p, progress=lambda f, s: True)
         assert err.value.status == planarvo.Status.CANCELLED
+        # Millimetres for metres (issue 25): refused as a ValueError naming the mistake, unless accepted.
+        mm = planarvo.Extrinsics(e.x * 1e3, e.y * 1e3, e.z * 1e3, e.roll, e.pitch, e.yaw)
+        with pytest.raises(ValueError) as err:
+            planarvo.build_mosaic(context, ds, mm, t, p, resolution=0.01)
+        assert err.value.status == planarvo.Status.INVALID_ARGUMENT and "millimetres" in err.value.message
+        # A camera on a 6 m mast: unusual (over 5 m), accepted when said so.
+        mast = planarvo.Extrinsics(e.x, e.y, 6.0, e.roll, e.pitch, e.yaw)
+        with pytest.raises(ValueError):
+            planarvo.build_mosaic(context, ds, mast, t, p, resolution=0.05)
+        m = planarvo.build_mosaic(context, ds, mast, t, p, resolution=0.05, accept_unusual_extrinsics=True)
+        assert m.info.frames_used > 0

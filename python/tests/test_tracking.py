@@ -91,6 +91,11 @@ def test_track_motions_matches_tracker(context, drive, tracked):
     assert len(pairs) == len(results) - 1
     np.testing.assert_allclose([p.sensor.as_array() for p in pairs],
                                _camera_motions(e, [r.motion.as_array() for r in results[1:]]), rtol=0, atol=1e-12)
+    # planarvo.sensor_motion is that conversion, the covariance carried through with it.
+    m, cov = planarvo.sensor_motion(e, results[-1].motion, results[-1].covariance)
+    np.testing.assert_allclose(m.as_array(), pairs[-1].sensor.as_array(), rtol=0, atol=1e-15)
+    np.testing.assert_allclose(cov, pairs[-1].sensor_covariance, rtol=1e-12, atol=0)
+    assert planarvo.sensor_motion(e, results[-1].motion)[1] is None
     with planarvo.Tracker(context, camera, neutral) as tracker, planarvo.Dataset(drive) as ds:
         mine = [tracker.track(ds.frame(i), ds.frame_data(i).timestamp) for i in range(len(ds))]
     np.testing.assert_allclose([p.sensor.as_array() for p in neutral_pairs], [r.motion.as_array() for r in mine[1:]],
