@@ -72,11 +72,10 @@ int cmd_devices(int argc, char** argv) {
     std::printf("%d  %-11s %s / %s\n", d.index, d.device_type, d.platform_name, d.device_name);
     std::printf("   %s; %s; driver %s\n", d.device_version, d.opencl_c_version, d.driver_version);
     std::printf("   image support %s, fp64 %s, local memory %s, global memory %s, max work-group %llu, "
-                "compute units %u\n",
+                "compute units %u%s\n",
                 d.image_support ? "yes" : "no", d.fp64 ? "yes" : "no", bytes(d.local_mem_size).c_str(),
                 bytes(d.global_mem_size).c_str(), static_cast<unsigned long long>(d.max_work_group_size),
-                d.compute_units);
-    if (d.driver_caches_kernels) std::printf("   compiled kernels cached by the driver itself\n");
+                d.compute_units, d.driver_caches_kernels ? ", compiled kernels cached by the driver" : "");
   }
   return kExitOk;
 }

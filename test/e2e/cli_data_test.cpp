@@ -67,6 +67,7 @@ TEST(CliData, DevicesPrintsWhatTheCApiLists) {
     EXPECT_EQ(numbers_after(third, "max work-group").at(0), static_cast<double>(d.max_work_group_size)) << third;
     EXPECT_EQ(numbers_after(third, "compute units").at(0), d.compute_units) << third;
     EXPECT_NE(third.find(std::string("fp64 ") + (d.fp64 ? "yes" : "no")), std::string::npos) << third;
+    EXPECT_EQ(third.find("kernels cached by the driver") != std::string::npos, d.driver_caches_kernels != 0) << third;
     pocl = pocl || std::string(d.platform_name) == "Portable Computing Language";
   }
   EXPECT_TRUE(pocl) << r.output;  // the CI machine's CPU device
