@@ -45,10 +45,12 @@ class KernelWarmup {
     if (started_ || !useful_) return;
     started_ = true;
     thread_ = std::thread([this] {
+      const auto t0 = std::chrono::steady_clock::now();
       try {
         run(args_, camera_, extrinsics_);
       } catch (const std::exception&) {
       }
+      seconds_ = seconds_since(t0);
     });
   }
   // A progress callback (planarvo_progress_fn) that starts the warm-up at the first report, then
@@ -62,6 +64,8 @@ class KernelWarmup {
   ~KernelWarmup() { wait(); }
   KernelWarmup(const KernelWarmup&) = delete;
   KernelWarmup& operator=(const KernelWarmup&) = delete;
+  // How long it ran (after wait()): over a second or so, it compiled (a first run).
+  double seconds() const { return seconds_; }
   // Seconds spent waiting for it to finish.
   double wait() {
     const auto t0 = std::chrono::steady_clock::now();
@@ -107,6 +111,7 @@ class KernelWarmup {
   const planarvo_camera camera_;
   const planarvo_extrinsics extrinsics_;
   bool useful_ = false, started_ = false;
+  double seconds_ = 0;
   std::thread thread_;
 };
 
@@ -215,9 +220,12 @@ int cmd_demo(int argc, char** argv) {
   std::printf("4. tracking every frame with the true extrinsics\n");
   std::fflush(stdout);
   t0 = std::chrono::steady_clock::now();
-  if (const double waited = warmup.wait(); waited > 0.5)
-    std::printf("   (%.1f s finishing the OpenCL kernels' compilation, begun during step 1: a first run's; they are "
-                "cached now)\n", waited);
+  const double waited = warmup.wait();
+  if (warmup.seconds() > 2.0)
+    std::printf("   (a first run: the OpenCL kernels of steps 4 and 5 were compiled during step 1, in %.1f s%s; they "
+                "are cached now)\n",
+                warmup.seconds(), waited > 0.5 ? (", " + std::to_string(static_cast<int>(waited + 0.5)) +
+                                                  " s of it waited for here").c_str() : "");
   planarvo_tracker_options to;
   planarvo_tracker_options_init(&to);
   const TrackRun run = track_dataset(ctx.get(), ds.get(), info.extrinsics_gt, to, {}, &progress);
