@@ -31,7 +31,8 @@ std::vector<OptionSpec> device_options() {
        "$PLANARVO_DEVICE, else first GPU/accelerator, else CPU"},
       {"kernel-binaries", "DIR", "load prebuilt kernel binaries from DIR; never compile", ""},
       {"cache-dir", "DIR", "kernel program cache directory",
-       "$PLANARVO_CACHE_DIR, else ~/.cache/planarvo, else $TMPDIR/planarvo-UID/programs"},
+       "$PLANARVO_CACHE_DIR, else none with PoCL (which caches compiled kernels itself), else ~/.cache/planarvo, "
+       "else $TMPDIR/planarvo-UID/programs"},
       {"no-cache", "", "do not use the kernel program cache", ""},
   };
 }
