@@ -9,6 +9,10 @@ std::optional<Eigen::Matrix<double, 4, 2>> graph_tilt_jacobian(
     const std::vector<graph::MotionSample>& samples, const std::vector<Eigen::Matrix<double, 3, 2>>& tilt_jacobians,
     const graph::CalibrationOptions& options, const graph::CalibrationResult& result, double step) {
   if (tilt_jacobians.size() != samples.size()) return std::nullopt;
+  // A solve that ended at a scale of 0 or less (a wrong tilt's motions can take it there) is no
+  // start for the graph: nothing to propagate (the result is not ok either).
+  if (!options.fix_scale && options.method == graph::CalibrationMethod::Odometry && !(result.value[2] > 0.0))
+    return std::nullopt;
   graph::CalibrationOptions o = options;
   o.initial = result.value;
   std::vector<bool> outlier(samples.size(), false);

@@ -123,10 +123,20 @@ OdometryPasses::OdometryPasses(Context& ctx)
 }
 
 void OdometryPasses::solve_pass(RobustKernelPtr kernel) {
-  og_ = build_odometry_graph(ctx_, poses_, z_, kernel);
-  ctx_.record(solve(og_.graph, pass_options(o_, kernel != nullptr)));
-  z_ = og_.graph.vector(og_.z);
-  for (size_t i = 0; i < poses_.size(); ++i) poses_[i] = og_.graph.pose(og_.poses[i]);
+  for (int round = 0; round < 2; ++round) {
+    og_ = build_odometry_graph(ctx_, poses_, z_, kernel);
+    ctx_.record(solve(og_.graph, pass_options(o_, kernel != nullptr)));
+    z_ = og_.graph.vector(og_.z);
+    for (size_t i = 0; i < poses_.size(); ++i) poses_[i] = og_.graph.pose(og_.poses[i]);
+    // (x, y, -s, yaw + pi) maps every sensor motion as (x, y, s, yaw) does: a half turn of the
+    // sensor's frame negates its translations, as a negative scale does (eq. 20's model in
+    // docs/conventions.md). A start far off in yaw can end on the negative branch; the same answer
+    // with the height positive, solved there once more so that the graph (and the covariance
+    // taken from it) is the positive one's. The robot's poses are the same on both.
+    if (o_.fix_scale || z_[CI::kHeight] >= 0.0) return;
+    z_[CI::kHeight] = -z_[CI::kHeight];
+    z_[CI::kYaw] = wrap_angle(z_[CI::kYaw] + M_PI);
+  }
 }
 
 SampleResiduals OdometryPasses::sample_chi2() const {
