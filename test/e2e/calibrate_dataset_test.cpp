@@ -301,6 +301,44 @@ TEST(CalibrateDataset, RollAndPitchFromAnotherStartWhenStraightDownFails) {
   EXPECT_EQ(r.frames_lost, 0);
 }
 
+// Stage 1 can also succeed on a wrong minimum: a camera 8 cm high behind the axle over black
+// planks under its own lamp and reflection gave roll and pitch 30.8 and 19.4 deg off from straight
+// down, with which stage 2 lost 234 of 300 frames. The pipeline sees stage 2 lose the held frames,
+// runs stage 1 from the other starts and keeps the one stage 2 holds. The precondition is checked
+// (the estimator alone, from straight down, ends over 5 deg off); the calibration then finds the
+// simulator's truth. (640x480: at 320x240 the first start is already right.)
+TEST(CalibrateDataset, AStage1MinimumThatStage2CannotHoldIsLeftForAnotherStart) {
+  test::ScratchDir dir;
+  ocl::Runtime rt;
+  sim::Options so = drive(6.0, sim::MotionProfile::Mixed, 1);
+  so.texture = test::texture("black_painted_planks.png").string();
+  so.camera = sim::default_camera(640, 480);
+  so.odometry_noise = 0.01;
+  so.extrinsics = {-0.15, 0.05, 0.08, -5 * kDeg, 30 * kDeg, 170 * kDeg};
+  so.lamp_falloff = 0.6;
+  so.reflection = 40;
+  sim::simulate(rt, so, dir.path().string());
+  io::Dataset ds(dir.path().string());
+  {
+    track::RollPitchEstimator alone(rt, ds.camera());
+    for (int64_t i = 0; i < ds.frame_count(); ++i) {
+      const cv::Mat f = ds.frame(i);
+      if (alone.add_frame(f.data, f.cols, f.rows, f.step, ds.timestamp(i))) break;
+    }
+    const track::RollPitchResult first = alone.estimate();
+    ASSERT_TRUE(first.ok()) << first.reason;
+    ASSERT_GT(std::abs(first.roll - so.extrinsics.roll) + std::abs(first.pitch - so.extrinsics.pitch), 5 * kDeg)
+        << "the first start is no longer wrong on this drive; make it harder";
+  }
+  planarvo_status st;
+  const planarvo_camera_calibration_result r = calibrate_c(dir.path().string(), &st);
+  ASSERT_EQ(st, PLANARVO_OK) << r.reason;
+  EXPECT_LT(std::abs(r.extrinsics.roll - so.extrinsics.roll), 0.1 * kDeg);
+  EXPECT_LT(std::abs(r.extrinsics.pitch - so.extrinsics.pitch), 0.1 * kDeg);
+  EXPECT_LT(std::abs(r.extrinsics.z - so.extrinsics.z), 1e-3);
+  EXPECT_EQ(r.frames_lost, 0);
+}
+
 TEST(CalibrateDataset, StandingStillIsTooLittleMotionExit1) {
   // A data set whose every frame is the same image: nothing moves.
   test::ScratchDir dir;
