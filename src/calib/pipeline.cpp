@@ -176,18 +176,33 @@ struct CameraCalibrator::Impl {
        {kOtherStart, kOtherStart}, {kOtherStart, -kOtherStart}, {-kOtherStart, kOtherStart},
        {-kOtherStart, -kOtherStart}}};
   void retry_from_other_starts() {
+    try_other_starts([] { return true; });
+  }
+
+  // A stage 1 estimator from the current start, fed the held frames until its map is complete.
+  std::unique_ptr<track::RollPitchEstimator> estimator_on_held() const {
+    auto e = std::make_unique<track::RollPitchEstimator>(rt, camera, roll_pitch_options());
+    for (const HeldFrame& f : held)
+      if (e->add_frame(f.gray.data, f.gray.cols, f.gray.rows, f.gray.step, f.t)) break;
+    return e;
+  }
+
+  // Stage 1 on the held frames from each of kOtherStarts in turn: the first that succeeds and that
+  // `keep` accepts (called with report.roll_pitch set to it) stays, and true is returned. Else the
+  // start and report.roll_pitch are as they were.
+  template <class Keep>
+  bool try_other_starts(Keep&& keep) {
+    const track::RollPitchResult first = report.roll_pitch;
     for (const std::array<double, 2>& s : kOtherStarts) {
       start_offset = s;
-      track::RollPitchEstimator e(rt, camera, roll_pitch_options());
-      for (const HeldFrame& f : held)
-        if (e.add_frame(f.gray.data, f.gray.cols, f.gray.rows, f.gray.step, f.t)) break;
-      track::RollPitchResult r = e.estimate();
-      if (r.ok()) {
-        report.roll_pitch = std::move(r);
-        return;
-      }
+      track::RollPitchResult r = estimator_on_held()->estimate();
+      if (!r.ok()) continue;
+      report.roll_pitch = std::move(r);
+      if (keep()) return true;
     }
-    start_offset = {0.0, 0.0};  // none helped: the first start's answer stands
+    start_offset = {0.0, 0.0};
+    report.roll_pitch = first;
+    return false;
   }
 
   // The readout time from the held frames, tracked with the tilt known so far; when it finds a
@@ -212,9 +227,7 @@ struct CameraCalibrator::Impl {
     camera.rolling_shutter_readout = report.readout.readout;
     if (!changed || !opt.estimate_roll_pitch) return true;
     const auto t1 = Clock::now();
-    roll_pitch = std::make_unique<track::RollPitchEstimator>(rt, camera, roll_pitch_options());
-    for (const HeldFrame& f : held)
-      if (roll_pitch->add_frame(f.gray.data, f.gray.cols, f.gray.rows, f.gray.step, f.t)) break;
+    roll_pitch = estimator_on_held();
     report.time.roll_pitch += seconds_since(t1);
     if (!estimate_roll_pitch()) return false;
     // The tilt moved (a rolling shutter biases it): the readout once more from there.
@@ -241,8 +254,12 @@ struct CameraCalibrator::Impl {
     held.clear();
   }
 
-  // Stage 2 from its start on the held frames (with stage 1's tilt).
+  // Stage 2 from its start on the held frames (with stage 1's tilt), anything tracked before
+  // forgotten.
   void track_held() {
+    sampler.clear();
+    report.tracking = {};
+    frame_ms.clear();
     start_tracking();
     for (const HeldFrame& f : held) track(f.gray.data, f.gray.cols, f.gray.rows, f.gray.step, f.t, f.odometry, f.direction);
   }
@@ -252,39 +269,16 @@ struct CameraCalibrator::Impl {
   bool tilt_held() const { return report.tracking.frames < 10 || 2 * report.tracking.lost <= report.tracking.frames; }
 
   // Stage 1 succeeded, but stage 2 lost most of the held frames with its tilt: stage 1 found a
-  // wrong minimum. It runs again from the other starts (retry_from_other_starts' set), and a start
-  // is kept when stage 2 then holds the held frames. Measured: a camera 8 cm high over black planks
-  // under its own lamp and reflection, stage 1 30.8 deg off from straight down and from roll
-  // +0.4 rad, right from pitch +-0.4 rad. When none holds, the first answer stands (and is refused
-  // at the end).
+  // wrong minimum. It runs again from the other starts, and a start is kept when stage 2 then
+  // holds the held frames. Measured: a camera 8 cm high over black planks under its own lamp and
+  // reflection, stage 1 30.8 deg off from straight down and from roll +0.4 rad, right from pitch
+  // +-0.4 rad. When none holds, the first answer stands (tracked again; refused at the end).
   void retry_until_tracking_holds() {
-    const track::RollPitchResult first = report.roll_pitch;
-    const PipelineReport::Tracking first_tracking = report.tracking;
-    const std::vector<double> first_ms = frame_ms;
-    const double tracking_time = report.time.tracking;
-    for (const std::array<double, 2>& s : kOtherStarts) {
-      start_offset = s;
-      track::RollPitchEstimator e(rt, camera, roll_pitch_options());
-      for (const HeldFrame& f : held)
-        if (e.add_frame(f.gray.data, f.gray.cols, f.gray.rows, f.gray.step, f.t)) break;
-      track::RollPitchResult r = e.estimate();
-      if (!r.ok()) continue;
-      report.roll_pitch = std::move(r);
-      sampler.clear();
-      report.tracking = {};
-      frame_ms.clear();
+    if (!try_other_starts([this] {
+          track_held();
+          return tilt_held();
+        }))
       track_held();
-      if (tilt_held()) return;
-    }
-    start_offset = {0.0, 0.0};
-    report.roll_pitch = first;
-    sampler.clear();
-    report.tracking = {};
-    frame_ms.clear();
-    track_held();
-    report.tracking = first_tracking;  // the same frames again: as counted the first time
-    frame_ms = first_ms;
-    report.time.tracking = tracking_time;
   }
 
   void add_frame(const uint8_t* gray, int width, int height, size_t stride, double t,
@@ -376,8 +370,8 @@ struct CameraCalibrator::Impl {
   // own lamp and reflection): roll 30.8 deg and pitch 19.4 deg off, 234 of 300 frames lost, and a
   // result with sigmas of 0.06 deg written as if sound. "" when tracking held.
   std::string tilt_not_held() const {
+    if (tilt_held()) return "";
     const PipelineReport::Tracking& k = report.tracking;
-    if (k.frames < 10 || 2 * k.lost <= k.frames) return "";
     char text[400];
     std::snprintf(text, sizeof text,
                   "tracking with the %s roll %.3f deg and pitch %.3f deg lost %d of %d frames: they do not "

@@ -49,22 +49,39 @@ sim::Options drive(double seconds, sim::MotionProfile motion, uint64_t seed) {
 }
 
 planarvo_camera_calibration_result calibrate_c(const std::string& dir, planarvo_status* status,
-                                               planarvo_calibration_method method = PLANARVO_CALIBRATE_ODOMETRY,
-                                               double height = 0) {
+                                               const planarvo_camera_calibration_options& o) {
   planarvo_context* ctx = nullptr;
   EXPECT_EQ(planarvo_context_create(nullptr, &ctx), PLANARVO_OK) << planarvo_last_error();
   std::unique_ptr<planarvo_context, ContextDeleter> context(ctx);
   planarvo_dataset* ds = nullptr;
   EXPECT_EQ(planarvo_dataset_open(dir.c_str(), nullptr, &ds), PLANARVO_OK) << planarvo_last_error();
   std::unique_ptr<planarvo_dataset, DatasetDeleter> dataset(ds);
-  planarvo_camera_calibration_options o;
-  planarvo_camera_calibration_options_init(&o);
-  o.method = method;
-  o.height = height;
   planarvo_camera_calibration_result r{};
   r.struct_size = sizeof r;
   *status = planarvo_calibrate_dataset(ctx, ds, &o, &r);
   return r;
+}
+
+planarvo_camera_calibration_result calibrate_c(const std::string& dir, planarvo_status* status,
+                                               planarvo_calibration_method method = PLANARVO_CALIBRATE_ODOMETRY,
+                                               double height = 0) {
+  planarvo_camera_calibration_options o;
+  planarvo_camera_calibration_options_init(&o);
+  o.method = method;
+  o.height = height;
+  return calibrate_c(dir, status, o);
+}
+
+// Stage 1 alone on a data set's frames, from straight down (the preconditions of the tests of
+// the pipeline's other starts).
+track::RollPitchResult roll_pitch_from_straight_down(ocl::Runtime& rt, const std::string& dir) {
+  io::Dataset ds(dir);
+  track::RollPitchEstimator alone(rt, ds.camera());
+  for (int64_t i = 0; i < ds.frame_count(); ++i) {
+    const cv::Mat f = ds.frame(i);
+    if (alone.add_frame(f.data, f.cols, f.rows, f.step, ds.timestamp(i))) break;
+  }
+  return alone.estimate();
 }
 
 // The tool's printed report against the C API's result: the stage counts and, per parameter,
@@ -240,21 +257,12 @@ TEST(CalibrateDataset, ATiltThatTrackingCannotHoldIsFailedNotWritten) {
   sim::simulate(rt, so, dir.path().string());
   const Extrinsics& t = so.extrinsics;
   const auto calibrate_with = [&](double roll, double pitch, planarvo_status* st) {
-    planarvo_context* ctx = nullptr;
-    EXPECT_EQ(planarvo_context_create(nullptr, &ctx), PLANARVO_OK) << planarvo_last_error();
-    std::unique_ptr<planarvo_context, ContextDeleter> context(ctx);
-    planarvo_dataset* ds = nullptr;
-    EXPECT_EQ(planarvo_dataset_open(dir.path().string().c_str(), nullptr, &ds), PLANARVO_OK) << planarvo_last_error();
-    std::unique_ptr<planarvo_dataset, DatasetDeleter> dataset(ds);
     planarvo_camera_calibration_options o;
     planarvo_camera_calibration_options_init(&o);
     o.estimate_roll_pitch = 0;
     o.has_initial = 1;
     o.initial = {t.x, t.y, t.z, roll, pitch, t.yaw};
-    planarvo_camera_calibration_result r{};
-    r.struct_size = sizeof r;
-    *st = planarvo_calibrate_dataset(ctx, ds, &o, &r);
-    return r;
+    return calibrate_c(dir.path().string(), st, o);
   };
   planarvo_status st;
   const planarvo_camera_calibration_result wrong = calibrate_with(t.roll + 20 * kDeg, t.pitch - 20 * kDeg, &st);
@@ -271,8 +279,9 @@ TEST(CalibrateDataset, ATiltThatTrackingCannotHoldIsFailedNotWritten) {
 // Stage 1 from straight down does not converge on every rig: a car at 15 fps with its camera
 // pitched 35 deg over gravel failed ("the keyframes do not align" on a 10-s drive; on this 6-s one
 // "moved too little": 2 keyframes, the map's tracker at 35 deg off losing the frames). The
-// pipeline then tries other starting tilts on the frames it holds. The precondition is checked here (the estimator alone,
-// from straight down, fails on this drive); the calibration then finds the simulator's truth.
+// pipeline then tries other starting tilts on the frames it holds. The precondition is checked
+// here (the estimator alone, from straight down, fails on this drive); the calibration then finds
+// the simulator's truth.
 TEST(CalibrateDataset, RollAndPitchFromAnotherStartWhenStraightDownFails) {
   test::ScratchDir dir;
   ocl::Runtime rt;
@@ -283,17 +292,9 @@ TEST(CalibrateDataset, RollAndPitchFromAnotherStartWhenStraightDownFails) {
   so.fps = 15;
   so.extrinsics = {0.3, 0.0, 0.25, 0.0, 35 * kDeg, 0.0};
   sim::simulate(rt, so, dir.path().string());
-  io::Dataset ds(dir.path().string());
-  {
-    track::RollPitchEstimator alone(rt, ds.camera());
-    for (int64_t i = 0; i < ds.frame_count(); ++i) {
-      const cv::Mat f = ds.frame(i);
-      if (alone.add_frame(f.data, f.cols, f.rows, f.step, ds.timestamp(i))) break;
-    }
-    const track::RollPitchResult first = alone.estimate();
-    ASSERT_FALSE(first.ok()) << "the drive no longer needs another start; make it harder: " << first.roll / kDeg
-                             << " " << first.pitch / kDeg;
-  }
+  const track::RollPitchResult first = roll_pitch_from_straight_down(rt, dir.path().string());
+  ASSERT_FALSE(first.ok()) << "the drive no longer needs another start; make it harder: " << first.roll / kDeg
+                           << " " << first.pitch / kDeg;
   planarvo_status st;
   const planarvo_camera_calibration_result r = calibrate_c(dir.path().string(), &st);
   ASSERT_EQ(st, PLANARVO_OK) << r.reason;
@@ -319,18 +320,10 @@ TEST(CalibrateDataset, AStage1MinimumThatStage2CannotHoldIsLeftForAnotherStart) 
   so.lamp_falloff = 0.6;
   so.reflection = 40;
   sim::simulate(rt, so, dir.path().string());
-  io::Dataset ds(dir.path().string());
-  {
-    track::RollPitchEstimator alone(rt, ds.camera());
-    for (int64_t i = 0; i < ds.frame_count(); ++i) {
-      const cv::Mat f = ds.frame(i);
-      if (alone.add_frame(f.data, f.cols, f.rows, f.step, ds.timestamp(i))) break;
-    }
-    const track::RollPitchResult first = alone.estimate();
-    ASSERT_TRUE(first.ok()) << first.reason;
-    ASSERT_GT(std::abs(first.roll - so.extrinsics.roll) + std::abs(first.pitch - so.extrinsics.pitch), 5 * kDeg)
-        << "the first start is no longer wrong on this drive; make it harder";
-  }
+  const track::RollPitchResult first = roll_pitch_from_straight_down(rt, dir.path().string());
+  ASSERT_TRUE(first.ok()) << first.reason;
+  ASSERT_GT(std::abs(first.roll - so.extrinsics.roll) + std::abs(first.pitch - so.extrinsics.pitch), 5 * kDeg)
+      << "the first start is no longer wrong on this drive; make it harder";
   planarvo_status st;
   const planarvo_camera_calibration_result r = calibrate_c(dir.path().string(), &st);
   ASSERT_EQ(st, PLANARVO_OK) << r.reason;
